@@ -1,0 +1,24 @@
+// Unit conversions used only at input and output boundaries; everything inside rollsim is SI.
+#pragma once
+
+namespace rollsim::units {
+
+inline constexpr double kStandardGravity_mps2 = 9.80665;
+inline constexpr double kPaPerBar = 1.0e5;
+inline constexpr double kMpsPerKmh = 1.0 / 3.6;
+inline constexpr double kMPerMm = 1.0e-3;
+inline constexpr double kMPerInch = 0.0254;
+inline constexpr double kJPerKwh = 3.6e6;
+inline constexpr double kMPerKm = 1000.0;
+inline constexpr double kM3PerLitre = 1.0e-3;
+inline constexpr double kKelvinOffset = 273.15;
+inline constexpr double kMPerMile = 1609.344;
+
+constexpr double kmh_to_mps(double speed_kmh) { return speed_kmh * kMpsPerKmh; }
+constexpr double mps_to_kmh(double speed_mps) { return speed_mps / kMpsPerKmh; }
+constexpr double bar_to_pa(double pressure_bar) { return pressure_bar * kPaPerBar; }
+constexpr double pa_to_bar(double pressure_pa) { return pressure_pa / kPaPerBar; }
+constexpr double j_to_kwh(double energy_j) { return energy_j / kJPerKwh; }
+constexpr double kwh_to_j(double energy_kwh) { return energy_kwh * kJPerKwh; }
+
+}  // namespace rollsim::units

@@ -1,0 +1,84 @@
+// Strict reading of YAML input files: every key is known, every value is checked and named on error.
+#pragma once
+
+#include <yaml-cpp/yaml.h>
+
+#include <functional>
+#include <initializer_list>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace rollsim {
+
+/// Allowed range of a number read from input. Bounds are inclusive unless marked open.
+struct Range {
+  double min = -1e300;
+  double max = 1e300;
+  bool min_open = false;  ///< true: value must be strictly greater than min
+  bool max_open = false;  ///< true: value must be strictly less than max
+
+  static Range positive() { return {0.0, 1e300, true, false}; }
+  static Range non_negative() { return {0.0, 1e300, false, false}; }
+  static Range fraction() { return {0.0, 1.0, false, false}; }            ///< [0, 1]
+  static Range efficiency() { return {0.0, 1.0, true, false}; }          ///< (0, 1]
+  static Range closed(double lo, double hi) { return {lo, hi, false, false}; }
+  static Range open_low(double lo, double hi) { return {lo, hi, true, false}; }
+  bool contains(double v) const;
+  std::string describe() const;  ///< e.g. "must be > 0", "must be in [0, 1]"
+};
+
+/// A view on one YAML mapping of a file, remembering its path ("vehicle.yaml: body.mass_kg") so that every
+/// error names file and key. Keys read are recorded; finish() rejects any key that was never asked for,
+/// which catches misspellings ("presure_bar") instead of silently using a default.
+class YamlMap {
+ public:
+  /// Loads `path` and returns its top-level mapping; throws InputError if missing or malformed.
+  static YamlMap load_file(const std::string& path);
+  YamlMap(YAML::Node node, std::string file, std::string prefix);
+
+  bool has(const std::string& key) const;
+  double number(const std::string& key, Range range);
+  double number_or(const std::string& key, double fallback, Range range);
+  std::optional<double> optional_number(const std::string& key, Range range);
+  std::string string(const std::string& key);
+  std::string string_or(const std::string& key, const std::string& fallback);
+  std::optional<std::string> optional_string(const std::string& key);
+  bool boolean_or(const std::string& key, bool fallback);
+  /// A list of numbers, each in range; `min_size` elements at least.
+  std::vector<double> numbers(const std::string& key, Range range, std::size_t min_size = 1);
+  std::optional<std::vector<double>> optional_numbers(const std::string& key, Range range,
+                                                      std::size_t min_size = 1);
+  /// A nested mapping; the returned view shares the file name and extends the key path.
+  YamlMap map(const std::string& key);
+  std::optional<YamlMap> optional_map(const std::string& key);
+  /// Marks a key as handled without reading it through this view (e.g. read by a sub-parser).
+  void accept(const std::string& key);
+  /// Throws InputError naming the first key that was never read, with the allowed keys listed.
+  void finish() const;
+
+  const YAML::Node& node() const { return node_; }
+  const std::string& file() const { return file_; }
+  /// "file: key 'prefix.key'" for error messages about `key` of this mapping.
+  std::string where(const std::string& key) const;
+
+ private:
+  YAML::Node get(const std::string& key, bool required);
+  double to_number(const YAML::Node& n, const std::string& key, Range range) const;
+
+  YAML::Node node_;
+  std::string file_;
+  std::string prefix_;
+  std::vector<std::string> read_keys_;
+};
+
+/// Resolves a data file named on the command line: the path as given if it exists, else the same name in
+/// the shipped folder `<source dir>/<shipped_dir>/`, with `.yaml`/`.csv` appended if `extension` is given
+/// and missing. Throws InputError naming the option when nothing is found.
+std::string resolve_data_file(const std::string& name, const std::string& shipped_dir,
+                              const std::string& extension, const std::string& option);
+
+/// The root folder of shipped data (tyres/, vehicles/, cycles/): ROLLSIM_DATA_DIR if set, else the source dir.
+std::string data_root();
+
+}  // namespace rollsim

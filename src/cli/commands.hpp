@@ -1,0 +1,10 @@
+// The subcommands of the rollsim executable; each lives in its own cmd_*.cpp and only glues CLI to library.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace rollsim::cli {
+
+void register_commands(CLI::App& app);
+
+}  // namespace rollsim::cli

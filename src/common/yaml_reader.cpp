@@ -1,0 +1,193 @@
+#include "rollsim/common/yaml_reader.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <sstream>
+
+#include "rollsim/common/error.hpp"
+
+namespace rollsim {
+
+bool Range::contains(double v) const {
+  if (!std::isfinite(v)) return false;
+  if (min_open ? !(v > min) : !(v >= min)) return false;
+  if (max_open ? !(v < max) : !(v <= max)) return false;
+  return true;
+}
+
+std::string Range::describe() const {
+  const bool has_min = min > -1e299;
+  const bool has_max = max < 1e299;
+  if (has_min && has_max) {
+    return std::string("must be in ") + (min_open ? "(" : "[") + format_value(min) + ", " +
+           format_value(max) + (max_open ? ")" : "]");
+  }
+  if (has_min) return std::string("must be ") + (min_open ? "> " : ">= ") + format_value(min);
+  if (has_max) return std::string("must be ") + (max_open ? "< " : "<= ") + format_value(max);
+  return "must be a finite number";
+}
+
+YamlMap YamlMap::load_file(const std::string& path) {
+  if (!std::filesystem::exists(path)) throw InputError(path, "file not found");
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::Exception& e) {
+    throw InputError(path + ": line " + std::to_string(e.mark.line + 1), "malformed YAML: " + e.msg);
+  }
+  if (!root.IsMap()) throw InputError(path, "expected a YAML mapping of keys to values at the top level");
+  return YamlMap(root, path, "");
+}
+
+YamlMap::YamlMap(YAML::Node node, std::string file, std::string prefix)
+    : node_(std::move(node)), file_(std::move(file)), prefix_(std::move(prefix)) {}
+
+std::string YamlMap::where(const std::string& key) const {
+  return file_ + ": key '" + prefix_ + key + "'";
+}
+
+bool YamlMap::has(const std::string& key) const { return node_[key].IsDefined() && !node_[key].IsNull(); }
+
+YAML::Node YamlMap::get(const std::string& key, bool required) {
+  if (std::find(read_keys_.begin(), read_keys_.end(), key) == read_keys_.end()) read_keys_.push_back(key);
+  YAML::Node n = node_[key];
+  if (!n.IsDefined() || n.IsNull()) {
+    if (required) throw InputError(where(key), "required key is missing");
+    return YAML::Node();
+  }
+  return n;
+}
+
+double YamlMap::to_number(const YAML::Node& n, const std::string& key, Range range) const {
+  if (!n.IsScalar()) throw InputError(where(key), "expected a number");
+  const std::string text = n.Scalar();
+  double v = 0.0;
+  try {
+    std::size_t used = 0;
+    v = std::stod(text, &used);
+    if (used != text.size()) throw std::invalid_argument(text);
+  } catch (const std::exception&) {
+    // yaml-cpp spells NaN as .nan; anything else that is not a number is a typo.
+    if (text == ".nan" || text == ".NaN" || text == ".NAN") {
+      v = std::nan("");
+    } else {
+      throw InputError(where(key), "'" + text + "' is not a number");
+    }
+  }
+  if (!range.contains(v)) throw InputError(where(key), format_value(v) + " is not allowed: " + range.describe());
+  return v;
+}
+
+double YamlMap::number(const std::string& key, Range range) { return to_number(get(key, true), key, range); }
+
+double YamlMap::number_or(const std::string& key, double fallback, Range range) {
+  auto v = optional_number(key, range);
+  return v ? *v : fallback;
+}
+
+std::optional<double> YamlMap::optional_number(const std::string& key, Range range) {
+  YAML::Node n = get(key, false);
+  if (!n) return std::nullopt;
+  return to_number(n, key, range);
+}
+
+std::string YamlMap::string(const std::string& key) {
+  YAML::Node n = get(key, true);
+  if (!n.IsScalar()) throw InputError(where(key), "expected a text value");
+  return n.Scalar();
+}
+
+std::string YamlMap::string_or(const std::string& key, const std::string& fallback) {
+  auto v = optional_string(key);
+  return v ? *v : fallback;
+}
+
+std::optional<std::string> YamlMap::optional_string(const std::string& key) {
+  YAML::Node n = get(key, false);
+  if (!n) return std::nullopt;
+  if (!n.IsScalar()) throw InputError(where(key), "expected a text value");
+  return n.Scalar();
+}
+
+bool YamlMap::boolean_or(const std::string& key, bool fallback) {
+  YAML::Node n = get(key, false);
+  if (!n) return fallback;
+  const std::string s = n.IsScalar() ? n.Scalar() : "";
+  if (s == "true" || s == "yes" || s == "on") return true;
+  if (s == "false" || s == "no" || s == "off") return false;
+  throw InputError(where(key), "'" + s + "' is not allowed: must be true or false");
+}
+
+std::vector<double> YamlMap::numbers(const std::string& key, Range range, std::size_t min_size) {
+  YAML::Node n = get(key, true);
+  if (!n.IsSequence()) throw InputError(where(key), "expected a list of numbers, e.g. [1, 2, 3]");
+  if (n.size() < min_size) {
+    throw InputError(where(key), "has " + std::to_string(n.size()) + " values; at least " +
+                                     std::to_string(min_size) + " are needed");
+  }
+  std::vector<double> out;
+  out.reserve(n.size());
+  for (std::size_t i = 0; i < n.size(); ++i) out.push_back(to_number(n[i], key + "[" + std::to_string(i) + "]", range));
+  return out;
+}
+
+std::optional<std::vector<double>> YamlMap::optional_numbers(const std::string& key, Range range,
+                                                             std::size_t min_size) {
+  if (!has(key)) {
+    get(key, false);
+    return std::nullopt;
+  }
+  return numbers(key, range, min_size);
+}
+
+YamlMap YamlMap::map(const std::string& key) {
+  YAML::Node n = get(key, true);
+  if (!n.IsMap()) throw InputError(where(key), "expected a mapping of keys to values");
+  return YamlMap(n, file_, prefix_ + key + ".");
+}
+
+std::optional<YamlMap> YamlMap::optional_map(const std::string& key) {
+  YAML::Node n = get(key, false);
+  if (!n) return std::nullopt;
+  if (!n.IsMap()) throw InputError(where(key), "expected a mapping of keys to values");
+  return YamlMap(n, file_, prefix_ + key + ".");
+}
+
+void YamlMap::accept(const std::string& key) { get(key, false); }
+
+void YamlMap::finish() const {
+  for (const auto& kv : node_) {
+    const std::string key = kv.first.as<std::string>();
+    if (std::find(read_keys_.begin(), read_keys_.end(), key) == read_keys_.end()) {
+      std::ostringstream allowed;
+      for (std::size_t i = 0; i < read_keys_.size(); ++i) allowed << (i ? ", " : "") << read_keys_[i];
+      throw InputError(where(key), "unknown key (misspelt?); allowed here: " + allowed.str());
+    }
+  }
+}
+
+std::string data_root() {
+  if (const char* env = std::getenv("ROLLSIM_DATA_DIR"); env && *env) return env;
+  return ROLLSIM_SOURCE_DIR;
+}
+
+std::string resolve_data_file(const std::string& name, const std::string& shipped_dir,
+                              const std::string& extension, const std::string& option) {
+  namespace fs = std::filesystem;
+  std::vector<fs::path> candidates{fs::path(name)};
+  if (!extension.empty() && fs::path(name).extension() != extension) candidates.emplace_back(name + extension);
+  const fs::path shipped = fs::path(data_root()) / shipped_dir;
+  if (fs::path(name).is_relative()) {
+    candidates.push_back(shipped / name);
+    if (!extension.empty()) candidates.push_back(shipped / (name + extension));
+  }
+  for (const auto& c : candidates) {
+    if (fs::is_regular_file(c)) return c.string();
+  }
+  throw InputError(option + " '" + name + "'",
+                   "file not found (looked in the current folder and in " + shipped.string() + ")");
+}
+
+}  // namespace rollsim

@@ -1,0 +1,154 @@
+#include "rollsim/tyre/tyre_model.hpp"
+
+#include <cmath>
+#include <numbers>
+#include <string>
+
+#include "rollsim/common/error.hpp"
+
+namespace rollsim {
+namespace {
+
+// Geometry of the loaded patch, shared by the reference sum and the prepared tyre.
+struct Patch {
+  double stiffness_n_per_m;
+  double deflection_m;
+  double loaded_radius_m;
+  double half_angle_rad;
+};
+
+Patch loaded_patch(const TyreState& tyre, double load_n) {
+  Patch p{};
+  p.stiffness_n_per_m = vertical_stiffness_n_per_m(tyre);
+  p.deflection_m = load_n / p.stiffness_n_per_m;
+  p.loaded_radius_m = tyre.geometry.outer_radius_m - p.deflection_m;
+  p.half_angle_rad = std::acos(p.loaded_radius_m / tyre.geometry.outer_radius_m);
+  return p;
+}
+
+// Sums over the n + 1 elements of |x_i| (Coulomb lever arms) and |sin theta_i| |x_i| (viscous lever arms per
+// unit rim speed w R). With sign(zdot_i) = -sign(theta_i), every element's moment F_i x_i is non-negative, so
+// M = (Cc/n) S0 + (Cv/n) V S1 exactly as the element-by-element sum, and F = N (the damping forces cancel
+// pairwise by symmetry).
+struct LeverSums {
+  double coulomb_m = 0.0;
+  double viscous_m = 0.0;
+};
+
+LeverSums lever_sums(const Patch& p, int n) {
+  LeverSums s;
+  const double dtheta = 2.0 * p.half_angle_rad / n;
+  for (int i = 0; i <= n; ++i) {
+    const double theta = -p.half_angle_rad + i * dtheta;
+    const double x_abs = std::abs(p.loaded_radius_m * std::tan(theta));
+    const double sin_abs = std::abs(std::sin(theta));
+    if (sin_abs > 0.0) s.coulomb_m += x_abs;  // sign(0) = 0: the centre element carries no force
+    s.viscous_m += sin_abs * x_abs;
+  }
+  return s;
+}
+
+std::string v(double x) { return format_value(x); }
+
+}  // namespace
+
+double vertical_stiffness_n_per_m(const TyreState& tyre) {
+  const double p_bar = tyre.pressure_pa / 1.0e5;
+  const double w_mm = tyre.geometry.section_width_m * 1.0e3;
+  const double d_mm = 2.0 * tyre.geometry.outer_radius_m * 1.0e3;
+  const auto& c = tyre.constants;
+  // Rhyne's fit is in kgf/mm with 0.7 W as contact width; the spec converts with 1e4 (not 9806.65).
+  return 1.0e4 * (c.stiffness_pressure_coeff * p_bar * std::sqrt(0.7 * w_mm * d_mm) + c.stiffness_offset_kgf_per_mm);
+}
+
+void check_operating_point(const TyreState& tyre, double load_n, double speed_mps) {
+  const auto& g = tyre.geometry;
+  if (!(g.outer_radius_m > 0.0) || !std::isfinite(g.outer_radius_m))
+    throw ModelDomainError("outer radius " + v(g.outer_radius_m) + " m: must be > 0");
+  if (!(g.section_width_m > 0.0) || !std::isfinite(g.section_width_m))
+    throw ModelDomainError("section width " + v(g.section_width_m) + " m: must be > 0");
+  if (!(g.rim_radius_m >= 0.0) || !(g.rim_radius_m < g.outer_radius_m))
+    throw ModelDomainError("rim radius " + v(g.rim_radius_m) + " m: must be >= 0 and below the outer radius " +
+                           v(g.outer_radius_m) + " m");
+  if (!(tyre.pressure_pa > 0.0) || !std::isfinite(tyre.pressure_pa))
+    throw ModelDomainError("inflation pressure " + v(tyre.pressure_pa / 1e5) + " bar: must be > 0");
+  if (!(load_n > 0.0) || !std::isfinite(load_n)) throw ModelDomainError("normal load " + v(load_n) + " N: must be > 0");
+  if (!(speed_mps >= 0.0) || !std::isfinite(speed_mps))
+    throw ModelDomainError("speed " + v(speed_mps * 3.6) + " km/h: must be >= 0");
+  const auto& c = tyre.constants;
+  if (c.elements < 2 || c.elements % 2 != 0)
+    throw ModelDomainError("element count " + std::to_string(c.elements) + ": must be an even number >= 2");
+  if (!(c.viscous_damping_ns_per_m >= 0.0) || !(c.coulomb_damping_n >= 0.0) || !(c.rotational_drag_kg_per_m2 >= 0.0))
+    throw ModelDomainError("damping and drag constants must be >= 0");
+  const double kz = vertical_stiffness_n_per_m(tyre);
+  if (!(kz > 0.0) || !std::isfinite(kz)) throw ModelDomainError("vertical stiffness " + v(kz) + " N/m: must be > 0");
+  const double deflection_m = load_n / kz;
+  const double limit_m = g.outer_radius_m - g.rim_radius_m;
+  if (!(deflection_m < limit_m)) {
+    throw ModelDomainError("load " + v(load_n) + " N deflects the tyre by " + v(deflection_m * 1e3) + " mm, which " +
+                           (g.rim_radius_m > 0.0 ? "reaches the rim (sidewall height " : "exceeds the outer radius (") +
+                           v(limit_m * 1e3) + " mm at stiffness " + v(kz) + " N/m); the model has no solution: " +
+                           "load must be below " + v(kz * limit_m) + " N at this pressure");
+  }
+}
+
+RollingResistance evaluate_rolling_resistance(const TyreState& tyre, double load_n, double speed_mps) {
+  check_operating_point(tyre, load_n, speed_mps);
+  const Patch p = loaded_patch(tyre, load_n);
+  const auto& c = tyre.constants;
+  const double r = tyre.geometry.outer_radius_m;
+  const int n = c.elements;
+  const double cv = c.viscous_damping_ns_per_m / n;
+  const double cc = c.coulomb_damping_n / n;
+  const double w = speed_mps / r;
+
+  // The element sum exactly as the spec writes it, keeping the three moment parts apart.
+  double m_coulomb = 0.0, m_viscous = 0.0, f_sum = 0.0;
+  const double dtheta = 2.0 * p.half_angle_rad / n;
+  for (int i = 0; i <= n; ++i) {
+    const double theta = -p.half_angle_rad + i * dtheta;
+    const double zdot = -w * r * std::sin(theta);
+    const double sgn = (zdot > 0.0) - (zdot < 0.0);
+    const double f_visc = -cv * zdot;
+    const double f_coul = -cc * sgn;
+    const double x = p.loaded_radius_m * std::tan(theta);
+    m_viscous += f_visc * x;
+    m_coulomb += f_coul * x;
+    f_sum += f_visc + f_coul;
+  }
+  const double m_drag = speed_mps * speed_mps * (2.0 * std::numbers::pi * r * tyre.geometry.section_width_m) *
+                        c.rotational_drag_kg_per_m2;
+  const double f_total = f_sum + load_n;
+
+  RollingResistance out;
+  out.stiffness_n_per_m = p.stiffness_n_per_m;
+  out.deflection_m = p.deflection_m;
+  out.loaded_radius_m = p.loaded_radius_m;
+  out.half_angle_rad = p.half_angle_rad;
+  out.contact_length_m = 2.0 * r * std::sin(p.half_angle_rad);
+  out.offset_e_m = (m_coulomb + m_viscous + m_drag) / f_total;
+  out.rrc = out.offset_e_m / r;
+  out.rrc_coulomb = m_coulomb / f_total / r;
+  out.rrc_viscous = m_viscous / f_total / r;
+  out.rrc_rotational_drag = m_drag / f_total / r;
+  out.rr_force_n = out.rrc * load_n;
+  out.rr_power_w = out.rr_force_n * speed_mps;
+  return out;
+}
+
+TyreAtLoad TyreAtLoad::prepare(const TyreState& tyre, double load_n) {
+  check_operating_point(tyre, load_n, 0.0);
+  const Patch p = loaded_patch(tyre, load_n);
+  const auto& c = tyre.constants;
+  const double r = tyre.geometry.outer_radius_m;
+  const LeverSums s = lever_sums(p, c.elements);
+  const double per_nr = 1.0 / (load_n * r);
+  TyreAtLoad t;
+  t.k0_ = c.coulomb_damping_n / c.elements * s.coulomb_m * per_nr;
+  t.k1_s_per_m_ = c.viscous_damping_ns_per_m / c.elements * s.viscous_m * per_nr;
+  t.k2_s2_per_m2_ = 2.0 * std::numbers::pi * r * tyre.geometry.section_width_m * c.rotational_drag_kg_per_m2 * per_nr;
+  t.load_n_ = load_n;
+  return t;
+}
+
+}  // namespace rollsim
