@@ -1,0 +1,43 @@
+// Tyre descriptions as users give them: size designations, the load-index table, and tyre YAML files.
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include "rollsim/tyre/tyre_model.hpp"
+
+namespace rollsim {
+
+/// What a size designation such as "P205/55 R16 91V XL" says, in SI.
+struct TyreSize {
+  std::string designation;          ///< as written by the user
+  std::string prefix;               ///< "", "P" or "LT"
+  double section_width_m = 0.0;     ///< 205 mm
+  double aspect_ratio = 0.0;        ///< 0.55
+  double rim_diameter_m = 0.0;      ///< 16 in
+  double outer_radius_m = 0.0;      ///< rim/2 + width * aspect
+  std::optional<int> load_index;    ///< 91
+  std::optional<std::string> speed_symbol;  ///< "V"
+  bool extra_load = false;          ///< "XL" / "Reinforced"
+};
+
+/// Parses a designation; throws InputError(where, ...) naming `where` (file key or option) if it does not parse
+/// or its load index is outside the table.
+TyreSize parse_tyre_size(const std::string& designation, const std::string& where);
+
+/// Maximum load [kg] of an ETRTO/ISO load index; std::nullopt outside the table (indices 60..125 at least).
+std::optional<double> load_index_max_load_kg(int load_index);
+
+/// A tyre ready for the model: geometry, inflation, model constants, and what is known of its rating.
+struct TyreSpec {
+  std::string name;                 ///< file stem or a label, for tables
+  std::string source;               ///< file path it came from, or "command line"
+  std::optional<TyreSize> size;     ///< when described by a designation
+  TyreState state;                  ///< geometry, pressure_pa, constants
+  double max_load_n = 0.0;          ///< rated maximum load at reference pressure; 0 when unknown
+};
+
+/// Loads and validates a tyre YAML file (strict keys; see tyres/README.md for the format).
+TyreSpec load_tyre_file(const std::string& path);
+
+}  // namespace rollsim
