@@ -32,6 +32,8 @@ std::optional<double> load_index_max_load_kg(int load_index);
 struct TyreSpec {
   std::string name;                 ///< file stem or a label, for tables
   std::string source;               ///< file path it came from, or "command line"
+  std::string description;          ///< free text from the file's `description`
+  std::string reference;            ///< where the data comes from (the file's `source` key)
   std::optional<TyreSize> size;     ///< when described by a designation
   TyreState state;                  ///< geometry, pressure_pa, constants
   double max_load_n = 0.0;          ///< rated maximum load at reference pressure; 0 when unknown

@@ -1,0 +1,262 @@
+#include "rollsim/tyre/tyre_spec.hpp"
+
+#include <array>
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "rollsim/common/error.hpp"
+#include "rollsim/common/units.hpp"
+#include "rollsim/common/yaml_reader.hpp"
+
+namespace rollsim {
+namespace {
+
+// ETRTO / ISO 4000-1 load-index table: maximum load per tyre [kg] at the reference pressure, indices 0..150.
+// Typed from the published standard table (the values are rounded, hence not an exact geometric series).
+constexpr int kFirstLoadIndex = 0;
+constexpr std::array<double, 151> kLoadIndexKg = {
+    45,   46.2, 47.5, 48.7, 50,   51.5, 53,   54.5, 56,   58,    // 0-9
+    60,   61.5, 63,   65,   67,   69,   71,   73,   75,   77.5,  // 10-19
+    80,   82.5, 85,   87.5, 90,   92.5, 95,   97.5, 100,  103,   // 20-29
+    106,  109,  112,  115,  118,  121,  125,  128,  132,  136,   // 30-39
+    140,  145,  150,  155,  160,  165,  170,  175,  180,  185,   // 40-49
+    190,  195,  200,  206,  212,  218,  224,  230,  236,  243,   // 50-59
+    250,  257,  265,  272,  280,  290,  300,  307,  315,  325,   // 60-69
+    335,  345,  355,  365,  375,  387,  400,  412,  425,  437,   // 70-79
+    450,  462,  475,  487,  500,  515,  530,  545,  560,  580,   // 80-89
+    600,  615,  630,  650,  670,  690,  710,  730,  750,  775,   // 90-99
+    800,  825,  850,  875,  900,  925,  950,  975,  1000, 1030,  // 100-109
+    1060, 1090, 1120, 1150, 1180, 1215, 1250, 1285, 1320, 1360,  // 110-119
+    1400, 1450, 1500, 1550, 1600, 1650, 1700, 1750, 1800, 1850,  // 120-129
+    1900, 1950, 2000, 2060, 2120, 2180, 2240, 2300, 2360, 2430,  // 130-139
+    2500, 2575, 2650, 2725, 2800, 2900, 3000, 3075, 3150, 3250,  // 140-149
+    3350};                                                       // 150
+constexpr int kLastLoadIndex = kFirstLoadIndex + static_cast<int>(kLoadIndexKg.size()) - 1;
+
+// Speed symbols of ISO 4000-1 / ETRTO (A1..A8 are for special vehicles and accepted too).
+bool is_speed_symbol(const std::string& s) {
+  static const std::string kLetters = "BCDEFGJKLMNPQRSTUHVWYZ";
+  if (s.size() == 1) return kLetters.find(s[0]) != std::string::npos;
+  return s.size() == 2 && s[0] == 'A' && s[1] >= '1' && s[1] <= '8';
+}
+
+std::string upper(std::string s) {
+  for (auto& c : s) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  return s;
+}
+
+// A small cursor over the upper-cased designation; each read either consumes what it matched or nothing.
+struct Cursor {
+  const std::string& s;
+  std::size_t i = 0;
+  void skip_spaces() {
+    while (i < s.size() && (s[i] == ' ' || s[i] == '\t')) ++i;
+  }
+  bool done() const { return i >= s.size(); }
+  bool eat(const std::string& lit) {
+    if (s.compare(i, lit.size(), lit) == 0) {
+      i += lit.size();
+      return true;
+    }
+    return false;
+  }
+  std::string digits() {
+    const std::size_t start = i;
+    while (i < s.size() && std::isdigit(static_cast<unsigned char>(s[i]))) ++i;
+    return s.substr(start, i - start);
+  }
+  std::string number() {  // digits with an optional decimal part ("16.5" LT rims)
+    const std::size_t start = i;
+    std::string d = digits();
+    if (!d.empty() && i + 1 < s.size() && s[i] == '.' && std::isdigit(static_cast<unsigned char>(s[i + 1]))) {
+      ++i;
+      digits();
+    }
+    return s.substr(start, i - start);
+  }
+  std::string word() {  // a run of letters and digits up to the next space
+    const std::size_t start = i;
+    while (i < s.size() && s[i] != ' ' && s[i] != '\t') ++i;
+    return s.substr(start, i - start);
+  }
+};
+
+const char* kFormat =
+    "expected a size designation like '205/55 R16 91V' ([P|LT]width/aspect [Z]R rim [load index][speed symbol] "
+    "[XL|Reinforced])";
+
+}  // namespace
+
+std::optional<double> load_index_max_load_kg(int load_index) {
+  if (load_index < kFirstLoadIndex || load_index > kLastLoadIndex) return std::nullopt;
+  return kLoadIndexKg[static_cast<std::size_t>(load_index - kFirstLoadIndex)];
+}
+
+TyreSize parse_tyre_size(const std::string& designation, const std::string& where) {
+  const std::string text = upper(designation);
+  const std::string quoted = "'" + designation + "'";
+  auto fail = [&](const std::string& why) -> TyreSize { throw InputError(where, quoted + " does not parse: " + why); };
+
+  TyreSize out;
+  out.designation = designation;
+  Cursor c{text};
+  c.skip_spaces();
+  if (c.eat("LT")) {
+    out.prefix = "LT";
+  } else if (c.eat("P")) {
+    out.prefix = "P";
+  }
+  const std::string width = c.digits();
+  if (width.size() != 3) return fail(std::string("section width must be 3 digits in mm; ") + kFormat);
+  if (!c.eat("/")) return fail(std::string("missing '/aspect ratio' after the width; ") + kFormat);
+  const std::string aspect = c.digits();
+  if (aspect.size() != 2) return fail(std::string("aspect ratio must be 2 digits in percent; ") + kFormat);
+  c.skip_spaces();
+  // Construction: R radial, ZR radial rated above 240 km/h. The model is for radial tyres only.
+  if (!c.eat("ZR") && !c.eat("R")) {
+    return fail(std::string("construction must be R or ZR (radial; the model is for radial tyres); ") + kFormat);
+  }
+  c.skip_spaces();
+  const std::string rim = c.number();
+  if (rim.empty()) return fail(std::string("missing rim diameter in inches; ") + kFormat);
+
+  out.section_width_m = std::stod(width) * units::kMPerMm;
+  out.aspect_ratio = std::stod(aspect) / 100.0;
+  out.rim_diameter_m = std::stod(rim) * units::kMPerInch;
+  if (out.section_width_m < 0.100 || out.section_width_m > 0.400)
+    return fail("section width " + width + " mm is outside 100..400 mm");
+  if (out.aspect_ratio < 0.20 || out.aspect_ratio > 0.95)
+    return fail("aspect ratio " + aspect + " is outside 20..95 %");
+  if (std::stod(rim) < 8.0 || std::stod(rim) > 30.0) return fail("rim diameter " + rim + " in is outside 8..30 in");
+  out.outer_radius_m = out.rim_diameter_m / 2.0 + out.section_width_m * out.aspect_ratio;
+
+  // Service description and suffixes, in any spacing: "91V", "(94Y)", "121/118S", "V", "XL", "Reinforced".
+  while (true) {
+    c.skip_spaces();
+    if (c.done()) break;
+    std::string tok = c.word();
+    if (tok == "XL" || tok == "REINFORCED" || tok == "RF" || tok == "EXTRA") {
+      out.extra_load = true;
+      if (tok == "EXTRA") {
+        c.skip_spaces();
+        if (c.word() != "LOAD") return fail("'Extra' must be followed by 'Load'");
+      }
+      continue;
+    }
+    if (tok.size() >= 2 && tok.front() == '(' && tok.back() == ')') tok = tok.substr(1, tok.size() - 2);
+    Cursor t{tok};
+    const std::string li = t.digits();
+    if (!li.empty()) {
+      if (out.load_index) return fail("more than one load index");
+      if (li.size() > 3) return fail("load index '" + li + "' has too many digits");
+      const int index = std::stoi(li);
+      if (t.eat("/")) {  // LT dual rating "121/118": single-wheel first, dual-wheel second; we use single
+        if (t.digits().empty()) return fail("a load pair must look like 121/118");
+      }
+      if (!load_index_max_load_kg(index)) {
+        throw InputError(where, quoted + ": load index " + li + " is outside the ETRTO/ISO table; allowed: " +
+                                    std::to_string(kFirstLoadIndex) + ".." + std::to_string(kLastLoadIndex));
+      }
+      out.load_index = index;
+    }
+    const std::string sym = tok.substr(t.i);
+    if (!sym.empty()) {
+      if (!is_speed_symbol(sym)) return fail("'" + sym + "' is not a speed symbol (L..Y, e.g. H, V, W) nor XL");
+      if (out.speed_symbol) return fail("more than one speed symbol");
+      out.speed_symbol = sym;
+    }
+  }
+  return out;
+}
+
+TyreSpec load_tyre_file(const std::string& path) {
+  YamlMap y = YamlMap::load_file(path);
+  TyreSpec spec;
+  spec.source = path;
+  spec.name = y.string_or("name", std::filesystem::path(path).stem().string());
+  spec.description = y.string_or("description", "");
+  spec.reference = y.string_or("source", "");
+
+  const auto size_text = y.optional_string("size");
+  const auto radius = y.optional_number("outer_radius_m", Range::open_low(0.0, 1.5));
+  const auto width = y.optional_number("section_width_m", Range::open_low(0.0, 1.0));
+  const auto rim_in = y.optional_number("rim_diameter_in", Range::open_low(0.0, 60.0));
+  const auto rim_r = y.optional_number("rim_radius_m", Range::non_negative());
+  const auto measured_d_mm = y.optional_number("outer_diameter_mm", Range::open_low(0.0, 3000.0));
+  auto& g = spec.state.geometry;
+
+  if (size_text) {
+    for (const char* k : {"outer_radius_m", "section_width_m", "rim_diameter_in", "rim_radius_m"}) {
+      if (y.has(k)) {
+        throw InputError(y.where(k), "not allowed together with 'size' (the designation gives the geometry; use "
+                                     "outer_diameter_mm to override the outer diameter with a measured one)");
+      }
+    }
+    spec.size = parse_tyre_size(*size_text, y.where("size"));
+    g.outer_radius_m = spec.size->outer_radius_m;
+    g.section_width_m = spec.size->section_width_m;
+    g.rim_radius_m = spec.size->rim_diameter_m / 2.0;
+  } else {
+    if (!radius && !measured_d_mm) {
+      throw InputError(y.where("size"), "missing: give 'size' (e.g. \"175/70 R14 84T\") or 'outer_radius_m' "
+                                        "(or 'outer_diameter_mm') and 'section_width_m'");
+    }
+    if (!width) throw InputError(y.where("section_width_m"), "required key is missing (needed when 'size' is not given)");
+    if (radius && measured_d_mm) {
+      throw InputError(y.where("outer_diameter_mm"), "not allowed together with 'outer_radius_m': give one of them");
+    }
+    if (rim_in && rim_r) throw InputError(y.where("rim_radius_m"), "not allowed together with 'rim_diameter_in'");
+    g.outer_radius_m = radius ? *radius : 0.0;
+    g.section_width_m = *width;
+    if (rim_in) g.rim_radius_m = *rim_in * units::kMPerInch / 2.0;
+    if (rim_r) g.rim_radius_m = *rim_r;
+  }
+  if (measured_d_mm) g.outer_radius_m = *measured_d_mm * units::kMPerMm / 2.0;
+  if (!(g.rim_radius_m < g.outer_radius_m)) {
+    const std::string key = rim_in ? "rim_diameter_in" : rim_r ? "rim_radius_m" : "outer_diameter_mm";
+    throw InputError(y.where(key), "rim radius " + format_value(g.rim_radius_m) + " m is not below the outer radius " +
+                                       format_value(g.outer_radius_m) + " m: the rim must be inside the tyre");
+  }
+
+  spec.state.pressure_pa = units::bar_to_pa(y.number("pressure_bar", Range::open_low(0.0, 20.0)));
+
+  const auto max_kg = y.optional_number("max_load_kg", Range::open_low(0.0, 20000.0));
+  const auto li = y.optional_number("load_index", Range::closed(kFirstLoadIndex, kLastLoadIndex));
+  if (max_kg && li) throw InputError(y.where("load_index"), "not allowed together with 'max_load_kg': give one of them");
+  if (li && *li != std::floor(*li)) {
+    throw InputError(y.where("load_index"), format_value(*li) + " is not allowed: must be a whole number");
+  }
+  // An explicit rating in the file wins over the designation's load index.
+  if (max_kg) {
+    spec.max_load_n = *max_kg * units::kStandardGravity_mps2;
+  } else if (li) {
+    spec.max_load_n = *load_index_max_load_kg(static_cast<int>(*li)) * units::kStandardGravity_mps2;
+  } else if (spec.size && spec.size->load_index) {
+    spec.max_load_n = *load_index_max_load_kg(*spec.size->load_index) * units::kStandardGravity_mps2;
+  }
+
+  if (auto m = y.optional_map("model")) {
+    auto& k = spec.state.constants;
+    k.viscous_damping_ns_per_m = m->number_or("viscous_damping_ns_per_m", k.viscous_damping_ns_per_m, Range::non_negative());
+    k.coulomb_damping_n = m->number_or("coulomb_damping_n", k.coulomb_damping_n, Range::non_negative());
+    k.rotational_drag_kg_per_m2 =
+        m->number_or("rotational_drag_kg_per_m2", k.rotational_drag_kg_per_m2, Range::non_negative());
+    k.stiffness_pressure_coeff = m->number_or("stiffness_pressure_coeff", k.stiffness_pressure_coeff, Range::positive());
+    k.stiffness_offset_kgf_per_mm =
+        m->number_or("stiffness_offset_kgf_per_mm", k.stiffness_offset_kgf_per_mm, Range::non_negative());
+    if (auto n = m->optional_number("elements", Range::closed(2, 1e6))) {
+      if (*n != std::floor(*n) || static_cast<long>(*n) % 2 != 0) {
+        throw InputError(m->where("elements"), format_value(*n) + " is not allowed: must be an even whole number >= 2");
+      }
+      k.elements = static_cast<int>(*n);
+    }
+    m->finish();
+  }
+  y.finish();
+  return spec;
+}
+
+}  // namespace rollsim
