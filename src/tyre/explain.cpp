@@ -99,9 +99,12 @@ std::string speed_text(const ParameterElasticity& p, const RollingResistance& r)
                   " of RRC) does not depend on speed, the viscous damping part grows linearly (contributes " +
                   f2(visc) + " to the elasticity) and rotational aerodynamic drag with V^2 (contributes " +
                   f2(drag) + "). ";
-  s += drag > visc ? "Rotational drag dominates the rise at this speed (typically above about 120 km/h)."
-                   : "Viscous damping dominates the rise at this speed; rotational drag takes over at higher speed.";
-  s += " Power = F_RR V, so its elasticity is 1 + " + f2(p.rrc_elasticity) + ".";
+  s += drag > visc ? "Most of the rise comes from rotational drag here."
+                   : "Most of the rise comes from viscous damping here; rotational drag takes over at higher speed.";
+  char buf[96];
+  std::snprintf(buf, sizeof buf, " Power = F_RR V, so its elasticity is 1 + (%.3f) = %.3f.", p.rrc_elasticity,
+                1.0 + p.rrc_elasticity);
+  s += buf;
   return s;
 }
 

@@ -84,6 +84,30 @@ struct Cursor {
   }
 };
 
+// YamlMap's optional readers treat a missing key as present (they return a default YAML::Node, which counts as
+// defined), so every optional key is asked through has() first and only marked as known when absent.
+std::optional<double> opt_number(YamlMap& y, const std::string& key, Range range) {
+  if (!y.has(key)) {
+    y.accept(key);
+    return std::nullopt;
+  }
+  return y.optional_number(key, range);
+}
+std::optional<std::string> opt_string(YamlMap& y, const std::string& key) {
+  if (!y.has(key)) {
+    y.accept(key);
+    return std::nullopt;
+  }
+  return y.optional_string(key);
+}
+std::optional<YamlMap> opt_map(YamlMap& y, const std::string& key) {
+  if (!y.has(key)) {
+    y.accept(key);
+    return std::nullopt;
+  }
+  return y.optional_map(key);
+}
+
 const char* kFormat =
     "expected a size designation like '205/55 R16 91V' ([P|LT]width/aspect [Z]R rim [load index][speed symbol] "
     "[XL|Reinforced])";
@@ -176,16 +200,16 @@ TyreSpec load_tyre_file(const std::string& path) {
   YamlMap y = YamlMap::load_file(path);
   TyreSpec spec;
   spec.source = path;
-  spec.name = y.string_or("name", std::filesystem::path(path).stem().string());
-  spec.description = y.string_or("description", "");
-  spec.reference = y.string_or("source", "");
+  spec.name = opt_string(y, "name").value_or(std::filesystem::path(path).stem().string());
+  spec.description = opt_string(y, "description").value_or("");
+  spec.reference = opt_string(y, "source").value_or("");
 
-  const auto size_text = y.optional_string("size");
-  const auto radius = y.optional_number("outer_radius_m", Range::open_low(0.0, 1.5));
-  const auto width = y.optional_number("section_width_m", Range::open_low(0.0, 1.0));
-  const auto rim_in = y.optional_number("rim_diameter_in", Range::open_low(0.0, 60.0));
-  const auto rim_r = y.optional_number("rim_radius_m", Range::non_negative());
-  const auto measured_d_mm = y.optional_number("outer_diameter_mm", Range::open_low(0.0, 3000.0));
+  const auto size_text = opt_string(y, "size");
+  const auto radius = opt_number(y, "outer_radius_m", Range::open_low(0.0, 1.5));
+  const auto width = opt_number(y, "section_width_m", Range::open_low(0.0, 1.0));
+  const auto rim_in = opt_number(y, "rim_diameter_in", Range::open_low(0.0, 60.0));
+  const auto rim_r = opt_number(y, "rim_radius_m", Range::non_negative());
+  const auto measured_d_mm = opt_number(y, "outer_diameter_mm", Range::open_low(0.0, 3000.0));
   auto& g = spec.state.geometry;
 
   if (size_text) {
@@ -223,8 +247,8 @@ TyreSpec load_tyre_file(const std::string& path) {
 
   spec.state.pressure_pa = units::bar_to_pa(y.number("pressure_bar", Range::open_low(0.0, 20.0)));
 
-  const auto max_kg = y.optional_number("max_load_kg", Range::open_low(0.0, 20000.0));
-  const auto li = y.optional_number("load_index", Range::closed(kFirstLoadIndex, kLastLoadIndex));
+  const auto max_kg = opt_number(y, "max_load_kg", Range::open_low(0.0, 20000.0));
+  const auto li = opt_number(y, "load_index", Range::closed(kFirstLoadIndex, kLastLoadIndex));
   if (max_kg && li) throw InputError(y.where("load_index"), "not allowed together with 'max_load_kg': give one of them");
   if (li && *li != std::floor(*li)) {
     throw InputError(y.where("load_index"), format_value(*li) + " is not allowed: must be a whole number");
@@ -238,16 +262,16 @@ TyreSpec load_tyre_file(const std::string& path) {
     spec.max_load_n = *load_index_max_load_kg(*spec.size->load_index) * units::kStandardGravity_mps2;
   }
 
-  if (auto m = y.optional_map("model")) {
+  if (auto m = opt_map(y, "model")) {
     auto& k = spec.state.constants;
-    k.viscous_damping_ns_per_m = m->number_or("viscous_damping_ns_per_m", k.viscous_damping_ns_per_m, Range::non_negative());
-    k.coulomb_damping_n = m->number_or("coulomb_damping_n", k.coulomb_damping_n, Range::non_negative());
+    k.viscous_damping_ns_per_m = opt_number(*m, "viscous_damping_ns_per_m", Range::non_negative()).value_or(k.viscous_damping_ns_per_m);
+    k.coulomb_damping_n = opt_number(*m, "coulomb_damping_n", Range::non_negative()).value_or(k.coulomb_damping_n);
     k.rotational_drag_kg_per_m2 =
-        m->number_or("rotational_drag_kg_per_m2", k.rotational_drag_kg_per_m2, Range::non_negative());
-    k.stiffness_pressure_coeff = m->number_or("stiffness_pressure_coeff", k.stiffness_pressure_coeff, Range::positive());
+        opt_number(*m, "rotational_drag_kg_per_m2", Range::non_negative()).value_or(k.rotational_drag_kg_per_m2);
+    k.stiffness_pressure_coeff = opt_number(*m, "stiffness_pressure_coeff", Range::positive()).value_or(k.stiffness_pressure_coeff);
     k.stiffness_offset_kgf_per_mm =
-        m->number_or("stiffness_offset_kgf_per_mm", k.stiffness_offset_kgf_per_mm, Range::non_negative());
-    if (auto n = m->optional_number("elements", Range::closed(2, 1e6))) {
+        opt_number(*m, "stiffness_offset_kgf_per_mm", Range::non_negative()).value_or(k.stiffness_offset_kgf_per_mm);
+    if (auto n = opt_number(*m, "elements", Range::closed(2, 1e6))) {
       if (*n != std::floor(*n) || static_cast<long>(*n) % 2 != 0) {
         throw InputError(m->where("elements"), format_value(*n) + " is not allowed: must be an even whole number >= 2");
       }
