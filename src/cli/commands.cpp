@@ -3,7 +3,7 @@
 namespace rollsim::cli {
 
 void register_commands(CLI::App& app) {
-  (void)app;
+  register_tyre_command(app);
 }
 
 }  // namespace rollsim::cli

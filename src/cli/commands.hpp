@@ -6,5 +6,6 @@
 namespace rollsim::cli {
 
 void register_commands(CLI::App& app);
+void register_tyre_command(CLI::App& app);
 
 }  // namespace rollsim::cli

@@ -1,0 +1,270 @@
+// `rollsim tyre`: one tyre at one load and one or more speeds, as a table, JSON lines, or an explanation.
+#include <cmath>
+#include <cstdlib>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "rollsim/common/error.hpp"
+#include "rollsim/common/units.hpp"
+#include "rollsim/common/yaml_reader.hpp"
+#include "rollsim/report/table.hpp"
+#include "rollsim/tyre/explain.hpp"
+#include "rollsim/tyre/tyre_model.hpp"
+#include "rollsim/tyre/tyre_spec.hpp"
+
+namespace rollsim::cli {
+namespace {
+
+// Options are taken as text and parsed here so that every bad value gets the same kind of message, naming the
+// option, the value and what is allowed (CLI11 would accept "nan" silently for a double).
+struct TyreOptions {
+  std::string file;
+  std::string size;
+  std::string outer_radius_m, width_m, pressure_bar, load_n, load_pct;
+  std::vector<std::string> speeds_kmh;
+  bool json = false;
+  bool explain = false;
+};
+
+double parse_number(const std::string& text, const std::string& option, Range range) {
+  double v = 0.0;
+  char* end = nullptr;
+  v = std::strtod(text.c_str(), &end);
+  if (text.empty() || end != text.c_str() + text.size()) {
+    throw InputError(option, "'" + text + "' is not a number; " + range.describe());
+  }
+  if (!range.contains(v)) throw InputError(option, format_value(v) + " is not allowed: " + range.describe());
+  return v;
+}
+
+std::string kg_text(double n) { return report::fixed(n / units::kStandardGravity_mps2, 0) + " kg"; }
+
+// Builds the tyre from a file, a designation, or explicit geometry; --pressure-bar overrides a file's pressure.
+TyreSpec build_tyre(const TyreOptions& o) {
+  TyreSpec spec;
+  const bool has_geometry = !o.outer_radius_m.empty() || !o.width_m.empty();
+  if (!o.file.empty()) {
+    if (!o.size.empty()) throw InputError("--size '" + o.size + "'", "not allowed together with a tyre file");
+    if (has_geometry) {
+      throw InputError(o.outer_radius_m.empty() ? "--width-m" : "--outer-radius-m",
+                       "not allowed together with a tyre file (the file gives the geometry)");
+    }
+    spec = load_tyre_file(resolve_data_file(o.file, "tyres", ".yaml", "tyre file"));
+  } else if (!o.size.empty()) {
+    if (has_geometry) {
+      throw InputError(o.outer_radius_m.empty() ? "--width-m" : "--outer-radius-m",
+                       "not allowed together with --size (the designation gives the geometry)");
+    }
+    spec.size = parse_tyre_size(o.size, "--size");
+    spec.name = o.size;
+    spec.source = "--size '" + o.size + "'";
+    spec.state.geometry.outer_radius_m = spec.size->outer_radius_m;
+    spec.state.geometry.section_width_m = spec.size->section_width_m;
+    spec.state.geometry.rim_radius_m = spec.size->rim_diameter_m / 2.0;
+    if (spec.size->load_index) {
+      spec.max_load_n = *load_index_max_load_kg(*spec.size->load_index) * units::kStandardGravity_mps2;
+    }
+  } else {
+    if (o.outer_radius_m.empty() || o.width_m.empty()) {
+      throw InputError(o.outer_radius_m.empty() ? "--outer-radius-m" : "--width-m",
+                       "missing: give a tyre file (e.g. 'rollsim tyre 175-70R14'), --size \"175/70 R14 84T\", or both "
+                       "--outer-radius-m and --width-m");
+    }
+    spec.name = "R " + o.outer_radius_m + " m, W " + o.width_m + " m";
+    spec.source = "command line";
+    spec.state.geometry.outer_radius_m = parse_number(o.outer_radius_m, "--outer-radius-m", Range::open_low(0.0, 1.5));
+    spec.state.geometry.section_width_m = parse_number(o.width_m, "--width-m", Range::open_low(0.0, 1.0));
+  }
+  if (!o.pressure_bar.empty()) {
+    spec.state.pressure_pa = units::bar_to_pa(parse_number(o.pressure_bar, "--pressure-bar", Range::open_low(0.0, 20.0)));
+  } else if (o.file.empty()) {
+    throw InputError("--pressure-bar", "missing: the inflation pressure in bar is needed (e.g. --pressure-bar 2.1)");
+  }
+  return spec;
+}
+
+struct LoadChoice {
+  double load_n;
+  std::string where;  // the option or rule that set it, for error messages
+};
+
+LoadChoice choose_load(const TyreOptions& o, const TyreSpec& spec) {
+  if (!o.load_n.empty() && !o.load_pct.empty()) {
+    throw InputError("--load-pct", "not allowed together with --load-n: give one of them");
+  }
+  if (!o.load_n.empty()) {
+    return {parse_number(o.load_n, "--load-n", Range::open_low(0.0, 1e6)), "--load-n " + o.load_n};
+  }
+  const bool pct_given = !o.load_pct.empty();
+  const double pct = pct_given ? parse_number(o.load_pct, "--load-pct", Range::open_low(0.0, 300.0)) : 80.0;
+  if (!(spec.max_load_n > 0.0)) {
+    throw InputError(pct_given ? "--load-pct " + o.load_pct : "--load-n",
+                     pct_given ? "the tyre's maximum load is unknown (no load index): give --load-n N instead"
+                               : "missing: the tyre's maximum load is unknown (no load index), so the default 80 % "
+                                 "of it cannot be used; give --load-n N");
+  }
+  return {pct / 100.0 * spec.max_load_n,
+          pct_given ? "--load-pct " + o.load_pct : "the default load (80 % of the maximum load)"};
+}
+
+// The model's domain errors carry no origin; name the file/options they came from.
+template <typename F>
+auto named(const TyreSpec& spec, const LoadChoice& load, const TyreOptions& o, F&& f) {
+  try {
+    return f();
+  } catch (const ModelDomainError& e) {
+    std::string where = spec.source + " at " + load.where;
+    if (!o.pressure_bar.empty()) where += ", --pressure-bar " + o.pressure_bar;
+    throw InputError(where, e.what());
+  }
+}
+
+std::string describe_tyre(const TyreSpec& spec) {
+  const auto& g = spec.state.geometry;
+  std::string s = "tyre " + spec.name;
+  if (spec.size && spec.size->designation != spec.name) s += " (" + spec.size->designation + ")";
+  s += ": outer radius " + report::fixed(g.outer_radius_m * 1e3, 1) + " mm, section width " +
+       report::fixed(g.section_width_m * 1e3, 0) + " mm";
+  if (g.rim_radius_m > 0.0) s += ", rim radius " + report::fixed(g.rim_radius_m * 1e3, 1) + " mm";
+  s += ", " + report::fixed(units::pa_to_bar(spec.state.pressure_pa), 2) + " bar";
+  if (spec.max_load_n > 0.0) {
+    s += ", max load " + report::fixed(spec.max_load_n, 0) + " N (" + kg_text(spec.max_load_n) + ")";
+  } else {
+    s += ", max load unknown";
+  }
+  return s + "\n";
+}
+
+std::string explanation_text(const TyreExplanation& x) {
+  std::string out = "\nElasticities at " + report::fixed(x.load_n, 0) + " N, " +
+                    report::fixed(units::mps_to_kmh(x.speed_mps), 1) +
+                    " km/h (% change of the output per % change of the parameter; model, central differences)\n";
+  report::TextTable t({"parameter", "value", "RRC", "sign", "RR power", "deflection", "contact length"});
+  t.set_left_aligned(0);
+  t.set_left_aligned(3);
+  for (const auto& p : x.parameters) {
+    std::string value;
+    switch (p.parameter) {
+      case TyreParameter::OuterDiameter: value = report::fixed(p.value_si * 1e3, 1) + " mm"; break;
+      case TyreParameter::SectionWidth: value = report::fixed(p.value_si * 1e3, 1) + " mm"; break;
+      case TyreParameter::Pressure: value = report::fixed(units::pa_to_bar(p.value_si), 2) + " bar"; break;
+      case TyreParameter::Load: value = report::fixed(p.value_si, 0) + " N"; break;
+      case TyreParameter::Speed: value = report::fixed(units::mps_to_kmh(p.value_si), 1) + " km/h"; break;
+    }
+    t.add_row({p.name, value, report::fixed(p.rrc_elasticity, 3), elasticity_sign(p.rrc_elasticity),
+               report::fixed(p.power_elasticity, 3), report::fixed(p.deflection_elasticity, 3),
+               report::fixed(p.contact_length_elasticity, 3)});
+  }
+  out += t.render() + "\nMechanisms in this model:\n";
+  for (const auto& p : x.parameters) out += "- " + p.name + ": " + p.mechanism + "\n";
+  return out;
+}
+
+void run_tyre(const TyreOptions& o) {
+  const TyreSpec spec = build_tyre(o);
+  const LoadChoice load = choose_load(o, spec);
+
+  std::vector<double> speeds_kmh;
+  for (const auto& s : o.speeds_kmh) speeds_kmh.push_back(parse_number(s, "--speed-kmh", Range::closed(0.0, 500.0)));
+  if (speeds_kmh.empty()) speeds_kmh.push_back(80.0);
+  // Explaining needs a rolling tyre: at standstill RRC is 0 and has no elasticity.
+  if (o.explain) {
+    for (std::size_t i = 0; i < speeds_kmh.size(); ++i) {
+      if (!(speeds_kmh[i] > 0.0)) {
+        throw InputError("--speed-kmh " + o.speeds_kmh[i], "0 is not allowed with --explain: must be > 0");
+      }
+    }
+  }
+
+  if (spec.max_load_n > 0.0 && load.load_n > spec.max_load_n) {
+    std::cerr << "warning: load " << report::fixed(load.load_n, 0) << " N is above the tyre's rated maximum "
+              << report::fixed(spec.max_load_n, 0) << " N (" << kg_text(spec.max_load_n)
+              << "); results are outside the tyre's rating\n";
+  }
+
+  std::vector<RollingResistance> results;
+  std::vector<TyreExplanation> explanations;
+  for (const double v_kmh : speeds_kmh) {
+    const double v_mps = units::kmh_to_mps(v_kmh);
+    results.push_back(named(spec, load, o, [&] { return evaluate_rolling_resistance(spec.state, load.load_n, v_mps); }));
+    if (o.explain) explanations.push_back(named(spec, load, o, [&] { return explain_tyre(spec.state, load.load_n, v_mps); }));
+  }
+
+  const double p_bar = units::pa_to_bar(spec.state.pressure_pa);
+  if (o.json) {
+    for (std::size_t i = 0; i < results.size(); ++i) {
+      const auto& r = results[i];
+      report::JsonObject j;
+      j.add("tyre", spec.name).add("source", spec.source);
+      if (spec.size) j.add("size", spec.size->designation);
+      j.add("outer_radius_m", spec.state.geometry.outer_radius_m)
+          .add("section_width_m", spec.state.geometry.section_width_m)
+          .add("rim_radius_m", spec.state.geometry.rim_radius_m)
+          .add("pressure_bar", p_bar)
+          .add("load_n", load.load_n);
+      if (spec.max_load_n > 0.0) j.add("max_load_n", spec.max_load_n); else j.add_null("max_load_n");
+      j.add("speed_kmh", speeds_kmh[i])
+          .add("rrc", r.rrc)
+          .add("rr_force_n", r.rr_force_n)
+          .add("rr_power_w", r.rr_power_w)
+          .add("stiffness_n_per_m", r.stiffness_n_per_m)
+          .add("deflection_m", r.deflection_m)
+          .add("contact_length_m", r.contact_length_m)
+          .add("offset_e_m", r.offset_e_m)
+          .add("rrc_coulomb", r.rrc_coulomb)
+          .add("rrc_viscous", r.rrc_viscous)
+          .add("rrc_rotational_drag", r.rrc_rotational_drag);
+      if (o.explain) {
+        for (const auto& p : explanations[i].parameters) {
+          j.add("elasticity_rrc_" + p.key, p.rrc_elasticity).add("elasticity_power_" + p.key, p.power_elasticity);
+        }
+      }
+      std::cout << j.str() << "\n";
+    }
+    return;
+  }
+
+  std::cout << describe_tyre(spec);
+  report::TextTable t({"tyre", "p [bar]", "load [N]", "speed [km/h]", "Kz [N/mm]", "defl [mm]", "contact [mm]",
+                       "RRC x1000", "Coulomb", "viscous", "drag", "F_RR [N]", "P_RR [W]"});
+  t.set_left_aligned(0);
+  for (std::size_t i = 0; i < results.size(); ++i) {
+    const auto& r = results[i];
+    t.add_row({spec.name, report::fixed(p_bar, 2), report::fixed(load.load_n, 0), report::fixed(speeds_kmh[i], 1),
+               report::fixed(r.stiffness_n_per_m * 1e-3, 1), report::fixed(r.deflection_m * 1e3, 2),
+               report::fixed(r.contact_length_m * 1e3, 1), report::fixed(r.rrc * 1e3, 3),
+               report::fixed(r.rrc_coulomb * 1e3, 3), report::fixed(r.rrc_viscous * 1e3, 3),
+               report::fixed(r.rrc_rotational_drag * 1e3, 3), report::fixed(r.rr_force_n, 2),
+               report::fixed(r.rr_power_w, 1)});
+  }
+  std::cout << t.render();
+  for (const auto& x : explanations) std::cout << explanation_text(x);
+}
+
+}  // namespace
+
+void register_tyre_command(CLI::App& app) {
+  auto opts = std::make_shared<TyreOptions>();
+  CLI::App* sub = app.add_subcommand(
+      "tyre", "Rolling resistance of one tyre at one load and one or more speeds (table, --json, or --explain)");
+  sub->add_option("tyre_file", opts->file,
+                  "Tyre YAML file, or a name in the shipped tyres/ folder (e.g. 175-70R14)");
+  sub->add_option("--size", opts->size, "Size designation instead of a file, e.g. \"175/70 R14 84T\"");
+  sub->add_option("--outer-radius-m", opts->outer_radius_m, "Unloaded outer radius R [m] (with --width-m)");
+  sub->add_option("--width-m", opts->width_m, "Section width W [m] (with --outer-radius-m)");
+  sub->add_option("--pressure-bar", opts->pressure_bar, "Inflation pressure [bar]; overrides a file's pressure");
+  sub->add_option("--load-n", opts->load_n, "Normal load per tyre [N]");
+  sub->add_option("--load-pct", opts->load_pct, "Normal load as % of the tyre's maximum load (default 80)");
+  sub->add_option("--speed-kmh", opts->speeds_kmh, "Speed(s) [km/h]: several values, repeated or comma-separated "
+                                                    "(default 80)")
+      ->delimiter(',');
+  sub->add_flag("--json", opts->json, "One JSON object per operating point per line");
+  sub->add_flag("--explain", opts->explain, "Elasticities of RRC and RR power and the mechanism behind each");
+  sub->callback([opts] { run_tyre(*opts); });
+}
+
+}  // namespace rollsim::cli
