@@ -1,0 +1,40 @@
+// Small strict CSV reader shared by every module that reads tabular input (cycles, recordings).
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace rollsim {
+
+/// A CSV file read into text cells. The first non-blank line is the header; every data row keeps the
+/// 1-based line number where it starts in the file, so errors can point at the line an editor shows.
+struct CsvTable {
+  std::string file;                            ///< path as given, for error messages
+  std::vector<std::string> header;             ///< column names, surrounding whitespace trimmed
+  std::size_t header_line = 0;                 ///< 1-based line of the header
+  std::vector<std::vector<std::string>> rows;  ///< each row has exactly header.size() cells
+  std::vector<std::size_t> row_line;           ///< 1-based line where each row starts
+
+  /// Index of the column named exactly `name` (after trimming), if present.
+  std::optional<std::size_t> column(const std::string& name) const;
+  /// "a, b, c": the header, quoted, for "found columns: ..." in error messages.
+  std::string columns_list() const;
+  /// "file: line N, column 'name'" for an error about one cell.
+  std::string where(std::size_t row, std::size_t col) const;
+};
+
+/// Reads `path`. Supports RFC 4180 quoting ("a,b" and "" inside quotes, line breaks inside quotes), CRLF
+/// line ends and a UTF-8 byte-order mark. Blank lines are skipped. Throws InputError for a missing or
+/// unreadable file, an empty file, an unterminated quote, or a row whose cell count differs from the header.
+CsvTable read_csv(const std::string& path, char delimiter = ',');
+
+/// Parses a whole cell as a number (surrounding spaces allowed, nothing else). Returns nullopt for text
+/// that is not a number. "nan" and "inf" parse (to NaN and infinity) so callers can reject them by name.
+std::optional<double> parse_number(const std::string& text);
+
+/// Trims spaces and tabs at both ends.
+std::string trim(const std::string& text);
+
+}  // namespace rollsim

@@ -1,0 +1,58 @@
+// Drive cycles: speed (and grade) against time, loaded by name or from a user CSV, with fast lookups.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace rollsim {
+
+/// A piecewise-linear speed trace. time_s is strictly increasing, speed_mps >= 0, grade (rise over run,
+/// dimensionless) has the same length (all zeros when the file gave none). Between samples every channel is
+/// linearly interpolated; outside [time_s.front(), time_s.back()] the end values are held.
+struct DriveCycle {
+  std::string name;    ///< shipped name ("nedc") or the file's stem
+  std::string source;  ///< path the trace was read from
+  std::vector<double> time_s;
+  std::vector<double> speed_mps;
+  std::vector<double> grade;
+
+  double duration_s() const;  ///< last time minus first time
+  double distance_m() const;  ///< trapezoid integral of speed, exact for the piecewise-linear trace
+
+  /// Index i of the segment [time_s[i], time_s[i+1]) holding t, clamped to [0, size-2]. At a sample time the
+  /// following segment is returned. `hint` (e.g. the previous answer) makes sequential calls O(1); any
+  /// value is safe, a wrong hint only costs a binary search.
+  std::size_t segment_index(double t, std::size_t hint = 0) const;
+
+  double speed_mps_at(double t) const;
+  double accel_mps2_at(double t) const;  ///< slope of the segment holding t; 0 outside the trace
+  double grade_at(double t) const;
+  /// Hinted forms for integrators: `hint` is read and updated with the segment used.
+  double speed_mps_at(double t, std::size_t& hint) const;
+  double accel_mps2_at(double t, std::size_t& hint) const;
+  double grade_at(double t, std::size_t& hint) const;
+};
+
+/// Interior sample times where the piecewise-linear speed changes slope (kinks), in increasing order; the
+/// first and last sample times are not included. An integrator uses them as stop times so that it never
+/// steps across a discontinuity of the acceleration.
+std::vector<double> breakpoints_s(const DriveCycle& cycle);
+
+/// Names accepted by load_cycle besides paths, in a stable order ("wltc" is an alias of "wltc_class3b").
+std::vector<std::string> shipped_cycle_names();
+
+/// Loads a shipped cycle by name (case-insensitive, see shipped_cycle_names) or a CSV file by path.
+/// CSV: a header line, then one sample per line. Columns: `time_s` (strictly increasing), exactly one of
+/// `speed_kmh` or `speed_mps` (>= 0), and at most one of `grade_pct` (percent, within +-30) or `elevation_m`
+/// (converted to grade over travelled distance). Any bad value throws InputError naming file, line, column.
+/// `option` names where the name came from in error messages (e.g. "--cycle").
+DriveCycle load_cycle(const std::string& name_or_path, const std::string& option = "--cycle");
+
+/// Reads a cycle CSV at `path` (no name lookup); `name` becomes DriveCycle::name.
+DriveCycle read_cycle_csv(const std::string& path, const std::string& name);
+
+/// Largest |grade| a cycle may hold: 30 %, steeper than any public road.
+inline constexpr double kMaxCycleGrade = 0.30;
+
+}  // namespace rollsim

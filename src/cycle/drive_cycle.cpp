@@ -1,0 +1,229 @@
+#include "rollsim/cycle/drive_cycle.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+#include <optional>
+
+#include "rollsim/common/csv.hpp"
+#include "rollsim/common/error.hpp"
+#include "rollsim/common/units.hpp"
+#include "rollsim/common/yaml_reader.hpp"
+
+namespace rollsim {
+
+namespace {
+
+// Slopes that differ by less than this are one straight line: the shipped traces are rounded to 1e-6 km/h,
+// which makes the slope of a straight ramp jitter by about 1e-6 m/s^2. A spurious kink would only add a
+// harmless stop time; a true kink this small does not matter to an integrator.
+constexpr double kKinkTolerance_mps2 = 1e-5;
+
+// Elevation is differenced over at least this much travelled distance: GPS and map elevations are noisy
+// at the metre scale, and over a standing vehicle a plain difference would divide by zero.
+constexpr double kGradeBaseline_m = 10.0;
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return s;
+}
+
+double lerp(const std::vector<double>& t, const std::vector<double>& y, std::size_t i, double at) {
+  const double w = (at - t[i]) / (t[i + 1] - t[i]);
+  return y[i] + w * (y[i + 1] - y[i]);
+}
+
+double value_at(const DriveCycle& c, const std::vector<double>& y, double t, std::size_t& hint) {
+  if (t <= c.time_s.front()) return y.front();
+  if (t >= c.time_s.back()) return y.back();
+  hint = c.segment_index(t, hint);
+  return lerp(c.time_s, y, hint, t);
+}
+
+}  // namespace
+
+double DriveCycle::duration_s() const { return time_s.empty() ? 0.0 : time_s.back() - time_s.front(); }
+
+double DriveCycle::distance_m() const {
+  double s = 0.0;
+  for (std::size_t i = 0; i + 1 < time_s.size(); ++i) s += 0.5 * (speed_mps[i] + speed_mps[i + 1]) * (time_s[i + 1] - time_s[i]);
+  return s;
+}
+
+std::size_t DriveCycle::segment_index(double t, std::size_t hint) const {
+  const std::size_t n = time_s.size();
+  if (n < 2) return 0;
+  const std::size_t last = n - 2;
+  if (hint <= last && time_s[hint] <= t && (t < time_s[hint + 1] || hint == last)) return hint;
+  // Integrators mostly move forward by less than a segment: try the next one before searching.
+  if (hint + 1 <= last && time_s[hint + 1] <= t && (t < time_s[hint + 2] || hint + 1 == last)) return hint + 1;
+  auto it = std::upper_bound(time_s.begin(), time_s.end(), t);
+  if (it == time_s.begin()) return 0;
+  const std::size_t i = static_cast<std::size_t>(it - time_s.begin()) - 1;
+  return std::min(i, last);
+}
+
+double DriveCycle::speed_mps_at(double t, std::size_t& hint) const { return value_at(*this, speed_mps, t, hint); }
+double DriveCycle::grade_at(double t, std::size_t& hint) const { return value_at(*this, grade, t, hint); }
+
+double DriveCycle::accel_mps2_at(double t, std::size_t& hint) const {
+  if (t < time_s.front() || t >= time_s.back()) return 0.0;
+  hint = segment_index(t, hint);
+  return (speed_mps[hint + 1] - speed_mps[hint]) / (time_s[hint + 1] - time_s[hint]);
+}
+
+double DriveCycle::speed_mps_at(double t) const {
+  std::size_t h = 0;
+  return speed_mps_at(t, h);
+}
+double DriveCycle::accel_mps2_at(double t) const {
+  std::size_t h = 0;
+  return accel_mps2_at(t, h);
+}
+double DriveCycle::grade_at(double t) const {
+  std::size_t h = 0;
+  return grade_at(t, h);
+}
+
+std::vector<double> breakpoints_s(const DriveCycle& c) {
+  std::vector<double> out;
+  for (std::size_t i = 1; i + 1 < c.time_s.size(); ++i) {
+    const double a0 = (c.speed_mps[i] - c.speed_mps[i - 1]) / (c.time_s[i] - c.time_s[i - 1]);
+    const double a1 = (c.speed_mps[i + 1] - c.speed_mps[i]) / (c.time_s[i + 1] - c.time_s[i]);
+    if (std::abs(a1 - a0) > kKinkTolerance_mps2) out.push_back(c.time_s[i]);
+  }
+  return out;
+}
+
+std::vector<std::string> shipped_cycle_names() {
+  return {"nedc",         "wltc_class3b",  "udds",          "ftp75",
+          "hwfet",        "us06",          "artemis_urban", "artemis_road",
+          "artemis_motorway_130", "artemis_motorway_150", "nedc_fastsim"};
+}
+
+DriveCycle load_cycle(const std::string& name_or_path, const std::string& option) {
+  std::string key = lower(name_or_path);
+  if (key == "wltc" || key == "wltc3b" || key == "wltc_3b") key = "wltc_class3b";
+  const auto names = shipped_cycle_names();
+  if (std::find(names.begin(), names.end(), key) != names.end()) {
+    return read_cycle_csv(resolve_data_file(key, "cycles", ".csv", option), key);
+  }
+  namespace fs = std::filesystem;
+  if (!fs::is_regular_file(name_or_path)) {
+    std::string list;
+    for (std::size_t i = 0; i < names.size(); ++i) list += (i ? ", " : "") + names[i];
+    throw InputError(option + " '" + name_or_path + "'",
+                     "no such file, and not a shipped cycle name; shipped cycles: " + list + " (wltc = wltc_class3b)");
+  }
+  return read_cycle_csv(name_or_path, fs::path(name_or_path).stem().string());
+}
+
+DriveCycle read_cycle_csv(const std::string& path, const std::string& name) {
+  const CsvTable table = read_csv(path);
+  const std::string allowed = "time_s, speed_kmh or speed_mps, optional grade_pct or elevation_m";
+  const std::string found = "found columns: " + table.columns_list();
+  // A header of numbers means the file has none, and its first sample would otherwise be lost or misread.
+  bool header_numeric = !table.header.empty();
+  for (const auto& h : table.header) header_numeric = header_numeric && parse_number(h).has_value();
+  if (header_numeric) {
+    throw InputError(path + ": line " + std::to_string(table.header_line),
+                     "holds numbers, but the first line must be a header naming the columns (" + allowed + ")");
+  }
+  for (std::size_t i = 0; i < table.header.size(); ++i) {
+    const std::string& h = table.header[i];
+    if (h != "time_s" && h != "speed_kmh" && h != "speed_mps" && h != "grade_pct" && h != "elevation_m") {
+      throw InputError(path + ": line " + std::to_string(table.header_line) + ", column " + std::to_string(i + 1),
+                       "unknown column '" + h + "' (misspelt?); allowed: " + allowed + "; " + found);
+    }
+    for (std::size_t j = 0; j < i; ++j) {
+      if (table.header[j] == h) {
+        throw InputError(path + ": line " + std::to_string(table.header_line), "column '" + h + "' appears twice");
+      }
+    }
+  }
+  const auto col_t = table.column("time_s");
+  const auto col_kmh = table.column("speed_kmh");
+  const auto col_mps = table.column("speed_mps");
+  const auto col_grade = table.column("grade_pct");
+  const auto col_elev = table.column("elevation_m");
+  if (!col_t) throw InputError(path, "missing column 'time_s'; " + found);
+  if (!col_kmh && !col_mps) throw InputError(path, "missing a speed column, 'speed_kmh' or 'speed_mps'; " + found);
+  if (col_kmh && col_mps) throw InputError(path, "has both 'speed_kmh' and 'speed_mps'; give exactly one");
+  if (col_grade && col_elev) throw InputError(path, "has both 'grade_pct' and 'elevation_m'; give at most one");
+  const std::size_t col_v = col_kmh ? *col_kmh : *col_mps;
+  if (table.rows.size() < 2) {
+    throw InputError(path, "has " + std::to_string(table.rows.size()) + " sample(s); a cycle needs at least 2");
+  }
+
+  auto number = [&](std::size_t row, std::size_t col) {
+    const std::string& cell = table.rows[row][col];
+    if (cell.empty()) throw InputError(table.where(row, col), "is empty; expected a number");
+    const auto v = parse_number(cell);
+    if (!v) throw InputError(table.where(row, col), "'" + cell + "' is not a number");
+    if (!std::isfinite(*v)) throw InputError(table.where(row, col), "'" + cell + "' is not allowed: must be a finite number");
+    return *v;
+  };
+
+  DriveCycle c;
+  c.name = name;
+  c.source = path;
+  const std::size_t n = table.rows.size();
+  c.time_s.resize(n);
+  c.speed_mps.resize(n);
+  c.grade.assign(n, 0.0);
+  std::vector<double> elevation;
+  for (std::size_t r = 0; r < n; ++r) {
+    c.time_s[r] = number(r, *col_t);
+    if (r > 0 && !(c.time_s[r] > c.time_s[r - 1])) {
+      throw InputError(table.where(r, *col_t),
+                       format_value(c.time_s[r]) + " s is not after " + format_value(c.time_s[r - 1]) + " s on line " +
+                           std::to_string(table.row_line[r - 1]) + ": time must be strictly increasing");
+    }
+    const double v = number(r, col_v);
+    if (v < 0.0) throw InputError(table.where(r, col_v), format_value(v) + " is not allowed: speed must be >= 0");
+    c.speed_mps[r] = col_kmh ? units::kmh_to_mps(v) : v;
+    if (col_grade) {
+      const double g = number(r, *col_grade);
+      if (std::abs(g) > kMaxCycleGrade * 100.0) {
+        throw InputError(table.where(r, *col_grade), format_value(g) + " % is not allowed: must be in [-30, 30]");
+      }
+      c.grade[r] = g / 100.0;
+    }
+    if (col_elev) elevation.push_back(number(r, *col_elev));
+  }
+
+  if (col_elev) {
+    // Grade at each sample: elevation difference over the distance travelled across a window that grows
+    // around the sample until it spans kGradeBaseline_m, so that standing still never divides by zero.
+    std::vector<double> s(n, 0.0);
+    for (std::size_t i = 1; i < n; ++i) {
+      s[i] = s[i - 1] + 0.5 * (c.speed_mps[i] + c.speed_mps[i - 1]) * (c.time_s[i] - c.time_s[i - 1]);
+    }
+    if (s.back() < kGradeBaseline_m) {
+      throw InputError(path + ": column 'elevation_m'",
+                       "the cycle travels only " + format_value(s.back()) +
+                           " m, too little to turn elevation into grade (needs " + format_value(kGradeBaseline_m) + " m)");
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      std::size_t j = i, k = i;
+      while (s[k] - s[j] < kGradeBaseline_m) {
+        if (j > 0) --j;
+        if (s[k] - s[j] >= kGradeBaseline_m) break;
+        if (k + 1 < n) ++k;
+      }
+      const double g = (elevation[k] - elevation[j]) / (s[k] - s[j]);
+      if (std::abs(g) > kMaxCycleGrade) {
+        throw InputError(path + ": lines " + std::to_string(table.row_line[j]) + "-" + std::to_string(table.row_line[k]) +
+                             ", column 'elevation_m'",
+                         "elevation goes from " + format_value(elevation[j]) + " m to " + format_value(elevation[k]) +
+                             " m over " + format_value(s[k] - s[j]) + " m travelled, a grade of " + format_value(100.0 * g) +
+                             " %; allowed: within +-30 %");
+      }
+      c.grade[i] = g;
+    }
+  }
+  return c;
+}
+
+}  // namespace rollsim
