@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
+#include <initializer_list>
 #include <string>
 #include <vector>
 
@@ -108,6 +109,21 @@ std::optional<YamlMap> opt_map(YamlMap& y, const std::string& key) {
   return y.optional_map(key);
 }
 
+// Rejects unknown keys before anything is read, so a misspelt key ("presure_bar") is reported as such rather
+// than as the required key it was meant to be.
+void reject_unknown_keys(const YamlMap& y, std::initializer_list<const char*> allowed) {
+  for (const auto& kv : y.node()) {
+    const std::string key = kv.first.as<std::string>();
+    bool known = false;
+    for (const char* a : allowed) known = known || key == a;
+    if (!known) {
+      std::string list;
+      for (const char* a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
+      throw InputError(y.where(key), "unknown key (misspelt?); allowed here: " + list);
+    }
+  }
+}
+
 const char* kFormat =
     "expected a size designation like '205/55 R16 91V' ([P|LT]width/aspect [Z]R rim [load index][speed symbol] "
     "[XL|Reinforced])";
@@ -122,7 +138,9 @@ std::optional<double> load_index_max_load_kg(int load_index) {
 TyreSize parse_tyre_size(const std::string& designation, const std::string& where) {
   const std::string text = upper(designation);
   const std::string quoted = "'" + designation + "'";
-  auto fail = [&](const std::string& why) -> TyreSize { throw InputError(where, quoted + " does not parse: " + why); };
+  auto fail = [&](const std::string& why) -> TyreSize {
+    throw InputError(where, quoted + " does not parse: " + why + "; " + kFormat);
+  };
 
   TyreSize out;
   out.designation = designation;
@@ -134,18 +152,18 @@ TyreSize parse_tyre_size(const std::string& designation, const std::string& wher
     out.prefix = "P";
   }
   const std::string width = c.digits();
-  if (width.size() != 3) return fail(std::string("section width must be 3 digits in mm; ") + kFormat);
-  if (!c.eat("/")) return fail(std::string("missing '/aspect ratio' after the width; ") + kFormat);
+  if (width.size() != 3) return fail("section width must be 3 digits in mm");
+  if (!c.eat("/")) return fail("missing '/aspect ratio' after the width");
   const std::string aspect = c.digits();
-  if (aspect.size() != 2) return fail(std::string("aspect ratio must be 2 digits in percent; ") + kFormat);
+  if (aspect.size() != 2) return fail("aspect ratio must be 2 digits in percent");
   c.skip_spaces();
   // Construction: R radial, ZR radial rated above 240 km/h. The model is for radial tyres only.
   if (!c.eat("ZR") && !c.eat("R")) {
-    return fail(std::string("construction must be R or ZR (radial; the model is for radial tyres); ") + kFormat);
+    return fail("construction must be R or ZR (radial; the model is for radial tyres)");
   }
   c.skip_spaces();
   const std::string rim = c.number();
-  if (rim.empty()) return fail(std::string("missing rim diameter in inches; ") + kFormat);
+  if (rim.empty()) return fail("missing rim diameter in inches");
 
   out.section_width_m = std::stod(width) * units::kMPerMm;
   out.aspect_ratio = std::stod(aspect) / 100.0;
@@ -198,6 +216,9 @@ TyreSize parse_tyre_size(const std::string& designation, const std::string& wher
 
 TyreSpec load_tyre_file(const std::string& path) {
   YamlMap y = YamlMap::load_file(path);
+  reject_unknown_keys(y, {"name", "description", "source", "size", "outer_radius_m", "section_width_m",
+                          "rim_diameter_in", "rim_radius_m", "outer_diameter_mm", "pressure_bar", "max_load_kg",
+                          "load_index", "model"});
   TyreSpec spec;
   spec.source = path;
   spec.name = opt_string(y, "name").value_or(std::filesystem::path(path).stem().string());
@@ -263,6 +284,8 @@ TyreSpec load_tyre_file(const std::string& path) {
   }
 
   if (auto m = opt_map(y, "model")) {
+    reject_unknown_keys(*m, {"viscous_damping_ns_per_m", "coulomb_damping_n", "rotational_drag_kg_per_m2",
+                             "stiffness_pressure_coeff", "stiffness_offset_kgf_per_mm", "elements"});
     auto& k = spec.state.constants;
     k.viscous_damping_ns_per_m = opt_number(*m, "viscous_damping_ns_per_m", Range::non_negative()).value_or(k.viscous_damping_ns_per_m);
     k.coulomb_damping_n = opt_number(*m, "coulomb_damping_n", Range::non_negative()).value_or(k.coulomb_damping_n);
