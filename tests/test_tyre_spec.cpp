@@ -6,6 +6,8 @@
 #include <fstream>
 #include <string>
 
+#include <unistd.h>
+
 #include "rollsim/common/error.hpp"
 #include "rollsim/tyre/tyre_model.hpp"
 #include "rollsim/tyre/tyre_spec.hpp"
@@ -20,7 +22,8 @@ std::string tyre_path(const std::string& name) { return std::string(ROLLSIM_SOUR
 
 // Writes `text` to a fresh file in the temp folder and returns its path.
 std::string temp_yaml(const std::string& stem, const std::string& text) {
-  const auto dir = std::filesystem::temp_directory_path() / "rollsim_test_tyre_spec";
+  // Unique per process: several test processes (ctest -j, other build folders) may run at once.
+  const auto dir = std::filesystem::temp_directory_path() / ("rollsim_test_tyre_spec_" + std::to_string(getpid()));
   std::filesystem::create_directories(dir);
   const auto path = dir / (stem + ".yaml");
   std::ofstream(path) << text;

@@ -180,18 +180,19 @@ void run_tyre(const TyreOptions& o) {
     }
   }
 
-  if (spec.max_load_n > 0.0 && load.load_n > spec.max_load_n) {
-    std::cerr << "warning: load " << report::fixed(load.load_n, 0) << " N is above the tyre's rated maximum "
-              << report::fixed(spec.max_load_n, 0) << " N (" << kg_text(spec.max_load_n)
-              << "); results are outside the tyre's rating\n";
-  }
-
   std::vector<RollingResistance> results;
   std::vector<TyreExplanation> explanations;
   for (const double v_kmh : speeds_kmh) {
     const double v_mps = units::kmh_to_mps(v_kmh);
     results.push_back(named(spec, load, o, [&] { return evaluate_rolling_resistance(spec.state, load.load_n, v_mps); }));
     if (o.explain) explanations.push_back(named(spec, load, o, [&] { return explain_tyre(spec.state, load.load_n, v_mps); }));
+  }
+
+  // Warned only once the point is known to be solvable, so a rejected load gets one message, not two.
+  if (spec.max_load_n > 0.0 && load.load_n > spec.max_load_n) {
+    std::cerr << "warning: load " << report::fixed(load.load_n, 0) << " N is above the tyre's rated maximum "
+              << report::fixed(spec.max_load_n, 0) << " N (" << kg_text(spec.max_load_n)
+              << "); results are outside the tyre's rating\n";
   }
 
   const double p_bar = units::pa_to_bar(spec.state.pressure_pa);
