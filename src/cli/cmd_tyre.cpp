@@ -253,16 +253,21 @@ void register_tyre_command(CLI::App& app) {
   CLI::App* sub = app.add_subcommand(
       "tyre", "Rolling resistance of one tyre at one load and one or more speeds (table, --json, or --explain)");
   sub->add_option("tyre_file", opts->file,
-                  "Tyre YAML file, or a name in the shipped tyres/ folder (e.g. 175-70R14)");
-  sub->add_option("--size", opts->size, "Size designation instead of a file, e.g. \"175/70 R14 84T\"");
-  sub->add_option("--outer-radius-m", opts->outer_radius_m, "Unloaded outer radius R [m] (with --width-m)");
-  sub->add_option("--width-m", opts->width_m, "Section width W [m] (with --outer-radius-m)");
-  sub->add_option("--pressure-bar", opts->pressure_bar, "Inflation pressure [bar]; overrides a file's pressure");
-  sub->add_option("--load-n", opts->load_n, "Normal load per tyre [N]");
-  sub->add_option("--load-pct", opts->load_pct, "Normal load as % of the tyre's maximum load (default 80)");
+                  "Tyre YAML file, or a name in the shipped tyres/ folder (e.g. 175-70R14)")
+      ->type_name("FILE");
+  sub->add_option("--size", opts->size, "Size designation instead of a file, e.g. \"175/70 R14 84T\"")
+      ->type_name("SIZE");
+  sub->add_option("--outer-radius-m", opts->outer_radius_m, "Unloaded outer radius R [m] (with --width-m)")->type_name("M");
+  sub->add_option("--width-m", opts->width_m, "Section width W [m] (with --outer-radius-m)")->type_name("M");
+  sub->add_option("--pressure-bar", opts->pressure_bar, "Inflation pressure [bar]; overrides a file's pressure")
+      ->type_name("BAR");
+  sub->add_option("--load-n", opts->load_n, "Normal load per tyre [N]")->type_name("N");
+  sub->add_option("--load-pct", opts->load_pct, "Normal load as % of the tyre's maximum load (default 80)")
+      ->type_name("PCT");
   sub->add_option("--speed-kmh", opts->speeds_kmh, "Speed(s) [km/h]: several values, repeated or comma-separated "
                                                     "(default 80)")
-      ->delimiter(',');
+      ->delimiter(',')
+      ->type_name("KMH");
   sub->add_flag("--json", opts->json, "One JSON object per operating point per line");
   sub->add_flag("--explain", opts->explain, "Elasticities of RRC and RR power and the mechanism behind each");
   sub->callback([opts] { run_tyre(*opts); });
