@@ -89,7 +89,7 @@ double YamlMap::number_or(const std::string& key, double fallback, Range range) 
 
 std::optional<double> YamlMap::optional_number(const std::string& key, Range range) {
   YAML::Node n = get(key, false);
-  if (!n) return std::nullopt;
+  if (!has(key)) return std::nullopt;
   return to_number(n, key, range);
 }
 
@@ -106,14 +106,14 @@ std::string YamlMap::string_or(const std::string& key, const std::string& fallba
 
 std::optional<std::string> YamlMap::optional_string(const std::string& key) {
   YAML::Node n = get(key, false);
-  if (!n) return std::nullopt;
+  if (!has(key)) return std::nullopt;
   if (!n.IsScalar()) throw InputError(where(key), "expected a text value");
   return n.Scalar();
 }
 
 bool YamlMap::boolean_or(const std::string& key, bool fallback) {
   YAML::Node n = get(key, false);
-  if (!n) return fallback;
+  if (!has(key)) return fallback;
   const std::string s = n.IsScalar() ? n.Scalar() : "";
   if (s == "true" || s == "yes" || s == "on") return true;
   if (s == "false" || s == "no" || s == "off") return false;
@@ -150,7 +150,7 @@ YamlMap YamlMap::map(const std::string& key) {
 
 std::optional<YamlMap> YamlMap::optional_map(const std::string& key) {
   YAML::Node n = get(key, false);
-  if (!n) return std::nullopt;
+  if (!has(key)) return std::nullopt;
   if (!n.IsMap()) throw InputError(where(key), "expected a mapping of keys to values");
   return YamlMap(n, file_, prefix_ + key + ".");
 }

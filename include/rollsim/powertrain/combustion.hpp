@@ -1,0 +1,64 @@
+// Combustion powertrain: Willans-line engine, stepped gearbox with shift schedule, clutch, fuel properties.
+#pragma once
+
+#include <vector>
+
+#include "rollsim/powertrain/powertrain.hpp"
+
+namespace rollsim {
+
+/// Willans-line engine (Guzzella & Sciarretta, Vehicle Propulsion Systems, ch. 4): fuel power
+/// P_fuel = (P_brake + P_friction) / e, with friction from a mean effective pressure that rises with speed,
+/// P_friction = (p_me0 + p_me0_speed * w) * V_d * w / (4 pi) for a four-stroke engine.
+struct EngineParams {
+  double displacement_m3 = 0.0;
+  double indicated_efficiency = 0.0;          ///< e, the Willans slope's inverse
+  double friction_mep_pa = 0.0;               ///< p_me0 at zero speed
+  double friction_mep_pa_s_per_rad = 0.0;     ///< growth of friction mean effective pressure with speed
+  double idle_speed_radps = 0.0;
+  double max_speed_radps = 0.0;
+  double max_torque_nm = 0.0;
+  double max_power_w = 0.0;
+  /// Overrun fuel cut-off: no fuel while the wheels drive the engine above this speed.
+  double fuel_cut_min_speed_radps = 0.0;
+};
+
+struct GearboxParams {
+  std::vector<double> ratios;          ///< engine speed / gearbox output speed, first gear first
+  double final_drive_ratio = 1.0;
+  double efficiency = 1.0;             ///< gearbox and final drive together, both directions
+  std::vector<double> upshift_speeds_mps;    ///< speed to leave gear i for i+1 (size = gears - 1)
+  std::vector<double> downshift_speeds_mps;  ///< speed to leave gear i+1 for i (size = gears - 1)
+};
+
+struct FuelParams {
+  double density_kg_per_m3 = 0.0;
+  double lower_heating_value_j_per_kg = 0.0;
+  double co2_kg_per_kg = 0.0;   ///< tank-to-wheel CO2 per kg of fuel burned
+};
+
+struct CombustionPowertrainParams {
+  EngineParams engine;
+  GearboxParams gearbox;
+  FuelParams fuel;
+  double aux_power_w = 0.0;      ///< electrical load carried by the alternator
+  double alternator_efficiency = 1.0;
+};
+
+class CombustionPowertrain final : public Powertrain {
+ public:
+  explicit CombustionPowertrain(const CombustionPowertrainParams& params) : p_(params) {}
+  PowerFlow deliver(double wheel_force_n, double speed_mps, int gear, double wheel_radius_m) const override;
+  int select_gear(double speed_mps, int current_gear) const override;
+  std::vector<double> shift_speeds_mps(int gear) const override;
+  std::vector<double> regime_speeds_mps() const override { return {}; }
+  double usable_battery_energy_j() const override { return 0.0; }
+  bool is_electric() const override { return false; }
+  const CombustionPowertrainParams& params() const { return p_; }
+
+ private:
+  double friction_power_w(double speed_radps) const;
+  CombustionPowertrainParams p_;
+};
+
+}  // namespace rollsim

@@ -1,0 +1,76 @@
+// Battery-electric powertrain: battery, motor loss model, single-speed reduction, blended regenerative braking.
+#pragma once
+
+#include "rollsim/powertrain/powertrain.hpp"
+
+namespace rollsim {
+
+/// Electric machine losses as a physical loss model instead of a measured map:
+/// P_loss = k_cu T^2 + k_fe w + k_w w^3 + P_0. Copper loss grows with torque (current) squared, iron (hysteresis
+/// and eddy) loss with speed, windage with speed cubed; P_0 covers the inverter's standby loss. The same model
+/// is used in motoring and generating, as the physics is symmetric in torque.
+struct MotorLossParams {
+  double copper_w_per_nm2 = 0.0;       ///< k_cu [W/(N m)^2]
+  double iron_w_s_per_rad = 0.0;       ///< k_fe [W/(rad/s)]
+  double windage_w_s3_per_rad3 = 0.0;  ///< k_w  [W/(rad/s)^3]
+  double constant_w = 0.0;             ///< P_0 [W], only while the machine turns
+};
+
+struct ElectricMotorParams {
+  double max_torque_nm = 0.0;
+  double max_power_w = 0.0;        ///< continuous-peak mechanical power, both directions
+  double max_speed_radps = 0.0;
+  MotorLossParams losses;
+};
+
+struct ReductionParams {
+  double ratio = 1.0;        ///< motor speed / wheel speed
+  double efficiency = 1.0;   ///< (0, 1], both directions
+};
+
+struct BatteryParams {
+  double open_circuit_voltage_v = 0.0;
+  double internal_resistance_ohm = 0.0;
+  double usable_capacity_j = 0.0;
+  double initial_soc = 1.0;  ///< fraction of usable capacity at the start
+};
+
+/// Regenerative braking and its blending with the friction brakes.
+struct RegenParams {
+  double max_power_w = 0.0;            ///< electrical power the battery/inverter accept while braking
+  /// Share of the total braking force the driven axle's motor may take (brake blending: a front-driven car with
+  /// a fixed front/rear brake balance recovers only the front share).
+  double driven_axle_brake_fraction = 1.0;
+  double min_speed_mps = 0.0;          ///< below this no regeneration (the motor cannot hold the car)
+  double fade_speed_mps = 0.0;         ///< regen ramps linearly from zero at min speed to full at this speed
+};
+
+struct ElectricPowertrainParams {
+  ElectricMotorParams motor;
+  ReductionParams reduction;
+  BatteryParams battery;
+  RegenParams regen;
+  double aux_power_w = 0.0;
+};
+
+class ElectricPowertrain final : public Powertrain {
+ public:
+  explicit ElectricPowertrain(const ElectricPowertrainParams& params) : p_(params) {}
+  PowerFlow deliver(double wheel_force_n, double speed_mps, int gear, double wheel_radius_m) const override;
+  int select_gear(double, int) const override { return 0; }
+  std::vector<double> shift_speeds_mps(int) const override { return {}; }
+  std::vector<double> regime_speeds_mps() const override;
+  double usable_battery_energy_j() const override { return p_.battery.usable_capacity_j; }
+  bool is_electric() const override { return true; }
+  const ElectricPowertrainParams& params() const { return p_; }
+
+  /// Battery current [A] (+ discharging) for a terminal power [W]; throws ModelDomainError when the battery
+  /// cannot deliver it (P > Voc^2 / 4R).
+  double battery_current_a(double terminal_power_w) const;
+
+ private:
+  double motor_loss_w(double torque_nm, double speed_radps) const;
+  ElectricPowertrainParams p_;
+};
+
+}  // namespace rollsim

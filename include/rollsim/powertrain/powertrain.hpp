@@ -1,0 +1,56 @@
+// The powertrain interface: turns a requested wheel force at a speed into delivered force, energy flows and losses.
+#pragma once
+
+#include <vector>
+
+namespace rollsim {
+
+/// Powers at one instant, all [W], signed where noted. Everything downstream of the wheel that the energy
+/// report and the energy balance need. Fields a powertrain does not have stay zero.
+struct PowerFlow {
+  double wheel_force_n = 0.0;           ///< force the powertrain and brakes deliver at the wheels (+ propels)
+  double traction_power_w = 0.0;        ///< >= 0: propulsive power at the wheels
+  double regen_wheel_power_w = 0.0;     ///< >= 0: braking power taken by the motor at the wheels
+  double friction_brake_power_w = 0.0;  ///< >= 0: braking power dissipated by friction brakes (and engine drag)
+  double gearbox_loss_w = 0.0;          ///< >= 0: reduction/gearbox and final-drive loss
+  double motor_loss_w = 0.0;            ///< >= 0: electric machine loss (copper, iron, windage)
+  double battery_terminal_power_w = 0.0;  ///< signed: + discharging, at the battery terminals
+  double battery_loss_w = 0.0;          ///< >= 0: I^2 R inside the battery
+  double aux_power_w = 0.0;             ///< >= 0: auxiliaries (electronics, HVAC), from battery or alternator
+  double fuel_power_w = 0.0;            ///< >= 0: fuel chemical power (lower heating value)
+  double fuel_rate_m3_per_s = 0.0;      ///< >= 0: fuel volume flow
+  double engine_loss_w = 0.0;           ///< >= 0: fuel power not turned into brake work (thermal + friction)
+  double clutch_loss_w = 0.0;           ///< >= 0: clutch slip at launch (engine held at idle speed)
+  double battery_current_a = 0.0;       ///< signed: + discharging
+  double machine_speed_radps = 0.0;     ///< motor or engine speed
+  double machine_torque_nm = 0.0;       ///< motor or engine torque
+  bool force_limited = false;           ///< true when the request exceeded what the powertrain can deliver
+};
+
+/// A powertrain. Implementations know their own parameters; the simulator calls only this interface, so the
+/// integrator and the vehicle dynamics stay independent of the kind of car.
+class Powertrain {
+ public:
+  virtual ~Powertrain() = default;
+
+  /// Delivers the requested wheel force (+ propel, - brake) at `speed_mps` in discrete mode `gear`, within the
+  /// powertrain's limits. `wheel_radius_m` is the driven tyres' effective rolling radius (it sets the gearing).
+  virtual PowerFlow deliver(double wheel_force_n, double speed_mps, int gear, double wheel_radius_m) const = 0;
+
+  /// The gear to use at `speed_mps` coming from `current_gear` (with hysteresis); 0 for single-speed drives.
+  virtual int select_gear(double speed_mps, int current_gear) const = 0;
+
+  /// Speeds [m/s] at which `select_gear` changes its answer from `gear`: the integrator finds these crossings as
+  /// roots so it never steps over a shift. Empty for single-speed drives.
+  virtual std::vector<double> shift_speeds_mps(int gear) const = 0;
+
+  /// Speeds [m/s] at which deliver() switches regime (regen fade, clutch lock-up); stop points for the integrator.
+  virtual std::vector<double> regime_speeds_mps() const = 0;
+
+  /// Usable battery energy [J] (electric), 0 for combustion.
+  virtual double usable_battery_energy_j() const = 0;
+
+  virtual bool is_electric() const = 0;
+};
+
+}  // namespace rollsim

@@ -1,0 +1,39 @@
+// Extension point for physical effects beyond the base model (tyre warm-up, wind, slip, ...): hooks into the simulator.
+#pragma once
+
+#include <string>
+
+namespace rollsim {
+
+/// What an effect may look at, at one instant of a simulation.
+struct EffectInputs {
+  double time_s = 0.0;
+  double speed_mps = 0.0;
+  double accel_mps2 = 0.0;
+  double grade = 0.0;
+  double distance_m = 0.0;
+  double base_rolling_force_n = 0.0;  ///< rolling resistance of the base tyre model at this speed
+  double wheel_force_demand_n = 0.0;  ///< force the driver asks of the wheels (feed-forward), + propels
+};
+
+/// A physical effect with its own parameters and, optionally, hidden states integrated with the vehicle's
+/// (tyre temperature, oil temperature). The neutral value of every hook leaves the base model unchanged, so an
+/// effect whose parameters are zero is off.
+class Effect {
+ public:
+  virtual ~Effect() = default;
+  virtual std::string id() const = 0;
+  virtual int num_states() const { return 0; }
+  virtual void initial_states(double* /*x*/) const {}
+  virtual void state_derivatives(const EffectInputs&, const double* /*x*/, double* /*xdot*/) const {}
+  /// Factor on the tyre model's rolling resistance (tyre temperature, ambient temperature).
+  virtual double rolling_resistance_factor(const EffectInputs&, const double* /*x*/) const { return 1.0; }
+  /// Extra force opposing motion [N] (wind, unmodelled grade), booked as "other resistance".
+  virtual double extra_resistance_n(const EffectInputs&, const double* /*x*/) const { return 0.0; }
+  /// Extra loss at the wheels [W] that the powertrain must supply on top of the wheel work (tyre slip).
+  virtual double wheel_loss_w(const EffectInputs&, const double* /*x*/) const { return 0.0; }
+  /// Factor on the engine's fuel power (cold engine friction).
+  virtual double fuel_power_factor(const EffectInputs&, const double* /*x*/) const { return 1.0; }
+};
+
+}  // namespace rollsim

@@ -1,0 +1,121 @@
+// Vehicle energy simulation over a speed trace: forward (driver + CVODE) and kinematic replay, one power flow.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "rollsim/cycle/drive_cycle.hpp"
+#include "rollsim/powertrain/powertrain.hpp"
+#include "rollsim/sim/effect.hpp"
+#include "rollsim/sim/ode_integrator.hpp"
+#include "rollsim/vehicle/road_load.hpp"
+#include "rollsim/vehicle/vehicle.hpp"
+
+namespace rollsim {
+
+/// The run-time model of a car: what the simulator needs, assembled once from a Vehicle description.
+struct VehicleModel {
+  std::string name;
+  std::string road_load_description;
+  double mass_kg = 0.0;             ///< test mass (grade and inertia)
+  double rotating_mass_kg = 0.0;    ///< equivalent mass of rotating parts (inertia only)
+  double wheel_radius_m = 0.0;      ///< effective rolling radius of the driven wheels
+  std::shared_ptr<const RoadLoadModel> road_load;
+  std::shared_ptr<const Powertrain> powertrain;
+  std::vector<std::shared_ptr<const Effect>> effects;
+
+  double inertial_mass_kg() const { return mass_kg + rotating_mass_kg; }
+  static VehicleModel assemble(const Vehicle& vehicle);
+};
+
+struct SimulationOptions {
+  double relative_tolerance = 1e-4;
+  double driver_kp_per_s = 2.0;        ///< proportional gain on speed error [1/s]
+  double driver_ki_per_s2 = 0.5;       ///< integral gain [1/s^2]
+  bool record_trace = false;           ///< one row per cycle sample
+  /// A shortfall is reported where the car falls behind the trace by more than this (the regulation's
+  /// speed tolerance is 2 km/h).
+  double shortfall_threshold_mps = 2.0 / 3.6;
+};
+
+/// Energies over a run [J]. At the wheel hubs: traction = rolling + aero + grade + other + friction brake + regen
+/// + wheel loss + kinetic change. Electric: battery terminal = traction - regen + gearbox + motor + aux.
+/// Combustion: fuel = engine loss + traction + gearbox + clutch + aux.
+struct EnergyBreakdown {
+  double traction_j = 0.0;
+  double rolling_j = 0.0;
+  double aero_j = 0.0;
+  double grade_j = 0.0;           ///< signed: net potential energy gained
+  double other_resistance_j = 0.0;  ///< effects' forces (wind, ...)
+  double friction_brake_j = 0.0;
+  double regen_wheel_j = 0.0;
+  double kinetic_change_j = 0.0;
+  double wheel_loss_j = 0.0;      ///< effects' wheel losses (tyre slip)
+  double gearbox_loss_j = 0.0;
+  double motor_loss_j = 0.0;
+  double battery_loss_j = 0.0;
+  double aux_j = 0.0;
+  double battery_terminal_j = 0.0;  ///< signed: + discharged
+  double fuel_j = 0.0;
+  double engine_loss_j = 0.0;
+  double clutch_loss_j = 0.0;
+
+  double wheel_residual_j() const;       ///< traction minus all its uses; ~0 when the balance closes
+  double powertrain_residual_j(bool electric) const;  ///< source energy minus all its uses
+};
+
+struct Shortfall {
+  double start_s = 0.0;
+  double end_s = 0.0;
+  double max_deficit_mps = 0.0;  ///< largest (trace - actual) speed in the interval
+  double at_s = 0.0;             ///< when it was largest
+};
+
+struct TracePoint {
+  double time_s, target_speed_mps, speed_mps, accel_mps2, grade;
+  double rolling_force_n, aero_force_n, grade_force_n, wheel_force_n;
+  double traction_power_w, battery_power_w, battery_current_a, fuel_rate_m3_per_s;
+  double rrc;  ///< rolling force / total normal load
+  double soc;  ///< state of charge, fraction (electric)
+  int gear;
+};
+
+struct SimulationResult {
+  std::string vehicle;
+  std::string road_load;
+  std::string cycle;
+  std::string mode;  ///< "forward" or "replay"
+  bool electric = false;
+  double duration_s = 0.0;
+  double distance_m = 0.0;
+  EnergyBreakdown energy;
+  double fuel_volume_m3 = 0.0;
+  double co2_kg = 0.0;
+  double usable_battery_j = 0.0;
+  double initial_soc = 1.0;
+  double final_soc = 1.0;
+  double max_speed_error_mps = 0.0;
+  double max_speed_error_time_s = 0.0;
+  OdeStats solver;
+  std::vector<Shortfall> shortfalls;
+  std::vector<TracePoint> trace;
+
+  /// Battery-terminal energy per distance in kWh/10 km (the platform study's unit).
+  double aec_kwh_per_10km() const;
+  double fuel_l_per_100km() const;
+  double co2_g_per_km() const;
+  /// Distance on the usable battery at this consumption [km] (battery chemical energy, incl. its loss).
+  double range_km() const;
+};
+
+/// Forward simulation: a driver (cycle feed-forward + PI) follows the trace; CVODE integrates speed,
+/// distance, the driver's integral and every energy accumulator, stopping at each kink of the trace, each
+/// gear shift (a located root) and each powertrain regime change. Throws SolverError if CVODE fails.
+SimulationResult simulate_forward(const VehicleModel& model, const DriveCycle& cycle, const SimulationOptions& opt = {});
+
+/// Kinematic replay: the car follows the trace exactly; the same power flow is integrated per segment
+/// (Gauss-Legendre, 3 points), with no driver and no ODE solver.
+SimulationResult simulate_replay(const VehicleModel& model, const DriveCycle& cycle, const SimulationOptions& opt = {});
+
+}  // namespace rollsim

@@ -1,0 +1,75 @@
+// Vehicle description (body, tyres, road load, powertrain) and its strict YAML file format.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <variant>
+
+#include "rollsim/powertrain/combustion.hpp"
+#include "rollsim/powertrain/electric.hpp"
+#include "rollsim/tyre/tyre_spec.hpp"
+#include "rollsim/vehicle/road_load.hpp"
+
+namespace rollsim {
+
+enum class DrivenAxle { front, rear, all };
+
+struct BodyParams {
+  double test_mass_kg = 0.0;
+  double rotating_mass_kg = 0.0;        ///< equivalent translational mass of wheels, driveline and motor
+  double drag_coefficient = 0.0;
+  double frontal_area_m2 = 0.0;
+  double air_density_kg_per_m3 = 1.2;
+  double front_axle_load_fraction = 0.5;  ///< static share of weight on the front axle
+  DrivenAxle driven_axle = DrivenAxle::front;
+  double wheel_radius_m = 0.0;          ///< used only when no tyre is given (coast-down road load)
+};
+
+/// Published coast-down road load F = A + B v + C v^2 (SI), as type-approval authorities publish it.
+struct CoastdownParams {
+  double a_n = 0.0;
+  double b_n_s_per_m = 0.0;
+  double c_n_s2_per_m2 = 0.0;
+};
+
+using PowertrainParams = std::variant<ElectricPowertrainParams, CombustionPowertrainParams>;
+
+struct Vehicle {
+  std::string name;
+  std::string source;
+  BodyParams body;
+  std::optional<TyreSpec> front_tyre;  ///< both present or both absent
+  std::optional<TyreSpec> rear_tyre;
+  std::optional<CoastdownParams> coastdown;  ///< when set, it is the road load; tyres only gear the car
+  PowertrainParams powertrain;
+
+  bool is_electric() const { return std::holds_alternative<ElectricPowertrainParams>(powertrain); }
+};
+
+/// Loads a vehicle file; tyre files named in it are found beside it or in the shipped tyres/.
+Vehicle load_vehicle_file(const std::string& path);
+
+/// Replaces the tyres of all four wheels (the `--tyre` option).
+void fit_tyres(Vehicle& vehicle, const TyreSpec& tyre);
+
+/// Static normal load on one tyre of each axle [N] on a grade (front, rear).
+struct AxleWheelLoads {
+  double front_n = 0.0;
+  double rear_n = 0.0;
+};
+AxleWheelLoads wheel_loads(const BodyParams& body, double grade);
+
+/// Effective rolling radius of the driven wheels [m]: R - dz/3 of the tyre at its static load (the usual
+/// approximation between free and loaded radius), or body.wheel_radius_m without tyres.
+double driven_wheel_radius_m(const Vehicle& vehicle);
+
+/// Builds the road-load model of the vehicle: the tyre model on every wheel plus body aero, or coast-down.
+std::unique_ptr<RoadLoadModel> make_road_load(const Vehicle& vehicle);
+
+/// Road load of the tyre model at the wheels: the tyres' share of a coast-down A term at speed -> 0.
+double tyre_rolling_force_at_standstill_limit_n(const Vehicle& vehicle);
+
+std::unique_ptr<Powertrain> make_powertrain(const Vehicle& vehicle);
+
+}  // namespace rollsim

@@ -1,0 +1,79 @@
+#include "rollsim/powertrain/combustion.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace rollsim {
+
+double CombustionPowertrain::friction_power_w(double speed_radps) const {
+  const auto& e = p_.engine;
+  const double pme0_pa = e.friction_mep_pa + e.friction_mep_pa_s_per_rad * speed_radps;
+  return pme0_pa * e.displacement_m3 * speed_radps / (4.0 * std::numbers::pi);
+}
+
+int CombustionPowertrain::select_gear(double speed_mps, int current_gear) const {
+  const auto& g = p_.gearbox;
+  const int n = static_cast<int>(g.ratios.size());
+  int gear = std::clamp(current_gear, 1, n);
+  while (gear < n && speed_mps > g.upshift_speeds_mps[gear - 1]) ++gear;
+  while (gear > 1 && speed_mps < g.downshift_speeds_mps[gear - 2]) --gear;
+  return gear;
+}
+
+std::vector<double> CombustionPowertrain::shift_speeds_mps(int gear) const {
+  const auto& g = p_.gearbox;
+  const int n = static_cast<int>(g.ratios.size());
+  std::vector<double> s;
+  if (gear < n) s.push_back(g.upshift_speeds_mps[gear - 1]);
+  if (gear > 1) s.push_back(g.downshift_speeds_mps[gear - 2]);
+  return s;
+}
+
+PowerFlow CombustionPowertrain::deliver(double wheel_force_n, double speed_mps, int gear,
+                                        double wheel_radius_m) const {
+  const auto& e = p_.engine;
+  const auto& g = p_.gearbox;
+  const int n = static_cast<int>(g.ratios.size());
+  const double ratio = g.ratios[std::clamp(gear, 1, n) - 1] * g.final_drive_ratio;
+  const double eta = g.efficiency;
+  const double v = std::max(speed_mps, 0.0);
+  const double coupled_speed_radps = v / wheel_radius_m * ratio;
+  // Below idle speed the clutch slips: the engine turns at idle while the gearbox input turns slower.
+  const double engine_speed_radps = std::max(coupled_speed_radps, e.idle_speed_radps);
+  const double accessory_power_w = p_.aux_power_w / p_.alternator_efficiency;
+
+  PowerFlow out;
+  out.machine_speed_radps = engine_speed_radps;
+  out.aux_power_w = accessory_power_w;
+  double brake_power_w = accessory_power_w;
+
+  if (wheel_force_n >= 0.0) {
+    double max_force_n = e.max_torque_nm * ratio * eta / wheel_radius_m;
+    if (v > 0.0) max_force_n = std::min(max_force_n, (e.max_power_w - accessory_power_w) * eta / v);
+    const double force_n = std::min(wheel_force_n, max_force_n);
+    out.force_limited = wheel_force_n > max_force_n * (1.0 + 1e-12);
+    out.wheel_force_n = force_n;
+    out.traction_power_w = force_n * v;
+    const double torque_nm = force_n * wheel_radius_m / (ratio * eta);
+    out.gearbox_loss_w = torque_nm * coupled_speed_radps - out.traction_power_w;
+    out.clutch_loss_w = torque_nm * (engine_speed_radps - coupled_speed_radps);
+    out.machine_torque_nm = torque_nm;
+    brake_power_w += torque_nm * engine_speed_radps;
+  } else {
+    // Braking: friction brakes and engine drag. Above the cut-off speed the engine is motored with no fuel and
+    // the wheels also carry the accessories, so all of it is braking energy; below, the engine idles declutched.
+    out.wheel_force_n = wheel_force_n;
+    out.friction_brake_power_w = -wheel_force_n * v;
+    if (coupled_speed_radps > e.fuel_cut_min_speed_radps) {
+      out.aux_power_w = 0.0;
+      return out;
+    }
+  }
+  out.fuel_power_w = (brake_power_w + friction_power_w(engine_speed_radps)) / e.indicated_efficiency;
+  out.engine_loss_w = out.fuel_power_w - brake_power_w;
+  out.fuel_rate_m3_per_s = out.fuel_power_w / p_.fuel.lower_heating_value_j_per_kg / p_.fuel.density_kg_per_m3;
+  return out;
+}
+
+}  // namespace rollsim

@@ -1,0 +1,99 @@
+#include "rollsim/powertrain/electric.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "rollsim/common/error.hpp"
+
+namespace rollsim {
+
+double ElectricPowertrain::motor_loss_w(double torque_nm, double speed_radps) const {
+  const auto& l = p_.motor.losses;
+  if (speed_radps <= 0.0 && torque_nm == 0.0) return 0.0;  // switched off at standstill
+  return l.copper_w_per_nm2 * torque_nm * torque_nm + l.iron_w_s_per_rad * speed_radps +
+         l.windage_w_s3_per_rad3 * speed_radps * speed_radps * speed_radps + l.constant_w;
+}
+
+double ElectricPowertrain::battery_current_a(double terminal_power_w) const {
+  const double voc = p_.battery.open_circuit_voltage_v;
+  const double r = p_.battery.internal_resistance_ohm;
+  if (r <= 0.0) return terminal_power_w / voc;
+  // P = (Voc - I R) I, the smaller root: the battery's operating branch.
+  const double disc = voc * voc - 4.0 * r * terminal_power_w;
+  if (disc < 0.0) {
+    throw ModelDomainError("battery cannot deliver " + format_value(terminal_power_w / 1e3) +
+                           " kW (maximum Voc^2/4R = " + format_value(voc * voc / (4.0 * r) / 1e3) + " kW)");
+  }
+  return (voc - std::sqrt(disc)) / (2.0 * r);
+}
+
+PowerFlow ElectricPowertrain::deliver(double wheel_force_n, double speed_mps, int /*gear*/,
+                                      double wheel_radius_m) const {
+  const double ratio = p_.reduction.ratio;
+  const double eta = p_.reduction.efficiency;
+  const double v = std::max(speed_mps, 0.0);
+  const double motor_speed_radps = v / wheel_radius_m * ratio;
+  PowerFlow out;
+  out.machine_speed_radps = motor_speed_radps;
+  double shaft_power_w = 0.0;
+  double torque_nm = 0.0;
+
+  if (wheel_force_n >= 0.0) {
+    double max_force_n = p_.motor.max_torque_nm * ratio * eta / wheel_radius_m;
+    if (v > 0.0) max_force_n = std::min(max_force_n, p_.motor.max_power_w * eta / v);
+    if (motor_speed_radps > p_.motor.max_speed_radps) max_force_n = 0.0;
+    const double force_n = std::min(wheel_force_n, max_force_n);
+    out.force_limited = wheel_force_n > max_force_n * (1.0 + 1e-12);
+    out.wheel_force_n = force_n;
+    out.traction_power_w = force_n * v;
+    shaft_power_w = out.traction_power_w / eta;
+    out.gearbox_loss_w = shaft_power_w - out.traction_power_w;
+    torque_nm = force_n * wheel_radius_m / (ratio * eta);
+  } else {
+    const double brake_force_n = -wheel_force_n;
+    const auto& rg = p_.regen;
+    double fade = 1.0;
+    if (v <= rg.min_speed_mps) {
+      fade = 0.0;
+    } else if (v < rg.fade_speed_mps) {
+      fade = (v - rg.min_speed_mps) / (rg.fade_speed_mps - rg.min_speed_mps);
+    }
+    double regen_force_n = brake_force_n * rg.driven_axle_brake_fraction * fade;
+    regen_force_n = std::min(regen_force_n, p_.motor.max_torque_nm * ratio / (wheel_radius_m * eta));
+    if (v > 0.0) {
+      // Mechanical power reaching the motor is limited by the motor rating and by what the battery accepts.
+      const double max_shaft_w = std::min(p_.motor.max_power_w, rg.max_power_w);
+      regen_force_n = std::min(regen_force_n, max_shaft_w / (v * eta));
+    } else {
+      regen_force_n = 0.0;
+    }
+    torque_nm = -regen_force_n * wheel_radius_m * eta / ratio;
+    // Regenerating must recover energy; where losses would exceed it, the controller leaves it to friction.
+    if (regen_force_n > 0.0 && -regen_force_n * v * eta + motor_loss_w(torque_nm, motor_speed_radps) >= 0.0) {
+      regen_force_n = 0.0;
+      torque_nm = 0.0;
+    }
+    out.wheel_force_n = wheel_force_n;
+    out.regen_wheel_power_w = regen_force_n * v;
+    out.friction_brake_power_w = (brake_force_n - regen_force_n) * v;
+    out.gearbox_loss_w = out.regen_wheel_power_w * (1.0 - eta);
+    shaft_power_w = -(out.regen_wheel_power_w - out.gearbox_loss_w);
+  }
+  out.machine_torque_nm = torque_nm;
+  out.motor_loss_w = motor_loss_w(torque_nm, motor_speed_radps);
+  out.aux_power_w = p_.aux_power_w;
+  out.battery_terminal_power_w = shaft_power_w + out.motor_loss_w + out.aux_power_w;
+  out.battery_current_a = battery_current_a(out.battery_terminal_power_w);
+  out.battery_loss_w = out.battery_current_a * out.battery_current_a * p_.battery.internal_resistance_ohm;
+  return out;
+}
+
+std::vector<double> ElectricPowertrain::regime_speeds_mps() const {
+  std::vector<double> s;
+  if (p_.regen.min_speed_mps > 0.0) s.push_back(p_.regen.min_speed_mps);
+  if (p_.regen.fade_speed_mps > p_.regen.min_speed_mps) s.push_back(p_.regen.fade_speed_mps);
+  return s;
+}
+
+}  // namespace rollsim

@@ -1,0 +1,306 @@
+#include "rollsim/vehicle/vehicle.hpp"
+
+#include <cmath>
+#include <filesystem>
+#include <numbers>
+
+#include "rollsim/common/error.hpp"
+#include "rollsim/common/units.hpp"
+#include "rollsim/common/yaml_reader.hpp"
+#include "rollsim/tyre/tyre_model.hpp"
+
+namespace rollsim {
+namespace {
+
+constexpr double kRadPerSPerRpm = 2.0 * std::numbers::pi / 60.0;
+
+// A tyre named in a vehicle file: relative to the vehicle file first, then the shipped tyres/ folder.
+TyreSpec load_tyre_named(const std::string& name, const YamlMap& m, const std::string& key) {
+  namespace fs = std::filesystem;
+  const fs::path beside = fs::path(m.file()).parent_path() / name;
+  for (const fs::path& p : {beside, fs::path(beside.string() + ".yaml")}) {
+    if (fs::is_regular_file(p)) return load_tyre_file(p.string());
+  }
+  try {
+    return load_tyre_file(resolve_data_file(name, "tyres", ".yaml", m.where(key)));
+  } catch (const InputError&) {
+    throw InputError(m.where(key), "tyre file '" + name + "' not found beside the vehicle file or in the shipped tyres/");
+  }
+}
+
+BodyParams read_body(YamlMap m) {
+  BodyParams b;
+  b.test_mass_kg = m.number("test_mass_kg", Range::positive());
+  b.rotating_mass_kg = m.number_or("rotating_mass_kg", 0.0, Range::non_negative());
+  b.drag_coefficient = m.number("drag_coefficient", Range::open_low(0.0, 2.0));
+  b.frontal_area_m2 = m.number("frontal_area_m2", Range::open_low(0.0, 20.0));
+  b.air_density_kg_per_m3 = m.number_or("air_density_kg_per_m3", 1.2, Range::open_low(0.0, 2.0));
+  b.front_axle_load_fraction = m.number_or("front_axle_load_fraction", 0.5, Range::fraction());
+  const std::string axle = m.string_or("driven_axle", "front");
+  if (axle == "front") {
+    b.driven_axle = DrivenAxle::front;
+  } else if (axle == "rear") {
+    b.driven_axle = DrivenAxle::rear;
+  } else if (axle == "all") {
+    b.driven_axle = DrivenAxle::all;
+  } else {
+    throw InputError(m.where("driven_axle"), "'" + axle + "' is not allowed: must be front, rear or all");
+  }
+  b.wheel_radius_m = m.number_or("wheel_radius_m", 0.0, Range::closed(0.0, 1.0));
+  m.finish();
+  return b;
+}
+
+CoastdownParams read_coastdown(YamlMap m) {
+  CoastdownParams c;
+  const bool us = m.has("a_lbf") || m.has("b_lbf_per_mph") || m.has("c_lbf_per_mph2");
+  if (us) {
+    constexpr double kNPerLbf = 4.4482216152605;
+    constexpr double kMpsPerMph = units::kMPerMile / 3600.0;
+    c.a_n = m.number("a_lbf", Range::non_negative()) * kNPerLbf;
+    c.b_n_s_per_m = m.number("b_lbf_per_mph", Range::closed(-50.0, 50.0)) * kNPerLbf / kMpsPerMph;
+    c.c_n_s2_per_m2 = m.number("c_lbf_per_mph2", Range::non_negative()) * kNPerLbf / (kMpsPerMph * kMpsPerMph);
+  } else {
+    c.a_n = m.number("a_n", Range::non_negative());
+    c.b_n_s_per_m = m.number("b_n_per_kmh", Range::closed(-50.0, 50.0)) * 3.6;
+    c.c_n_s2_per_m2 = m.number("c_n_per_kmh2", Range::non_negative()) * 3.6 * 3.6;
+  }
+  m.finish();
+  return c;
+}
+
+ElectricPowertrainParams read_electric(YamlMap& pt) {
+  ElectricPowertrainParams p;
+  {
+    YamlMap m = pt.map("motor");
+    p.motor.max_torque_nm = m.number("max_torque_nm", Range::positive());
+    p.motor.max_power_w = m.number("max_power_kw", Range::positive()) * 1e3;
+    p.motor.max_speed_radps = m.number("max_speed_rpm", Range::positive()) * kRadPerSPerRpm;
+    p.motor.losses.copper_w_per_nm2 = m.number("copper_loss_w_per_nm2", Range::non_negative());
+    p.motor.losses.iron_w_s_per_rad = m.number("iron_loss_w_per_radps", Range::non_negative());
+    p.motor.losses.windage_w_s3_per_rad3 = m.number_or("windage_loss_w_per_radps3", 0.0, Range::non_negative());
+    p.motor.losses.constant_w = m.number_or("constant_loss_w", 0.0, Range::non_negative());
+    m.finish();
+  }
+  {
+    YamlMap m = pt.map("reduction");
+    p.reduction.ratio = m.number("ratio", Range::positive());
+    p.reduction.efficiency = m.number("efficiency", Range::efficiency());
+    m.finish();
+  }
+  {
+    YamlMap m = pt.map("battery");
+    p.battery.open_circuit_voltage_v = m.number("open_circuit_voltage_v", Range::positive());
+    p.battery.internal_resistance_ohm = m.number("internal_resistance_ohm", Range::non_negative());
+    p.battery.usable_capacity_j = units::kwh_to_j(m.number("usable_capacity_kwh", Range::positive()));
+    p.battery.initial_soc = m.number_or("initial_soc_pct", 100.0, Range::closed(0.0, 100.0)) / 100.0;
+    m.finish();
+  }
+  {
+    YamlMap m = pt.map("regen");
+    p.regen.max_power_w = m.number("max_power_kw", Range::non_negative()) * 1e3;
+    p.regen.driven_axle_brake_fraction = m.number("driven_axle_brake_fraction", Range::fraction());
+    p.regen.min_speed_mps = units::kmh_to_mps(m.number_or("min_speed_kmh", 0.0, Range::non_negative()));
+    p.regen.fade_speed_mps = units::kmh_to_mps(m.number_or("fade_speed_kmh", p.regen.min_speed_mps * 3.6, Range::non_negative()));
+    if (p.regen.fade_speed_mps < p.regen.min_speed_mps)
+      throw InputError(m.where("fade_speed_kmh"), "must be >= min_speed_kmh");
+    m.finish();
+  }
+  p.aux_power_w = pt.number_or("aux_power_w", 0.0, Range::non_negative());
+  return p;
+}
+
+CombustionPowertrainParams read_combustion(YamlMap& pt) {
+  CombustionPowertrainParams p;
+  {
+    YamlMap m = pt.map("engine");
+    auto& e = p.engine;
+    e.displacement_m3 = m.number("displacement_l", Range::positive()) * units::kM3PerLitre;
+    e.indicated_efficiency = m.number("indicated_efficiency", Range::open_low(0.0, 0.6));
+    e.friction_mep_pa = m.number("friction_mep_bar", Range::non_negative()) * units::kPaPerBar;
+    e.friction_mep_pa_s_per_rad =
+        m.number_or("friction_mep_bar_per_1000rpm", 0.0, Range::non_negative()) * units::kPaPerBar / (1000.0 * kRadPerSPerRpm);
+    e.idle_speed_radps = m.number("idle_speed_rpm", Range::positive()) * kRadPerSPerRpm;
+    e.max_speed_radps = m.number("max_speed_rpm", Range::positive()) * kRadPerSPerRpm;
+    e.max_torque_nm = m.number("max_torque_nm", Range::positive());
+    e.max_power_w = m.number("max_power_kw", Range::positive()) * 1e3;
+    e.fuel_cut_min_speed_radps = m.number_or("fuel_cut_min_speed_rpm", 1.2 * e.idle_speed_radps / kRadPerSPerRpm,
+                                             Range::non_negative()) * kRadPerSPerRpm;
+    if (e.max_speed_radps <= e.idle_speed_radps) throw InputError(m.where("max_speed_rpm"), "must exceed idle_speed_rpm");
+    m.finish();
+  }
+  {
+    YamlMap m = pt.map("gearbox");
+    auto& g = p.gearbox;
+    g.ratios = m.numbers("ratios", Range::positive());
+    g.final_drive_ratio = m.number("final_drive_ratio", Range::positive());
+    g.efficiency = m.number("efficiency", Range::efficiency());
+    const std::size_t shifts = g.ratios.size() - 1;
+    auto up = m.numbers("upshift_speeds_kmh", Range::positive(), shifts);
+    auto down = m.numbers("downshift_speeds_kmh", Range::positive(), shifts);
+    if (up.size() != shifts || down.size() != shifts)
+      throw InputError(m.where("upshift_speeds_kmh"), "needs exactly " + std::to_string(shifts) +
+                                                          " values (one per shift) for both up and down shifts");
+    for (std::size_t i = 0; i < shifts; ++i) {
+      if (down[i] >= up[i])
+        throw InputError(m.where("downshift_speeds_kmh"), "downshift speed " + format_value(down[i]) +
+                                                              " km/h must be below the upshift speed " + format_value(up[i]) + " km/h");
+      if (i > 0 && up[i] <= up[i - 1]) throw InputError(m.where("upshift_speeds_kmh"), "must increase gear by gear");
+      g.upshift_speeds_mps.push_back(units::kmh_to_mps(up[i]));
+      g.downshift_speeds_mps.push_back(units::kmh_to_mps(down[i]));
+    }
+    m.finish();
+  }
+  {
+    YamlMap m = pt.map("fuel");
+    p.fuel.density_kg_per_m3 = m.number("density_kg_per_l", Range::open_low(0.0, 2.0)) / units::kM3PerLitre;
+    p.fuel.lower_heating_value_j_per_kg = m.number("lower_heating_value_mj_per_kg", Range::positive()) * 1e6;
+    p.fuel.co2_kg_per_kg = m.number("co2_kg_per_kg", Range::non_negative());
+    m.finish();
+  }
+  p.aux_power_w = pt.number_or("aux_power_w", 0.0, Range::non_negative());
+  p.alternator_efficiency = pt.number_or("alternator_efficiency", 1.0, Range::efficiency());
+  return p;
+}
+
+}  // namespace
+
+Vehicle load_vehicle_file(const std::string& path) {
+  YamlMap root = YamlMap::load_file(path);
+  Vehicle v;
+  v.source = path;
+  v.name = root.string_or("name", std::filesystem::path(path).stem().string());
+  root.accept("description");
+  root.accept("sources");
+  v.body = read_body(root.map("body"));
+  if (auto t = root.optional_map("tyres")) {
+    if (t->has("all")) {
+      v.front_tyre = load_tyre_named(t->string("all"), *t, "all");
+      v.rear_tyre = v.front_tyre;
+    } else {
+      v.front_tyre = load_tyre_named(t->string("front"), *t, "front");
+      v.rear_tyre = load_tyre_named(t->string("rear"), *t, "rear");
+    }
+    t->accept("all");
+    t->accept("front");
+    t->accept("rear");
+    t->finish();
+  }
+  if (auto c = root.optional_map("coastdown")) v.coastdown = read_coastdown(*c);
+  if (!v.front_tyre && !v.coastdown)
+    throw InputError(root.where("tyres"), "a vehicle needs tyres (tyres: {all: FILE}) or coastdown coefficients");
+  if (!v.front_tyre && !(v.body.wheel_radius_m > 0.0))
+    throw InputError(root.where("body"), "without tyres, body.wheel_radius_m must be given (it sets the gearing)");
+
+  YamlMap pt = root.map("powertrain");
+  const std::string type = pt.string("type");
+  if (type == "electric") {
+    v.powertrain = read_electric(pt);
+  } else if (type == "combustion") {
+    v.powertrain = read_combustion(pt);
+  } else {
+    throw InputError(pt.where("type"), "'" + type + "' is not allowed: must be electric or combustion");
+  }
+  pt.finish();
+  root.accept("effects");  // read by the effects module (diagnosis); see vehicles/README.md
+  root.finish();
+
+  // Every tyre must carry its static load: the model has no solution past the rim.
+  if (v.front_tyre) {
+    const auto loads = wheel_loads(v.body, 0.0);
+    for (const auto& [tyre, load_n, axle] : {std::tuple{*v.front_tyre, loads.front_n, "front"},
+                                              std::tuple{*v.rear_tyre, loads.rear_n, "rear"}}) {
+      try {
+        check_operating_point(tyre.state, load_n, 0.0);
+      } catch (const ModelDomainError& e) {
+        throw InputError(path + ": " + axle + " tyre '" + tyre.name + "'", e.what());
+      }
+    }
+  }
+  return v;
+}
+
+void fit_tyres(Vehicle& vehicle, const TyreSpec& tyre) {
+  vehicle.front_tyre = tyre;
+  vehicle.rear_tyre = tyre;
+}
+
+AxleWheelLoads wheel_loads(const BodyParams& body, double grade) {
+  const double normal_n = body.test_mass_kg * units::kStandardGravity_mps2 / std::sqrt(1.0 + grade * grade);
+  return {normal_n * body.front_axle_load_fraction / 2.0, normal_n * (1.0 - body.front_axle_load_fraction) / 2.0};
+}
+
+double driven_wheel_radius_m(const Vehicle& vehicle) {
+  if (!vehicle.front_tyre) return vehicle.body.wheel_radius_m;
+  const bool rear = vehicle.body.driven_axle == DrivenAxle::rear;
+  const TyreSpec& tyre = rear ? *vehicle.rear_tyre : *vehicle.front_tyre;
+  const auto loads = wheel_loads(vehicle.body, 0.0);
+  const double load_n = rear ? loads.rear_n : loads.front_n;
+  const double deflection_m = load_n / vertical_stiffness_n_per_m(tyre.state);
+  return tyre.state.geometry.outer_radius_m - deflection_m / 3.0;
+}
+
+namespace {
+
+class TyreRoadLoad final : public RoadLoadModel {
+ public:
+  TyreRoadLoad(const Vehicle& v) : body_(v.body), front_(*v.front_tyre), rear_(*v.rear_tyre) {}
+  RoadLoadCoeffs at_grade(double grade) const override {
+    const auto loads = wheel_loads(body_, grade);
+    const auto f = TyreAtLoad::prepare(front_.state, loads.front_n);
+    const auto r = TyreAtLoad::prepare(rear_.state, loads.rear_n);
+    RoadLoadCoeffs c;
+    c.rolling_f0_n = 2.0 * (f.k0() * loads.front_n + r.k0() * loads.rear_n);
+    c.rolling_f1_n_s_per_m = 2.0 * (f.k1_s_per_m() * loads.front_n + r.k1_s_per_m() * loads.rear_n);
+    c.rolling_f2_n_s2_per_m2 = 2.0 * (f.k2_s2_per_m2() * loads.front_n + r.k2_s2_per_m2() * loads.rear_n);
+    c.aero_n_s2_per_m2 = 0.5 * body_.air_density_kg_per_m3 * body_.drag_coefficient * body_.frontal_area_m2;
+    return c;
+  }
+  std::string describe() const override {
+    return front_.name == rear_.name ? "tyre model, 4 x " + front_.name
+                                     : "tyre model, front " + front_.name + ", rear " + rear_.name;
+  }
+
+ private:
+  BodyParams body_;
+  TyreSpec front_, rear_;
+};
+
+// Coast-down coefficients already hold rolling, driveline spin loss and aero; A scales with normal load.
+class CoastdownRoadLoad final : public RoadLoadModel {
+ public:
+  explicit CoastdownRoadLoad(const CoastdownParams& c) : c_(c) {}
+  RoadLoadCoeffs at_grade(double grade) const override {
+    RoadLoadCoeffs r;
+    r.rolling_f0_n = c_.a_n / std::sqrt(1.0 + grade * grade);
+    r.rolling_f1_n_s_per_m = c_.b_n_s_per_m;
+    r.aero_n_s2_per_m2 = c_.c_n_s2_per_m2;
+    return r;
+  }
+  std::string describe() const override { return "coast-down A + B v + C v^2"; }
+
+ private:
+  CoastdownParams c_;
+};
+
+}  // namespace
+
+std::unique_ptr<RoadLoadModel> make_road_load(const Vehicle& vehicle) {
+  if (vehicle.coastdown) return std::make_unique<CoastdownRoadLoad>(*vehicle.coastdown);
+  return std::make_unique<TyreRoadLoad>(vehicle);
+}
+
+double tyre_rolling_force_at_standstill_limit_n(const Vehicle& vehicle) {
+  if (!vehicle.front_tyre) return 0.0;
+  Vehicle tyres_only = vehicle;
+  tyres_only.coastdown.reset();
+  return TyreRoadLoad(tyres_only).at_grade(0.0).rolling_f0_n;
+}
+
+std::unique_ptr<Powertrain> make_powertrain(const Vehicle& vehicle) {
+  if (const auto* e = std::get_if<ElectricPowertrainParams>(&vehicle.powertrain))
+    return std::make_unique<ElectricPowertrain>(*e);
+  return std::make_unique<CombustionPowertrain>(std::get<CombustionPowertrainParams>(vehicle.powertrain));
+}
+
+}  // namespace rollsim
