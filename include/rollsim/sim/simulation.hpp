@@ -30,7 +30,7 @@ struct VehicleModel {
 };
 
 struct SimulationOptions {
-  double relative_tolerance = 1e-4;
+  double relative_tolerance = 1e-5;
   double driver_kp_per_s = 2.0;        ///< proportional gain on speed error [1/s]
   double driver_ki_per_s2 = 0.5;       ///< integral gain [1/s^2]
   bool record_trace = false;           ///< one row per cycle sample
