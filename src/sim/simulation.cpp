@@ -18,6 +18,7 @@ VehicleModel VehicleModel::assemble(const Vehicle& vehicle) {
   m.road_load = make_road_load(vehicle);
   m.road_load_description = m.road_load->describe();
   m.powertrain = make_powertrain(vehicle);
+  m.effects = vehicle.effects;
   return m;
 }
 
@@ -132,6 +133,26 @@ struct Evaluator {
       out.flow.fuel_rate_m3_per_s *= fuel_factor;
       out.flow.fuel_power_w += extra_w;
       out.flow.engine_loss_w += extra_w;
+    }
+    double extra_electric_w = 0.0;
+    for (std::size_t i = 0; i < m.effects.size(); ++i) extra_electric_w += m.effects[i]->extra_electric_power_w(in, x + effect_state_offset[i]);
+    if (extra_electric_w != 0.0) add_electric_load(extra_electric_w, out.flow);
+  }
+
+  // An extra electrical load: from the battery terminals (its own I^2 R is neglected: under 1 % of it at these
+  // currents), or from the alternator at the engine's marginal (Willans) efficiency, even in fuel cut-off.
+  void add_electric_load(double p_w, PowerFlow& flow) const {
+    flow.aux_power_w += p_w;
+    if (m.powertrain->is_electric()) {
+      flow.battery_terminal_power_w += p_w;
+      return;
+    }
+    if (const auto* c = dynamic_cast<const CombustionPowertrain*>(m.powertrain.get())) {
+      const auto& cp = c->params();
+      const double fuel_w = p_w / (cp.alternator_efficiency * cp.engine.indicated_efficiency);
+      flow.fuel_power_w += fuel_w;
+      flow.engine_loss_w += fuel_w - p_w;
+      flow.fuel_rate_m3_per_s += fuel_w / (cp.fuel.lower_heating_value_j_per_kg * cp.fuel.density_kg_per_m3);
     }
   }
 };

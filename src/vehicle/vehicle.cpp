@@ -1,4 +1,5 @@
 #include "rollsim/vehicle/vehicle.hpp"
+#include "rollsim/effects/catalogue.hpp"
 
 #include <cmath>
 #include <filesystem>
@@ -202,7 +203,13 @@ Vehicle load_vehicle_file(const std::string& path) {
     throw InputError(pt.where("type"), "'" + type + "' is not allowed: must be electric or combustion");
   }
   pt.finish();
-  root.accept("effects");  // read by the effects module (diagnosis); see vehicles/README.md
+  if (auto eff = root.optional_map("effects")) {
+    EffectContext ctx;
+    ctx.mass_kg = v.body.test_mass_kg;
+    ctx.rho_cda_kg_per_m = v.coastdown ? 2.0 * v.coastdown->c_n_s2_per_m2
+                                       : v.body.air_density_kg_per_m3 * v.body.drag_coefficient * v.body.frontal_area_m2;
+    v.effects = load_effects(*eff, ctx);
+  }
   root.finish();
 
   // Every tyre must carry its static load: the model has no solution past the rim.

@@ -34,6 +34,9 @@ class Effect {
   virtual double wheel_loss_w(const EffectInputs&, const double* /*x*/) const { return 0.0; }
   /// Factor on the engine's fuel power (cold engine friction).
   virtual double fuel_power_factor(const EffectInputs&, const double* /*x*/) const { return 1.0; }
+  /// Extra electrical consumer [W] (HVAC, electronics), booked as auxiliary power: drawn from the battery of an
+  /// electric car, or from the alternator (fuel at its marginal efficiency) of a combustion car.
+  virtual double extra_electric_power_w(const EffectInputs&, const double* /*x*/) const { return 0.0; }
 };
 
 }  // namespace rollsim

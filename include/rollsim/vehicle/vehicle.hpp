@@ -2,12 +2,14 @@
 #pragma once
 
 #include <memory>
+#include <vector>
 #include <optional>
 #include <string>
 #include <variant>
 
 #include "rollsim/powertrain/combustion.hpp"
 #include "rollsim/powertrain/electric.hpp"
+#include "rollsim/sim/effect.hpp"
 #include "rollsim/tyre/tyre_spec.hpp"
 #include "rollsim/vehicle/road_load.hpp"
 
@@ -43,6 +45,7 @@ struct Vehicle {
   std::optional<TyreSpec> rear_tyre;
   std::optional<CoastdownParams> coastdown;  ///< when set, it is the road load; tyres only gear the car
   PowertrainParams powertrain;
+  std::vector<std::shared_ptr<const Effect>> effects;  ///< the file's `effects:` block (effects/catalogue.hpp)
 
   bool is_electric() const { return std::holds_alternative<ElectricPowertrainParams>(powertrain); }
 };

@@ -1,0 +1,56 @@
+// Catalogue of physical effects beyond the base model (tyre warm-up, auxiliary load, wind, ...), each a sim Effect.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "rollsim/common/yaml_reader.hpp"
+#include "rollsim/sim/effect.hpp"
+
+namespace rollsim {
+
+/// What an effect needs to know about the car it is fitted to (set from the vehicle description).
+struct EffectContext {
+  double mass_kg = 0.0;            ///< test mass (the mass effect's rolling share is scaled from it)
+  double rho_cda_kg_per_m = 0.0;   ///< air density x drag area (2 x coast-down C for coast-down vehicles)
+};
+
+/// One parameter of a catalogue effect, with its unit, neutral value and allowed bounds.
+struct EffectParameterInfo {
+  std::string name;        ///< YAML key, e.g. "cold_rrc_excess"
+  std::string unit;        ///< "1", "W", "m/s", "kg", "J/K", ...
+  double neutral = 0.0;    ///< value at which the effect is off (or, for shape parameters, its default)
+  double nominal = 0.0;    ///< literature-typical size (used for signatures)
+  double min = 0.0;
+  double max = 0.0;
+  bool amplitude = false;  ///< the effect's size (fitted linearly); otherwise a shape parameter
+};
+
+struct EffectInfo {
+  std::string id;
+  std::string description;
+  std::vector<EffectParameterInfo> parameters;
+};
+
+/// The implemented effects, in a stable order.
+const std::vector<EffectInfo>& effect_catalogue();
+/// Catalogue identifiers the issue lists that have no module yet (documented in docs/diagnose.md).
+const std::vector<std::string>& effects_not_implemented();
+const EffectInfo& effect_info(const std::string& id);  ///< throws InputError for an unknown id
+
+using EffectParameters = std::map<std::string, double>;
+
+/// Builds one effect; missing parameters take their neutral (or default) value; throws InputError on an unknown
+/// id or parameter, or a value out of bounds.
+std::shared_ptr<const Effect> make_effect(const std::string& id, const EffectParameters& params,
+                                          const EffectContext& context);
+
+/// Reads a vehicle file's `effects:` block ({id: {param: value}}), strictly.
+std::vector<std::shared_ptr<const Effect>> load_effects(YamlMap effects, const EffectContext& context);
+
+/// The `effects:` block text (YAML, two-space indented under `effects:`) for these effects.
+std::string effects_yaml(const std::vector<std::pair<std::string, EffectParameters>>& effects);
+
+}  // namespace rollsim
