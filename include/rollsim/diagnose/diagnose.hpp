@@ -1,0 +1,85 @@
+// Diagnosis of a recording against the model: locate the mismatch, name the missing catalogue effect, fit it.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "rollsim/effects/catalogue.hpp"
+#include "rollsim/recording/recording.hpp"
+#include "rollsim/vehicle/vehicle.hpp"
+
+namespace rollsim {
+
+/// Fixed in advance (not tuned per recording), so that the null case's false-discovery rate is what it is.
+struct DiagnoseOptions {
+  double window_s = 60.0;          ///< energy windows
+  int block_windows = 3;           ///< held-out folds alternate in blocks of this many windows
+  double bic_threshold = 10.0;     ///< "very strong" evidence on the Kass-Raftery scale
+  double collinear_corr = 0.9;     ///< |corr| of calibration-cleaned signatures above which effects are confounded
+  int max_effects = 2;
+};
+
+struct ParameterEstimate {
+  std::string name, unit;
+  double value = 0.0, ci_low = 0.0, ci_high = 0.0;  ///< 95 %; a shape parameter taken from a grid has ci = value
+};
+
+struct Finding {
+  std::string effect;  ///< catalogue identifier
+  std::vector<ParameterEstimate> parameters;
+  std::vector<std::string> confounded_with;
+  double delta_bic = 0.0;
+  double heldout_rmse_before_j = 0.0, heldout_rmse_after_j = 0.0;  ///< per window
+  double heldout_energy_error_pct_before = 0.0, heldout_energy_error_pct_after = 0.0;
+  EffectParameters fitted;  ///< for --write-vehicle
+};
+
+struct RegimeResidual {
+  std::string regime;
+  int samples = 0;
+  double mean_w = 0.0, ci_low_w = 0.0, ci_high_w = 0.0;  ///< measured minus calibrated model, 95 % (effective n)
+};
+
+struct Diagnosis {
+  std::string verdict;   ///< missing_physics, nothing_missing, confounded
+  std::string channel;   ///< which measured channel was compared
+  int windows = 0;
+  double effective_windows = 0.0;
+  double lag1_autocorrelation = 0.0;
+  double raw_trip_energy_error_pct = 0.0;  ///< uncalibrated model against measured, whole data
+  double channel_scale = 1.0;              ///< calibration: measured / simulated
+  double rrc_level_change = 0.0;           ///< calibration: fractional RRC change
+  double drag_change = 0.0;                ///< calibration: fractional aero (C term) change
+  double heldout_rmse_calibrated_j = 0.0;
+  double heldout_energy_error_pct_calibrated = 0.0;
+  std::vector<Finding> findings;
+  std::vector<RegimeResidual> located;
+};
+
+/// Replays each recording's speed (and grade) through the vehicle, compares energies per window, calibrates,
+/// and tests each catalogue effect (see docs/diagnose.md for the method).
+Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordings, const DiagnoseOptions& opt = {});
+
+std::string diagnosis_json(const Diagnosis& d);
+std::string diagnosis_text(const Diagnosis& d);
+
+/// The vehicle file at `vehicle_path` with an `effects:` block holding the findings' fitted effects.
+std::string fitted_vehicle_yaml(const std::string& vehicle_path, const Diagnosis& d);
+
+/// Synthetic recording with a concealed effect, for the proof. The truth uses its own models (a two-node tyre
+/// thermal network with an exponential RRC law), never the catalogue's modules.
+struct SyntheticOptions {
+  std::string cycle = "wltc";
+  int repeats = 2;
+  double tyre_cold_excess = 0.0;   ///< truth's RRC excess of a cold tyre (0: null recording)
+  double rrc_level_jitter = 0.03;  ///< truth's RRC level, uniform +- (calibration, not a discovery)
+  double scale_jitter = 0.02;      ///< measured channel scale, uniform +-
+  double noise_w = 400.0;          ///< white sensor noise, standard deviation
+  double quantum_w = 100.0;        ///< logger quantisation
+  double lag_s = 1.0;              ///< channel lag
+  bool time_reversed = false;      ///< the truth's warm-up decay placed at the end of the trip (a null)
+  unsigned seed = 1;
+};
+Recording generate_recording(const Vehicle& vehicle, const SyntheticOptions& opt);
+
+}  // namespace rollsim

@@ -1,0 +1,508 @@
+// Diagnosis: kinematic replay, window energies, calibration, effect signatures, selection by BIC, held-out scoring.
+#include "rollsim/diagnose/diagnose.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "rollsim/common/error.hpp"
+#include "rollsim/cycle/drive_cycle.hpp"
+#include "rollsim/sim/simulation.hpp"
+
+namespace rollsim {
+namespace {
+
+// Calibration signature of the aero (C) term: a force k * 0.5 rho CdA v^2 (k = fractional change).
+class DragScale final : public Effect {
+ public:
+  DragScale(double k, double rho_cda) : k_(k), half_rho_cda_(0.5 * rho_cda) {}
+  std::string id() const override { return "calibration_drag"; }
+  double extra_resistance_n(const EffectInputs& in, const double*) const override {
+    const double v = std::max(in.speed_mps, 0.0);
+    return k_ * half_rho_cda_ * v * v;
+  }
+
+ private:
+  double k_, half_rho_cda_;
+};
+
+// Calibration signature of the RRC level: a constant factor on rolling resistance.
+class RrcLevel final : public Effect {
+ public:
+  explicit RrcLevel(double k) : k_(k) {}
+  std::string id() const override { return "calibration_rrc"; }
+  double rolling_resistance_factor(const EffectInputs&, const double*) const override { return 1.0 + k_; }
+
+ private:
+  double k_;
+};
+
+EffectContext context_of(const Vehicle& v) {
+  EffectContext c;
+  c.mass_kg = v.body.test_mass_kg;
+  c.rho_cda_kg_per_m = v.coastdown ? 2.0 * v.coastdown->c_n_s2_per_m2
+                                   : v.body.air_density_kg_per_m3 * v.body.drag_coefficient * v.body.frontal_area_m2;
+  return c;
+}
+
+DriveCycle cycle_of(const Recording& r) {
+  DriveCycle c;
+  c.name = r.source;
+  c.source = r.source;
+  c.time_s = r.time_s;
+  c.speed_mps = r.speed_mps;
+  c.grade = r.grade ? *r.grade : std::vector<double>(r.time_s.size(), 0.0);
+  return c;
+}
+
+// Measured power per sample [W] in the energy domain of the simulation (battery terminals or fuel chemical).
+// SOC is handled per window (a difference), so it returns an empty vector and sets `soc` instead.
+std::vector<double> measured_power_w(const Vehicle& v, const Recording& r, std::string& channel) {
+  if (r.battery_power_w) {
+    channel = "battery_power";
+    return *r.battery_power_w;
+  }
+  if (r.battery_voltage_v && r.battery_current_a) {
+    channel = "battery_voltage_x_current";
+    std::vector<double> p(r.time_s.size());
+    for (std::size_t i = 0; i < p.size(); ++i) p[i] = (*r.battery_voltage_v)[i] * (*r.battery_current_a)[i];
+    return p;
+  }
+  if (r.fuel_rate_m3ps) {
+    const auto* cp = std::get_if<CombustionPowertrainParams>(&v.powertrain);
+    if (!cp) throw InputError(r.source, "fuel rate recorded but the vehicle is electric");
+    channel = "fuel_rate";
+    std::vector<double> p(r.time_s.size());
+    const double j_per_m3 = cp->fuel.density_kg_per_m3 * cp->fuel.lower_heating_value_j_per_kg;
+    for (std::size_t i = 0; i < p.size(); ++i) p[i] = (*r.fuel_rate_m3ps)[i] * j_per_m3;
+    return p;
+  }
+  channel = "soc";
+  return {};
+}
+
+double sim_power_w(const TracePoint& t, bool electric, double fuel_j_per_m3) {
+  return electric ? t.battery_power_w : t.fuel_rate_m3_per_s * fuel_j_per_m3;
+}
+
+struct Window {
+  std::size_t rec = 0, begin = 0, end = 0;  // sample range [begin, end]
+};
+
+// Everything the fit needs, per sample and per window, for one model variant.
+struct Variant {
+  std::vector<std::vector<double>> power_w;  // per recording, per segment start
+  Eigen::VectorXd window_j;
+};
+
+struct Data {
+  std::vector<Window> windows;
+  std::vector<std::vector<double>> dt_s;  // per recording, per segment
+  Eigen::VectorXd measured_j;
+  std::vector<std::vector<double>> measured_w;  // empty for SOC
+  std::string channel;
+};
+
+Variant run_variant(const Vehicle& vehicle, const std::vector<DriveCycle>& cycles, const Data& d,
+                    const std::vector<std::shared_ptr<const Effect>>& extra) {
+  VehicleModel model = VehicleModel::assemble(vehicle);
+  for (const auto& e : extra) model.effects.push_back(e);
+  const bool electric = vehicle.is_electric();
+  double fuel_j_per_m3 = 0.0;
+  if (const auto* cp = std::get_if<CombustionPowertrainParams>(&vehicle.powertrain))
+    fuel_j_per_m3 = cp->fuel.density_kg_per_m3 * cp->fuel.lower_heating_value_j_per_kg;
+  SimulationOptions so;
+  so.record_trace = true;
+  Variant out;
+  for (const auto& c : cycles) {
+    const SimulationResult r = simulate_replay(model, c, so);
+    std::vector<double> p(r.trace.size());
+    for (std::size_t i = 0; i < p.size(); ++i) p[i] = sim_power_w(r.trace[i], electric, fuel_j_per_m3);
+    out.power_w.push_back(std::move(p));
+  }
+  out.window_j.resize(static_cast<Eigen::Index>(d.windows.size()));
+  for (std::size_t w = 0; w < d.windows.size(); ++w) {
+    const auto& win = d.windows[w];
+    double e = 0.0;
+    for (std::size_t i = win.begin; i < win.end; ++i) e += out.power_w[win.rec][i] * d.dt_s[win.rec][i];
+    out.window_j[static_cast<Eigen::Index>(w)] = e;
+  }
+  return out;
+}
+
+struct Fit {
+  Eigen::VectorXd coef;
+  Eigen::MatrixXd cov;  // unscaled (X'X)^-1 sigma^2
+  double rss = 0.0;
+};
+
+Fit least_squares(const Eigen::MatrixXd& x, const Eigen::VectorXd& y) {
+  Fit f;
+  f.coef = x.colPivHouseholderQr().solve(y);
+  const Eigen::VectorXd r = y - x * f.coef;
+  f.rss = r.squaredNorm();
+  const double dof = std::max<double>(1.0, static_cast<double>(x.rows() - x.cols()));
+  f.cov = (x.transpose() * x).completeOrthogonalDecomposition().pseudoInverse() * (f.rss / dof);
+  return f;
+}
+
+double lag1_autocorrelation(const Eigen::VectorXd& r) {
+  if (r.size() < 3) return 0.0;
+  const double mean = r.mean();
+  double num = 0.0, den = 0.0;
+  for (Eigen::Index i = 0; i < r.size(); ++i) {
+    den += (r[i] - mean) * (r[i] - mean);
+    if (i > 0) num += (r[i] - mean) * (r[i - 1] - mean);
+  }
+  return den > 0.0 ? num / den : 0.0;
+}
+
+// Out-of-fold prediction: each window predicted by a fit on the other fold (alternating blocks of windows).
+Eigen::VectorXd heldout_prediction(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, int block) {
+  const Eigen::Index n = x.rows();
+  Eigen::VectorXd pred(n);
+  for (int fold = 0; fold < 2; ++fold) {
+    std::vector<Eigen::Index> train, test;
+    for (Eigen::Index i = 0; i < n; ++i) ((i / block) % 2 == fold ? test : train).push_back(i);
+    if (train.empty()) train = test;
+    Eigen::MatrixXd xt(static_cast<Eigen::Index>(train.size()), x.cols());
+    Eigen::VectorXd yt(static_cast<Eigen::Index>(train.size()));
+    for (std::size_t k = 0; k < train.size(); ++k) {
+      xt.row(static_cast<Eigen::Index>(k)) = x.row(train[k]);
+      yt[static_cast<Eigen::Index>(k)] = y[train[k]];
+    }
+    const Eigen::VectorXd c = xt.colPivHouseholderQr().solve(yt);
+    for (Eigen::Index i : test) pred[i] = x.row(i).dot(c);
+  }
+  return pred;
+}
+
+double rmse(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  return std::sqrt((a - b).squaredNorm() / static_cast<double>(std::max<Eigen::Index>(1, a.size())));
+}
+double energy_error_pct(const Eigen::VectorXd& pred, const Eigen::VectorXd& meas) {
+  return 100.0 * (pred.sum() - meas.sum()) / std::max(1e-9, std::abs(meas.sum()));
+}
+
+Eigen::MatrixXd hcat(const Eigen::MatrixXd& a, const Eigen::VectorXd& b) {
+  Eigen::MatrixXd m(a.rows(), a.cols() + 1);
+  m << a, b;
+  return m;
+}
+
+// A candidate: a catalogue effect with its shape parameters fixed (hidden-state effects: one per time constant).
+struct Candidate {
+  std::string id;
+  std::string label;
+  EffectParameters shape;
+  double nominal = 0.0;
+  std::string amplitude_name, amplitude_unit;
+  double amp_min = 0.0, amp_max = 0.0;
+  Eigen::VectorXd signature;  // window energy per unit amplitude
+};
+
+std::string num(double v) {
+  std::ostringstream os;
+  os.precision(6);
+  os << v;
+  return os.str();
+}
+
+}  // namespace
+
+Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordings, const DiagnoseOptions& opt) {
+  if (recordings.empty()) throw InputError("--recording", "at least one recording is needed");
+  Diagnosis out;
+  Data d;
+  std::vector<DriveCycle> cycles;
+  double soc_capacity_j = 0.0;
+  if (const auto* ep = std::get_if<ElectricPowertrainParams>(&vehicle.powertrain)) soc_capacity_j = ep->battery.usable_capacity_j;
+  std::vector<double> meas;
+  for (std::size_t ri = 0; ri < recordings.size(); ++ri) {
+    const Recording& r = recordings[ri];
+    cycles.push_back(cycle_of(r));
+    std::string ch;
+    d.measured_w.push_back(measured_power_w(vehicle, r, ch));
+    if (!d.channel.empty() && d.channel != ch) throw InputError(r.source, "all recordings must carry the same energy channel");
+    d.channel = ch;
+    std::vector<double> dt(r.time_s.size() - 1);
+    for (std::size_t i = 0; i + 1 < r.time_s.size(); ++i) dt[i] = r.time_s[i + 1] - r.time_s[i];
+    d.dt_s.push_back(dt);
+    std::size_t begin = 0;
+    for (std::size_t i = 1; i < r.time_s.size(); ++i) {
+      if (r.time_s[i] - r.time_s[begin] >= opt.window_s || i + 1 == r.time_s.size()) {
+        if (r.time_s[i] - r.time_s[begin] >= 0.5 * opt.window_s) {
+          d.windows.push_back({ri, begin, i});
+          double e = 0.0;
+          if (ch == "soc") {
+            if (soc_capacity_j <= 0.0) throw InputError(r.source, "SOC recorded but the vehicle has no battery");
+            e = ((*r.soc_fraction)[begin] - (*r.soc_fraction)[i]) * soc_capacity_j;
+          } else {
+            for (std::size_t k = begin; k < i; ++k) e += d.measured_w.back()[k] * dt[k];
+          }
+          meas.push_back(e);
+        }
+        begin = i;
+      }
+    }
+  }
+  const Eigen::Index n = static_cast<Eigen::Index>(d.windows.size());
+  if (n < 8) throw InputError("--recording", "too short to diagnose: " + std::to_string(n) + " windows of " + num(opt.window_s) + " s, need 8");
+  d.measured_j = Eigen::Map<Eigen::VectorXd>(meas.data(), n);
+  out.channel = d.channel;
+  out.windows = static_cast<int>(n);
+
+  const EffectContext ctx = context_of(vehicle);
+  const Variant base = run_variant(vehicle, cycles, d, {});
+  const Variant rrc = run_variant(vehicle, cycles, d, {std::make_shared<RrcLevel>(0.1)});
+  const Variant drag = run_variant(vehicle, cycles, d, {std::make_shared<DragScale>(0.1, ctx.rho_cda_kg_per_m)});
+  out.raw_trip_energy_error_pct = energy_error_pct(base.window_j, d.measured_j);
+
+  // Calibration: measured = s * sim + a * S_rrc + b * S_drag (RRC level and CdA as nuisances, per 10 %).
+  Eigen::MatrixXd xc(n, 3);
+  xc.col(0) = base.window_j;
+  xc.col(1) = rrc.window_j - base.window_j;
+  xc.col(2) = drag.window_j - base.window_j;
+  const Fit cal = least_squares(xc, d.measured_j);
+  out.channel_scale = cal.coef[0];
+  out.rrc_level_change = 0.1 * cal.coef[1] / cal.coef[0];
+  out.drag_change = 0.1 * cal.coef[2] / cal.coef[0];
+  const Eigen::VectorXd cal_resid = d.measured_j - xc * cal.coef;
+  out.lag1_autocorrelation = lag1_autocorrelation(cal_resid);
+  const double rho = std::clamp(out.lag1_autocorrelation, 0.0, 0.95);
+  const double n_eff = std::max(4.0, static_cast<double>(n) * (1.0 - rho) / (1.0 + rho));
+  out.effective_windows = n_eff;
+  const Eigen::VectorXd cal_pred = heldout_prediction(xc, d.measured_j, opt.block_windows);
+  out.heldout_rmse_calibrated_j = rmse(cal_pred, d.measured_j);
+  out.heldout_energy_error_pct_calibrated = energy_error_pct(cal_pred, d.measured_j);
+
+  // Signatures: every catalogue effect at its nominal size, through the whole simulator.
+  std::vector<Candidate> cands;
+  for (const auto& info : effect_catalogue()) {
+    if (info.id == "ambient_rrc") continue;  // within one trip it is the RRC level (a calibration quantity)
+    std::vector<EffectParameters> shapes{{}};
+    if (info.id == "tyre_warmup") shapes = {{{"heat_capacity_j_per_k", 20000.0}}, {{"heat_capacity_j_per_k", 50000.0}}, {{"heat_capacity_j_per_k", 120000.0}}};
+    const EffectParameterInfo* amp = nullptr;
+    for (const auto& p : info.parameters)
+      if (p.amplitude) amp = &p;
+    for (const auto& shape : shapes) {
+      Candidate c;
+      c.id = info.id;
+      c.shape = shape;
+      c.nominal = amp->nominal;
+      c.amplitude_name = amp->name;
+      c.amplitude_unit = amp->unit;
+      c.amp_min = amp->min;
+      c.amp_max = amp->max;
+      EffectParameters p = shape;
+      p[amp->name] = amp->nominal;
+      c.label = info.id;
+      for (const auto& [k, v] : shape) c.label += " (" + k + " " + num(v) + ")";
+      const Variant var = run_variant(vehicle, cycles, d, {make_effect(info.id, p, ctx)});
+      c.signature = (var.window_j - base.window_j) / amp->nominal;
+      if (c.signature.norm() > 0.0) cands.push_back(std::move(c));
+    }
+  }
+
+  // Forward selection: add the candidate with the largest BIC gain while it passes the threshold and improves
+  // the held-out fit; confounded if another candidate's cleaned signature is nearly collinear and also passes.
+  Eigen::MatrixXd x = xc;
+  double rss = cal.rss;
+  std::vector<std::string> chosen_ids;
+  Eigen::VectorXd pred_before = cal_pred;
+  auto cleaned = [&](const Eigen::MatrixXd& basis, const Eigen::VectorXd& s) {
+    const Eigen::VectorXd c = basis.colPivHouseholderQr().solve(s);
+    return Eigen::VectorXd(s - basis * c);
+  };
+  for (int round = 0; round < opt.max_effects; ++round) {
+    struct Scored {
+      std::size_t idx;
+      double dbic;
+      Fit fit;
+      Eigen::VectorXd pred;
+    };
+    std::vector<Scored> passing;
+    for (std::size_t k = 0; k < cands.size(); ++k) {
+      if (std::find(chosen_ids.begin(), chosen_ids.end(), cands[k].id) != chosen_ids.end()) continue;
+      const Eigen::MatrixXd xk = hcat(x, cands[k].signature);
+      const Fit f = least_squares(xk, d.measured_j);
+      if (f.rss <= 0.0) continue;
+      const double dbic = n_eff * std::log(rss / f.rss) - std::log(n_eff);
+      const double amp = f.coef[f.coef.size() - 1] / f.coef[0];  // in the simulated channel's scale
+      if (dbic < opt.bic_threshold || amp < cands[k].amp_min || amp > cands[k].amp_max) continue;
+      Eigen::VectorXd pred = heldout_prediction(xk, d.measured_j, opt.block_windows);
+      if (rmse(pred, d.measured_j) >= rmse(pred_before, d.measured_j)) continue;
+      passing.push_back({k, dbic, f, pred});
+    }
+    if (passing.empty()) break;
+    std::sort(passing.begin(), passing.end(), [](const Scored& a, const Scored& b) { return a.dbic > b.dbic; });
+    const Scored& best = passing.front();
+    const Candidate& c = cands[best.idx];
+    Finding fnd;
+    fnd.effect = c.id;
+    fnd.delta_bic = best.dbic;
+    const Eigen::Index j = best.fit.coef.size() - 1;
+    const double inflate = std::sqrt(static_cast<double>(n) / n_eff);  // autocorrelated windows carry less information
+    const double se = std::sqrt(std::max(0.0, best.fit.cov(j, j))) * inflate;
+    // The signature is per unit amplitude of the measured channel's scale 1; divide by the channel scale.
+    const double s = best.fit.coef[0];
+    const double value = best.fit.coef[j] / s;
+    fnd.parameters.push_back({c.amplitude_name, c.amplitude_unit, value, (best.fit.coef[j] - 1.96 * se) / s,
+                              (best.fit.coef[j] + 1.96 * se) / s});
+    fnd.fitted = c.shape;
+    fnd.fitted[c.amplitude_name] = value;
+    for (const auto& [k, v] : c.shape) {
+      for (const auto& pi : effect_info(c.id).parameters)
+        if (pi.name == k) fnd.parameters.push_back({k, pi.unit, v, v, v});
+    }
+    const Eigen::VectorXd sb = cleaned(x, c.signature);
+    for (std::size_t q = 1; q < passing.size(); ++q) {
+      const Candidate& o = cands[passing[q].idx];
+      if (o.id == c.id) continue;
+      const Eigen::VectorXd so = cleaned(x, o.signature);
+      const double corr = sb.dot(so) / std::max(1e-300, sb.norm() * so.norm());
+      if (std::abs(corr) > opt.collinear_corr &&
+          std::find(fnd.confounded_with.begin(), fnd.confounded_with.end(), o.id) == fnd.confounded_with.end())
+        fnd.confounded_with.push_back(o.id);
+    }
+    fnd.heldout_rmse_before_j = rmse(pred_before, d.measured_j);
+    fnd.heldout_rmse_after_j = rmse(best.pred, d.measured_j);
+    fnd.heldout_energy_error_pct_before = energy_error_pct(pred_before, d.measured_j);
+    fnd.heldout_energy_error_pct_after = energy_error_pct(best.pred, d.measured_j);
+    x = hcat(x, c.signature);
+    rss = best.fit.rss;
+    pred_before = best.pred;
+    chosen_ids.push_back(c.id);
+    out.findings.push_back(std::move(fnd));
+  }
+  if (out.findings.empty()) out.verdict = "nothing_missing";
+  else out.verdict = out.findings.front().confounded_with.empty() ? "missing_physics" : "confounded";
+
+  // Locate: per-sample residual of the calibrated model, by regime, with a normal interval on an effective n.
+  if (d.channel != "soc") {
+    std::map<std::string, std::pair<std::vector<double>, int>> by;  // values, order
+    const std::vector<std::string> order{"standing", "accelerating", "cruising", "braking", "speed 0-50 km/h",
+                                         "speed 50-90 km/h", "speed >90 km/h", "first 10 min", "10-30 min", "after 30 min"};
+    std::map<std::string, std::vector<double>> vals;
+    std::vector<double> all;
+    for (std::size_t ri = 0; ri < recordings.size(); ++ri) {
+      const Recording& r = recordings[ri];
+      for (std::size_t i = 0; i + 1 < r.time_s.size(); ++i) {
+        const double sim = cal.coef[0] * base.power_w[ri][i] + cal.coef[1] * (rrc.power_w[ri][i] - base.power_w[ri][i]) +
+                           cal.coef[2] * (drag.power_w[ri][i] - base.power_w[ri][i]);
+        const double res = d.measured_w[ri][i] - sim;
+        const double v = r.speed_mps[i], a = (r.speed_mps[i + 1] - v) / d.dt_s[ri][i];
+        const double t = r.time_s[i] - r.time_s.front();
+        all.push_back(res);
+        vals[v < 0.3 ? "standing" : a > 0.3 ? "accelerating" : a < -0.3 ? "braking" : "cruising"].push_back(res);
+        if (v >= 0.3) vals[v < 50 / 3.6 ? "speed 0-50 km/h" : v < 90 / 3.6 ? "speed 50-90 km/h" : "speed >90 km/h"].push_back(res);
+        vals[t < 600 ? "first 10 min" : t < 1800 ? "10-30 min" : "after 30 min"].push_back(res);
+      }
+    }
+    Eigen::VectorXd allv = Eigen::Map<Eigen::VectorXd>(all.data(), static_cast<Eigen::Index>(all.size()));
+    const double rs = std::clamp(lag1_autocorrelation(allv), 0.0, 0.99);
+    const double factor = (1.0 + rs) / (1.0 - rs);  // variance inflation of a mean of AR(1) samples
+    for (const auto& name : order) {
+      const auto it = vals.find(name);
+      if (it == vals.end() || it->second.size() < 2) continue;
+      const auto& v = it->second;
+      double mean = 0.0, var = 0.0;
+      for (double e : v) mean += e;
+      mean /= static_cast<double>(v.size());
+      for (double e : v) var += (e - mean) * (e - mean);
+      var /= static_cast<double>(v.size() - 1);
+      const double half = 1.96 * std::sqrt(var * factor / static_cast<double>(v.size()));
+      out.located.push_back({name, static_cast<int>(v.size()), mean, mean - half, mean + half});
+    }
+  }
+  return out;
+}
+
+std::string diagnosis_json(const Diagnosis& d) {
+  std::ostringstream os;
+  os << "{\n  \"verdict\": \"" << d.verdict << "\",\n  \"channel\": \"" << d.channel << "\",\n";
+  os << "  \"windows\": " << d.windows << ",\n  \"effective_windows\": " << num(d.effective_windows) << ",\n";
+  os << "  \"calibration\": {\"channel_scale\": " << num(d.channel_scale) << ", \"rrc_level_change\": " << num(d.rrc_level_change)
+     << ", \"drag_change\": " << num(d.drag_change) << "},\n";
+  os << "  \"raw_trip_energy_error_pct\": " << num(d.raw_trip_energy_error_pct) << ",\n";
+  os << "  \"heldout_rmse_calibrated\": " << num(d.heldout_rmse_calibrated_j) << ",\n";
+  os << "  \"heldout_energy_error_pct_calibrated\": " << num(d.heldout_energy_error_pct_calibrated) << ",\n";
+  os << "  \"findings\": [";
+  for (std::size_t i = 0; i < d.findings.size(); ++i) {
+    const auto& f = d.findings[i];
+    os << (i ? "," : "") << "\n    {\"effect\": \"" << f.effect << "\", \"parameters\": {";
+    for (std::size_t k = 0; k < f.parameters.size(); ++k) {
+      const auto& p = f.parameters[k];
+      os << (k ? ", " : "") << "\"" << p.name << "\": {\"value\": " << num(p.value) << ", \"ci_low\": " << num(p.ci_low)
+         << ", \"ci_high\": " << num(p.ci_high) << ", \"unit\": \"" << p.unit << "\"}";
+    }
+    os << "}, \"confounded_with\": [";
+    for (std::size_t k = 0; k < f.confounded_with.size(); ++k) os << (k ? ", " : "") << "\"" << f.confounded_with[k] << "\"";
+    os << "], \"delta_bic\": " << num(f.delta_bic) << ", \"heldout_rmse_before\": " << num(f.heldout_rmse_before_j)
+       << ", \"heldout_rmse_after\": " << num(f.heldout_rmse_after_j)
+       << ", \"heldout_energy_error_pct_before\": " << num(f.heldout_energy_error_pct_before)
+       << ", \"heldout_energy_error_pct_after\": " << num(f.heldout_energy_error_pct_after) << "}";
+  }
+  os << (d.findings.empty() ? "" : "\n  ") << "],\n  \"located\": [";
+  for (std::size_t i = 0; i < d.located.size(); ++i) {
+    const auto& l = d.located[i];
+    os << (i ? "," : "") << "\n    {\"regime\": \"" << l.regime << "\", \"samples\": " << l.samples << ", \"mean_residual_w\": "
+       << num(l.mean_w) << ", \"ci_low_w\": " << num(l.ci_low_w) << ", \"ci_high_w\": " << num(l.ci_high_w) << "}";
+  }
+  os << (d.located.empty() ? "" : "\n  ") << "]\n}\n";
+  return os.str();
+}
+
+std::string diagnosis_text(const Diagnosis& d) {
+  std::ostringstream os;
+  os.setf(std::ios::fixed);
+  os.precision(3);
+  os << "channel " << d.channel << ", " << d.windows << " windows (effective " << d.effective_windows
+     << ", lag-1 autocorrelation " << d.lag1_autocorrelation << ")\n";
+  os << "uncalibrated trip energy error: " << d.raw_trip_energy_error_pct << " %\n";
+  os << "calibration: channel scale " << d.channel_scale << ", RRC level " << 100 * d.rrc_level_change << " %, aero C "
+     << 100 * d.drag_change << " %\n";
+  os << "held-out, calibrated: RMSE " << d.heldout_rmse_calibrated_j / 1e3 << " kJ per window, trip energy error "
+     << d.heldout_energy_error_pct_calibrated << " %\n";
+  os << "verdict: " << d.verdict << "\n";
+  for (const auto& f : d.findings) {
+    os << "  " << f.effect << " (delta BIC " << f.delta_bic << ")";
+    if (!f.confounded_with.empty()) {
+      os << " confounded with";
+      for (const auto& c : f.confounded_with) os << " " << c;
+    }
+    os << "\n";
+    for (const auto& p : f.parameters)
+      os << "    " << p.name << " = " << p.value << " [" << p.ci_low << ", " << p.ci_high << "] " << p.unit << "\n";
+    os << "    held-out RMSE " << f.heldout_rmse_before_j / 1e3 << " -> " << f.heldout_rmse_after_j / 1e3
+       << " kJ/window, trip energy error " << f.heldout_energy_error_pct_before << " -> " << f.heldout_energy_error_pct_after << " %\n";
+  }
+  os << "located (measured - calibrated model, mean power, 95 %):\n";
+  os.precision(0);
+  for (const auto& l : d.located)
+    os << "  " << l.regime << ": " << l.mean_w << " W [" << l.ci_low_w << ", " << l.ci_high_w << "] (" << l.samples << " samples)\n";
+  return os.str();
+}
+
+std::string fitted_vehicle_yaml(const std::string& vehicle_path, const Diagnosis& d) {
+  std::ifstream in(vehicle_path);
+  if (!in) throw InputError(vehicle_path, "cannot read");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  std::string text = ss.str();
+  // Only files without an effects block are rewritten: merging two blocks would silently drop one.
+  std::istringstream lines(text);
+  for (std::string line; std::getline(lines, line);)
+    if (line.rfind("effects:", 0) == 0) throw InputError(vehicle_path, "already has an effects: block; remove it to write a fitted one");
+  std::vector<std::pair<std::string, EffectParameters>> eff;
+  for (const auto& f : d.findings) eff.emplace_back(f.effect, f.fitted);
+  if (!text.empty() && text.back() != '\n') text += '\n';
+  text += "# effects fitted by rollsim diagnose (verdict: " + d.verdict + ")\n";
+  if (eff.empty()) return text;
+  return text + effects_yaml(eff);
+}
+
+}  // namespace rollsim
