@@ -104,6 +104,7 @@ struct Data {
   Eigen::VectorXd measured_j;
   std::vector<std::vector<double>> measured_w;  // empty for SOC
   std::string channel;
+  int lag_samples = 0;  // measured channel lags the simulation by this many samples (calibration)
 };
 
 Variant run_variant(const Vehicle& vehicle, const std::vector<DriveCycle>& cycles, const Data& d,
@@ -127,7 +128,8 @@ Variant run_variant(const Vehicle& vehicle, const std::vector<DriveCycle>& cycle
   for (std::size_t w = 0; w < d.windows.size(); ++w) {
     const auto& win = d.windows[w];
     double e = 0.0;
-    for (std::size_t i = win.begin; i < win.end; ++i) e += out.power_w[win.rec][i] * d.dt_s[win.rec][i];
+    const auto lag = static_cast<std::size_t>(d.lag_samples);
+    for (std::size_t i = win.begin; i < win.end; ++i) e += out.power_w[win.rec][i >= lag ? i - lag : 0] * d.dt_s[win.rec][i];
     out.window_j[static_cast<Eigen::Index>(w)] = e;
   }
   return out;
@@ -256,9 +258,29 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
   out.windows = static_cast<int>(n);
 
   const EffectContext ctx = context_of(vehicle);
-  const Variant base = run_variant(vehicle, cycles, d, {});
   const Variant rrc = run_variant(vehicle, cycles, d, {std::make_shared<RrcLevel>(0.1)});
   const Variant drag = run_variant(vehicle, cycles, d, {std::make_shared<DragScale>(0.1, ctx.rho_cda_kg_per_m)});
+  Variant base = run_variant(vehicle, cycles, d, {});
+  // Channel lag (calibration): the shift of the simulated power, 0-10 samples, that best matches the measured.
+  if (d.channel != "soc") {
+    double best = 1e300;
+    for (int lag = 0; lag <= 10; ++lag) {
+      double sse = 0.0;
+      for (std::size_t ri = 0; ri < recordings.size(); ++ri) {
+        const auto& p = base.power_w[ri];
+        for (std::size_t i = static_cast<std::size_t>(lag); i < p.size(); ++i) {
+          const double e = d.measured_w[ri][i] - p[i - static_cast<std::size_t>(lag)];
+          sse += e * e;
+        }
+      }
+      if (sse < best) {
+        best = sse;
+        d.lag_samples = lag;
+      }
+    }
+    base = run_variant(vehicle, cycles, d, {});
+  }
+  out.lag_samples = d.lag_samples;
   out.raw_trip_energy_error_pct = energy_error_pct(base.window_j, d.measured_j);
 
   // Calibration: measured = s * sim + a * S_rrc + b * S_drag (RRC level and CdA as nuisances, per 10 %).
@@ -391,8 +413,9 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
     for (std::size_t ri = 0; ri < recordings.size(); ++ri) {
       const Recording& r = recordings[ri];
       for (std::size_t i = 0; i + 1 < r.time_s.size(); ++i) {
-        const double sim = cal.coef[0] * base.power_w[ri][i] + cal.coef[1] * (rrc.power_w[ri][i] - base.power_w[ri][i]) +
-                           cal.coef[2] * (drag.power_w[ri][i] - base.power_w[ri][i]);
+        const std::size_t j = i >= static_cast<std::size_t>(d.lag_samples) ? i - static_cast<std::size_t>(d.lag_samples) : 0;
+        const double sim = cal.coef[0] * base.power_w[ri][j] + cal.coef[1] * (rrc.power_w[ri][j] - base.power_w[ri][j]) +
+                           cal.coef[2] * (drag.power_w[ri][j] - base.power_w[ri][j]);
         const double res = d.measured_w[ri][i] - sim;
         const double v = r.speed_mps[i], a = (r.speed_mps[i + 1] - v) / d.dt_s[ri][i];
         const double t = r.time_s[i] - r.time_s.front();
@@ -427,6 +450,7 @@ std::string diagnosis_json(const Diagnosis& d) {
   os << "  \"windows\": " << d.windows << ",\n  \"effective_windows\": " << num(d.effective_windows) << ",\n";
   os << "  \"calibration\": {\"channel_scale\": " << num(d.channel_scale) << ", \"rrc_level_change\": " << num(d.rrc_level_change)
      << ", \"drag_change\": " << num(d.drag_change) << "},\n";
+  os << "  \"lag_samples\": " << d.lag_samples << ",\n";
   os << "  \"raw_trip_energy_error_pct\": " << num(d.raw_trip_energy_error_pct) << ",\n";
   os << "  \"heldout_rmse_calibrated\": " << num(d.heldout_rmse_calibrated_j) << ",\n";
   os << "  \"heldout_energy_error_pct_calibrated\": " << num(d.heldout_energy_error_pct_calibrated) << ",\n";
@@ -462,6 +486,7 @@ std::string diagnosis_text(const Diagnosis& d) {
   os.precision(3);
   os << "channel " << d.channel << ", " << d.windows << " windows (effective " << d.effective_windows
      << ", lag-1 autocorrelation " << d.lag1_autocorrelation << ")\n";
+  os << "channel lag: " << d.lag_samples << " samples\n";
   os << "uncalibrated trip energy error: " << d.raw_trip_energy_error_pct << " %\n";
   os << "calibration: channel scale " << d.channel_scale << ", RRC level " << 100 * d.rrc_level_change << " %, aero C "
      << 100 * d.drag_change << " %\n";

@@ -46,6 +46,7 @@ struct Diagnosis {
   int windows = 0;
   double effective_windows = 0.0;
   double lag1_autocorrelation = 0.0;
+  int lag_samples = 0;                     ///< calibration: measured channel lag behind the model, samples
   double raw_trip_energy_error_pct = 0.0;  ///< uncalibrated model against measured, whole data
   double channel_scale = 1.0;              ///< calibration: measured / simulated
   double rrc_level_change = 0.0;           ///< calibration: fractional RRC change
