@@ -54,7 +54,19 @@ YAML::Node YamlMap::get(const std::string& key, bool required) {
   if (std::find(read_keys_.begin(), read_keys_.end(), key) == read_keys_.end()) read_keys_.push_back(key);
   YAML::Node n = node_[key];
   if (!n.IsDefined() || n.IsNull()) {
-    if (required) throw InputError(where(key), "required key is missing");
+    if (required) {
+      // A misspelt key shows up here first as a missing one: name the present keys that nobody asked for.
+      std::string unknown;
+      if (node_.IsMap()) {
+        for (const auto& kv : node_) {
+          const std::string k = kv.first.as<std::string>();
+          if (k != key && std::find(read_keys_.begin(), read_keys_.end(), k) == read_keys_.end())
+            unknown += (unknown.empty() ? "" : ", ") + ("'" + k + "'");
+        }
+      }
+      throw InputError(where(key), "required key is missing" +
+                                       (unknown.empty() ? std::string() : " (present and not yet known here: " + unknown + "; misspelt?)"));
+    }
     return YAML::Node();
   }
   return n;

@@ -107,4 +107,9 @@ JsonObject& JsonObject::add_null(const std::string& key) {
 
 std::string JsonObject::str() const { return "{" + body_ + "}"; }
 
+JsonObject& JsonObject::add(const std::string& key, const JsonObject& value) {
+  add_raw(key, value.str());
+  return *this;
+}
+
 }  // namespace rollsim::report

@@ -23,7 +23,7 @@ VehicleModel VehicleModel::assemble(const Vehicle& vehicle) {
 }
 
 double EnergyBreakdown::wheel_residual_j() const {
-  return traction_j - (rolling_j + aero_j + grade_j + other_resistance_j + friction_brake_j + regen_wheel_j +
+  return traction_j + unmet_demand_j - (rolling_j + aero_j + grade_j + other_resistance_j + friction_brake_j + regen_wheel_j +
                        wheel_loss_j + kinetic_change_j);
 }
 
@@ -50,7 +50,7 @@ namespace {
 enum Idx : int {
   kSpeed, kDistance, kDriverIntegral,
   kTraction, kRolling, kAero, kGrade, kOther, kFriction, kRegen, kWheelLoss,
-  kGearbox, kMotor, kBatteryLoss, kAux, kTerminal, kFuelEnergy, kEngineLoss, kClutch, kFuelVolume,
+  kGearbox, kMotor, kBatteryLoss, kAux, kTerminal, kFuelEnergy, kEngineLoss, kClutch, kFuelVolume, kUnmet,
   kBaseStates
 };
 
@@ -196,6 +196,7 @@ EnergyBreakdown breakdown_from(const double* y) {
   e.fuel_j = y[kFuelEnergy];
   e.engine_loss_j = y[kEngineLoss];
   e.clutch_loss_j = y[kClutch];
+  e.unmet_demand_j = y[kUnmet];
   return e;
 }
 
@@ -504,9 +505,11 @@ SimulationResult simulate_replay(const VehicleModel& m, const DriveCycle& c, con
       EffectInputs in{t, v, a, grade, y[kDistance] + (v0 + v) / 2.0 * kNode[k] * dt, 0.0, 0.0};
       Instant s;
       eval.resistance(rl, in, x, s);
-      eval.deliver(m_eff * a + s.resistance_n(), gear, in, x, s);
+      const double request_n = m_eff * a + s.resistance_n();
+      eval.deliver(request_n, gear, in, x, s);
       segment_limited = segment_limited || s.flow.force_limited;
       accumulate(s, v, rate.data());
+      rate[kUnmet] = (request_n - s.flow.wheel_force_n) * v;
       for (int j = kTraction; j < kBaseStates; ++j) y[j] += kWeight[k] * dt * rate[j];
       for (std::size_t e = 0; e < m.effects.size(); ++e) {
         m.effects[e]->state_derivatives(in, x + eval.effect_state_offset[e], xdot.data() + eval.effect_state_offset[e]);

@@ -36,6 +36,8 @@ class JsonObject {
   JsonObject& add(const std::string& key, const std::string& value);
   JsonObject& add(const std::string& key, const char* value) { return add(key, std::string(value)); }
   JsonObject& add_null(const std::string& key);
+  /// A nested object as the value of `key`.
+  JsonObject& add(const std::string& key, const JsonObject& value);
   /// "{...}" without a trailing newline.
   std::string str() const;
 

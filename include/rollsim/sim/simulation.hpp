@@ -39,8 +39,8 @@ struct SimulationOptions {
   double shortfall_threshold_mps = 2.0 / 3.6;
 };
 
-/// Energies over a run [J]. At the wheel hubs: traction = rolling + aero + grade + other + friction brake + regen
-/// + wheel loss + kinetic change. Electric: battery terminal = traction - regen + gearbox + motor + aux.
+/// Energies over a run [J]. At the wheel hubs: traction + unmet demand = rolling + aero + grade + other +
+/// friction brake + regen + wheel loss + kinetic change. Electric: battery terminal = traction - regen + gearbox + motor + aux.
 /// Combustion: fuel = engine loss + traction + gearbox + clutch + aux.
 struct EnergyBreakdown {
   double traction_j = 0.0;
@@ -52,6 +52,9 @@ struct EnergyBreakdown {
   double regen_wheel_j = 0.0;
   double kinetic_change_j = 0.0;
   double wheel_loss_j = 0.0;      ///< effects' wheel losses (tyre slip)
+  /// Replay only: wheel work the trace demanded beyond the powertrain's limits (the car could not have followed;
+  /// such intervals are also reported as shortfalls). Zero in forward simulation, where the car falls behind.
+  double unmet_demand_j = 0.0;
   double gearbox_loss_j = 0.0;
   double motor_loss_j = 0.0;
   double battery_loss_j = 0.0;

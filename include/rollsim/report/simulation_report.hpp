@@ -1,0 +1,31 @@
+// Presenting simulation results: readable summary, JSON, the time-series trace CSV, and comparison tables.
+#pragma once
+
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "rollsim/report/table.hpp"
+#include "rollsim/sim/simulation.hpp"
+
+namespace rollsim::report {
+
+/// Where the energy went, in kWh, in the order a reader expects (wheel uses, then powertrain losses).
+std::vector<std::pair<std::string, double>> energy_terms_kwh(const SimulationResult& r);
+
+/// Multi-line human summary: consumption, range or fuel and CO2, energy breakdown with shares, balance
+/// closure, tracking error and shortfalls; with `solver_stats`, CVODE's counters.
+std::string summary_text(const SimulationResult& r, bool solver_stats);
+
+/// JSON with at least distance_km, aec_kwh_per_10km (electric), fuel_l_per_100km (combustion), co2_g_per_km,
+/// energy_breakdown_kwh, max_speed_error_kmh.
+JsonObject to_json(const SimulationResult& r, const std::string& tyre_label);
+
+/// One row per trace point: speed, forces, powers, tyre RRC, battery current or fuel rate, state of charge.
+void write_trace_csv(std::ostream& out, const SimulationResult& r);
+
+/// The figure a run is judged by: kWh/10 km for electric cars, l/100 km for combustion ones.
+double headline_value(const SimulationResult& r);
+std::string headline_unit(const SimulationResult& r);
+
+}  // namespace rollsim::report

@@ -1,0 +1,131 @@
+// `rollsim simulate`: a car over one or more drive cycles with one or more tyre sets; CLI glue only.
+#include <CLI/CLI.hpp>
+
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "rollsim/common/atomic_file.hpp"
+#include "rollsim/common/error.hpp"
+#include "rollsim/common/yaml_reader.hpp"
+#include "rollsim/report/simulation_report.hpp"
+#include "rollsim/sim/simulation.hpp"
+
+namespace rollsim::cli {
+namespace {
+
+struct SimulateOptions {
+  std::string vehicle;
+  std::vector<std::string> tyres;
+  std::vector<std::string> cycles;
+  std::string trace_path;
+  bool json = false;
+  bool replay = false;
+  bool stats = false;
+};
+
+struct Run {
+  std::string tyre_label;
+  SimulationResult result;
+};
+
+void run_simulate(const SimulateOptions& o) {
+  const Vehicle base = load_vehicle_file(resolve_data_file(o.vehicle, "vehicles", ".yaml", "--vehicle"));
+  std::vector<std::optional<TyreSpec>> tyre_sets;
+  for (const auto& t : o.tyres) tyre_sets.emplace_back(load_tyre_file(resolve_data_file(t, "tyres", ".yaml", "--tyre")));
+  if (tyre_sets.empty()) tyre_sets.emplace_back(std::nullopt);
+  std::vector<DriveCycle> cycles;
+  for (const auto& c : o.cycles.empty() ? std::vector<std::string>{"nedc"} : o.cycles) cycles.push_back(load_cycle(c));
+  if (!o.trace_path.empty() && tyre_sets.size() * cycles.size() > 1)
+    throw InputError("--trace", "writes the time series of one run; give one --tyre and one --cycle with it");
+
+  SimulationOptions sim_opt;
+  sim_opt.record_trace = !o.trace_path.empty();
+  std::vector<Run> runs;
+  for (const auto& cycle : cycles) {
+    for (const auto& tyre : tyre_sets) {
+      Vehicle v = base;
+      std::string label = v.front_tyre ? v.front_tyre->name : "coast-down";
+      if (tyre) {
+        fit_tyres(v, *tyre);
+        label = tyre->name;
+        // A tyre must carry the car's wheel load: the model has no solution past the rim.
+        const auto loads = wheel_loads(v.body, 0.0);
+        try {
+          check_operating_point(tyre->state, std::max(loads.front_n, loads.rear_n), 0.0);
+        } catch (const ModelDomainError& e) {
+          throw InputError("--tyre '" + tyre->source + "'", e.what());
+        }
+        if (tyre->max_load_n > 0.0 && std::max(loads.front_n, loads.rear_n) > tyre->max_load_n)
+          std::cerr << "warning: --tyre '" << tyre->source << "': wheel load " << report::fixed(std::max(loads.front_n, loads.rear_n), 0)
+                    << " N exceeds the tyre's rated maximum " << report::fixed(tyre->max_load_n, 0) << " N\n";
+      }
+      const VehicleModel model = VehicleModel::assemble(v);
+      SimulationResult r;
+      try {
+        r = o.replay ? simulate_replay(model, cycle, sim_opt) : simulate_forward(model, cycle, sim_opt);
+      } catch (const SolverError& e) {
+        throw std::runtime_error(std::string("simulation of '") + v.name + "' on " + cycle.name +
+                                 " failed, no result is reported: " + e.what());
+      }
+      // With coast-down road load, say how much of A the tyres account for (the rest is driveline drag).
+      if (v.coastdown && v.front_tyre && !o.json) {
+        const double tyre_a_n = tyre_rolling_force_at_standstill_limit_n(v);
+        std::cout << "tyres' share of coast-down A: " << report::fixed(tyre_a_n, 1) << " N of "
+                  << report::fixed(v.coastdown->a_n, 1) << " N (" << report::fixed(100.0 * tyre_a_n / v.coastdown->a_n, 1)
+                  << " %)\n";
+      }
+      runs.push_back({label, std::move(r)});
+    }
+  }
+
+  if (!o.trace_path.empty()) {
+    write_file_atomically(o.trace_path, "--trace", [&](std::ostream& out) { report::write_trace_csv(out, runs.front().result); });
+  }
+  if (o.json) {
+    for (const auto& run : runs) std::cout << report::to_json(run.result, run.tyre_label).str() << "\n";
+    return;
+  }
+  if (runs.size() == 1) {
+    std::cout << "tyres: " << runs.front().tyre_label << "\n" << report::summary_text(runs.front().result, o.stats);
+    return;
+  }
+  // Several runs: one table, each against the first run on the same cycle.
+  const std::string unit = report::headline_unit(runs.front().result);
+  report::TextTable t({"cycle", "tyre", unit, "diff %", "rolling kWh", "rolling diff %",
+                       runs.front().result.electric ? "range km" : "CO2 g/km", "max err km/h"});
+  t.set_left_aligned(0);
+  t.set_left_aligned(1);
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    const auto& r = runs[i].result;
+    const auto& ref = runs[i - i % tyre_sets.size()].result;
+    const double value = report::headline_value(r), ref_value = report::headline_value(ref);
+    t.add_row({r.cycle, runs[i].tyre_label, report::fixed(value, 3), report::fixed(100.0 * (value / ref_value - 1.0), 2),
+               report::fixed(r.energy.rolling_j / 3.6e6, 4),
+               report::fixed(100.0 * (r.energy.rolling_j / ref.energy.rolling_j - 1.0), 2),
+               r.electric ? report::fixed(r.range_km(), 1) : report::fixed(r.co2_g_per_km(), 1),
+               report::fixed(r.max_speed_error_mps * 3.6, 2)});
+  }
+  std::cout << base.name << " (" << (o.replay ? "replay" : "forward") << " simulation)\n" << t.render();
+  std::cout << "diff %: against the first tyre on the same cycle\n";
+}
+
+}  // namespace
+
+void register_simulate_command(CLI::App& app) {
+  auto opts = std::make_shared<SimulateOptions>();
+  auto* sub = app.add_subcommand("simulate", "Drive a car over drive cycles and report energy or fuel use");
+  sub->add_option("--vehicle", opts->vehicle, "Vehicle file (YAML); a bare name is looked up in vehicles/")->required();
+  sub->add_option("--tyre", opts->tyres, "Tyre file for all four wheels, overriding the vehicle's; repeat to compare");
+  sub->add_option("--cycle", opts->cycles, "Cycle name (nedc, wltc, udds, ftp75, hwfet, us06, artemis_*) or CSV; repeat to compare (default nedc)");
+  sub->add_flag("--replay", opts->replay, "Kinematic replay: follow the trace exactly, no driver and no ODE solver");
+  sub->add_flag("--json", opts->json, "One JSON object per run per line");
+  sub->add_flag("--stats", opts->stats, "Print CVODE's statistics (steps, right-hand-side calls, failures)");
+  sub->add_option("--trace", opts->trace_path, "Write the time series of the run to this CSV file");
+  sub->callback([opts] { run_simulate(*opts); });
+}
+
+}  // namespace rollsim::cli

@@ -1,0 +1,157 @@
+#include "rollsim/report/simulation_report.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include "rollsim/common/units.hpp"
+
+namespace rollsim::report {
+
+std::vector<std::pair<std::string, double>> energy_terms_kwh(const SimulationResult& r) {
+  const auto& e = r.energy;
+  auto k = [](double j) { return units::j_to_kwh(j); };
+  std::vector<std::pair<std::string, double>> t{
+      {"traction_at_wheels", k(e.traction_j)},
+      {"rolling_resistance", k(e.rolling_j)},
+      {"aerodynamic_drag", k(e.aero_j)},
+      {"grade", k(e.grade_j)},
+      {"other_resistance", k(e.other_resistance_j)},
+      {"braking_lost", k(e.friction_brake_j)},
+      {"regenerated_at_wheels", k(e.regen_wheel_j)},
+      {"wheel_slip", k(e.wheel_loss_j)},
+      {"kinetic_change", k(e.kinetic_change_j)},
+      {"unmet_demand", k(e.unmet_demand_j)},
+      {"gearbox", k(e.gearbox_loss_j)},
+      {"auxiliaries", k(e.aux_j)},
+  };
+  if (r.electric) {
+    t.push_back({"motor", k(e.motor_loss_j)});
+    t.push_back({"battery_internal", k(e.battery_loss_j)});
+    t.push_back({"battery_terminals", k(e.battery_terminal_j)});
+  } else {
+    t.push_back({"engine", k(e.engine_loss_j)});
+    t.push_back({"clutch", k(e.clutch_loss_j)});
+    t.push_back({"fuel", k(e.fuel_j)});
+  }
+  return t;
+}
+
+double headline_value(const SimulationResult& r) { return r.electric ? r.aec_kwh_per_10km() : r.fuel_l_per_100km(); }
+std::string headline_unit(const SimulationResult& r) { return r.electric ? "kWh/10 km" : "l/100 km"; }
+
+std::string summary_text(const SimulationResult& r, bool solver_stats) {
+  std::ostringstream o;
+  const auto& e = r.energy;
+  const double km = r.distance_m / 1000.0;
+  o << r.vehicle << " on " << r.cycle << " (" << r.mode << " simulation; road load: " << r.road_load << ")\n";
+  o << "  distance " << fixed(km, 3) << " km in " << fixed(r.duration_s, 0) << " s, mean speed "
+    << fixed(km / (r.duration_s / 3600.0), 1) << " km/h\n";
+  if (r.electric) {
+    o << "  energy at the battery terminals: " << fixed(r.aec_kwh_per_10km(), 3) << " kWh/10 km = "
+      << fixed(r.aec_kwh_per_10km() * 10.0, 2) << " kWh/100 km = " << fixed(r.aec_kwh_per_10km() * 100.0, 1) << " Wh/km\n";
+    o << "  range on the usable battery (" << fixed(units::j_to_kwh(r.usable_battery_j), 1) << " kWh): "
+      << fixed(r.range_km(), 0) << " km; state of charge " << fixed(r.initial_soc * 100, 1) << " % -> "
+      << fixed(r.final_soc * 100, 1) << " %\n";
+  } else {
+    o << "  fuel: " << fixed(r.fuel_l_per_100km(), 3) << " l/100 km (" << fixed(r.fuel_volume_m3 * 1e3, 3)
+      << " l), CO2 " << fixed(r.co2_g_per_km(), 1) << " g/km\n";
+  }
+  const double source_j = r.electric ? e.battery_terminal_j : e.fuel_j;
+  TextTable t({"energy", "kWh", "share %"});
+  t.set_left_aligned(0);
+  auto row = [&](const std::string& name, double j, double of_j) {
+    t.add_row({name, fixed(units::j_to_kwh(j), 4), of_j != 0.0 ? fixed(100.0 * j / of_j, 1) : "-"});
+  };
+  row("at the wheels: traction", e.traction_j, e.traction_j);
+  row("  rolling resistance (tyres)", e.rolling_j, e.traction_j);
+  row("  aerodynamic drag", e.aero_j, e.traction_j);
+  if (e.grade_j != 0.0) row("  grade (net climb)", e.grade_j, e.traction_j);
+  if (e.other_resistance_j != 0.0) row("  other resistance (effects)", e.other_resistance_j, e.traction_j);
+  row("  braking lost (friction)", e.friction_brake_j, e.traction_j);
+  if (r.electric) row("  regenerated at the wheels", e.regen_wheel_j, e.traction_j);
+  if (e.wheel_loss_j != 0.0) row("  tyre slip", e.wheel_loss_j, e.traction_j);
+  row("  kinetic energy change", e.kinetic_change_j, e.traction_j);
+  if (e.unmet_demand_j != 0.0) row("demanded beyond the powertrain (replay)", e.unmet_demand_j, e.traction_j);
+  if (r.electric) {
+    row("battery terminals (net)", e.battery_terminal_j, source_j);
+    row("  traction - regenerated", e.traction_j - e.regen_wheel_j, source_j);
+    row("  reduction gear", e.gearbox_loss_j, source_j);
+    row("  motor and inverter", e.motor_loss_j, source_j);
+    row("  auxiliaries", e.aux_j, source_j);
+    row("battery internal loss (extra)", e.battery_loss_j, source_j);
+  } else {
+    row("fuel (lower heating value)", e.fuel_j, source_j);
+    row("  engine loss (heat, friction)", e.engine_loss_j, source_j);
+    row("  traction", e.traction_j, source_j);
+    row("  gearbox and final drive", e.gearbox_loss_j, source_j);
+    row("  clutch slip at launch", e.clutch_loss_j, source_j);
+    row("  accessories (alternator)", e.aux_j, source_j);
+  }
+  o << t.render();
+  o << "  energy balance closes to " << fixed(100.0 * std::abs(e.wheel_residual_j()) / e.traction_j, 4)
+    << " % at the wheels and " << fixed(100.0 * std::abs(e.powertrain_residual_j(r.electric)) / std::abs(source_j), 4)
+    << " % in the powertrain\n";
+  o << "  speed tracking: max error " << fixed(r.max_speed_error_mps * 3.6, 2) << " km/h at t = "
+    << fixed(r.max_speed_error_time_s, 1) << " s\n";
+  for (const auto& s : r.shortfalls) {
+    o << "  WARNING: the car could not follow the trace from t = " << fixed(s.start_s, 0) << " to " << fixed(s.end_s, 0)
+      << " s" << (s.max_deficit_mps > 0.0 ? ", falling behind by up to " + fixed(s.max_deficit_mps * 3.6, 1) +
+                                                " km/h at t = " + fixed(s.at_s, 0) + " s"
+                                          : " (powertrain at its limit)")
+      << "\n";
+  }
+  if (solver_stats && r.mode == "forward") {
+    o << "  CVODE: " << r.solver.steps << " steps, " << r.solver.rhs_evals << " right-hand-side calls, "
+      << r.solver.error_test_failures << " error-test failures, " << r.solver.nonlinear_failures
+      << " nonlinear failures, " << r.solver.root_evals << " root-function calls, " << r.solver.restarts
+      << " restarts at discontinuities\n";
+  }
+  return o.str();
+}
+
+JsonObject to_json(const SimulationResult& r, const std::string& tyre_label) {
+  JsonObject j;
+  j.add("vehicle", r.vehicle).add("tyre", tyre_label).add("road_load", r.road_load).add("cycle", r.cycle);
+  j.add("mode", r.mode).add("powertrain", r.electric ? "electric" : "combustion");
+  j.add("distance_km", r.distance_m / 1000.0).add("duration_s", r.duration_s);
+  if (r.electric) {
+    j.add("aec_kwh_per_10km", r.aec_kwh_per_10km()).add("aec_kwh_per_100km", r.aec_kwh_per_10km() * 10.0);
+    j.add("aec_wh_per_km", r.aec_kwh_per_10km() * 100.0).add("range_km", r.range_km());
+    j.add("final_soc_pct", r.final_soc * 100.0);
+    j.add_null("fuel_l_per_100km");
+    j.add("co2_g_per_km", 0.0);
+  } else {
+    j.add_null("aec_kwh_per_10km");
+    j.add("fuel_l_per_100km", r.fuel_l_per_100km()).add("co2_g_per_km", r.co2_g_per_km());
+  }
+  JsonObject b;
+  for (const auto& [k, v] : energy_terms_kwh(r)) b.add(k, v);
+  j.add("energy_breakdown_kwh", b);
+  j.add("energy_balance_residual_pct", 100.0 * r.energy.wheel_residual_j() / r.energy.traction_j);
+  j.add("max_speed_error_kmh", r.max_speed_error_mps * 3.6);
+  j.add("shortfalls", static_cast<int>(r.shortfalls.size()));
+  if (r.mode == "forward") {
+    JsonObject s;
+    s.add("steps", static_cast<int>(r.solver.steps)).add("rhs_evals", static_cast<int>(r.solver.rhs_evals));
+    s.add("error_test_failures", static_cast<int>(r.solver.error_test_failures));
+    s.add("nonlinear_failures", static_cast<int>(r.solver.nonlinear_failures));
+    s.add("restarts", static_cast<int>(r.solver.restarts));
+    j.add("cvode", s);
+  }
+  return j;
+}
+
+void write_trace_csv(std::ostream& out, const SimulationResult& r) {
+  out << "time_s,target_speed_kmh,speed_kmh,accel_mps2,grade_pct,gear,rolling_force_n,aero_force_n,grade_force_n,"
+         "wheel_force_n,traction_power_kw,battery_power_kw,battery_current_a,fuel_rate_lph,tyre_rrc,soc_pct\n";
+  out.precision(8);
+  for (const auto& p : r.trace) {
+    out << p.time_s << ',' << p.target_speed_mps * 3.6 << ',' << p.speed_mps * 3.6 << ',' << p.accel_mps2 << ','
+        << p.grade * 100.0 << ',' << p.gear << ',' << p.rolling_force_n << ',' << p.aero_force_n << ','
+        << p.grade_force_n << ',' << p.wheel_force_n << ',' << p.traction_power_w / 1e3 << ','
+        << p.battery_power_w / 1e3 << ',' << p.battery_current_a << ',' << p.fuel_rate_m3_per_s * 3.6e6 << ','
+        << p.rrc << ',' << p.soc * 100.0 << '\n';
+  }
+}
+
+}  // namespace rollsim::report

@@ -1,0 +1,186 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "rollsim/common/error.hpp"
+#include "rollsim/sim/simulation.hpp"
+
+using namespace rollsim;
+
+namespace {
+
+std::string shipped(const std::string& rel) { return std::string(ROLLSIM_SOURCE_DIR) + "/" + rel; }
+
+VehicleModel model_of(const std::string& vehicle_file) { return VehicleModel::assemble(load_vehicle_file(shipped(vehicle_file))); }
+
+DriveCycle constant_speed_cycle(double speed_mps, double duration_s) {
+  DriveCycle c;
+  c.name = "constant";
+  for (double t = 0.0; t <= duration_s; t += 10.0) {
+    c.time_s.push_back(t);
+    c.speed_mps.push_back(speed_mps);
+    c.grade.push_back(0.0);
+  }
+  return c;
+}
+
+std::string temp_file(const std::string& name, const std::string& text) {
+  const auto dir = std::filesystem::temp_directory_path() / ("rollsim_sim_test_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const auto p = dir / name;
+  std::ofstream(p) << text;
+  return p.string();
+}
+
+}  // namespace
+
+// The platform study's figures (Redrouthu & Das 2014) for its two cars on NEDC: the shipped cars are built
+// to reproduce them, so a change to any model that moves them fails here.
+TEST(Simulation, ShippedCarsReproduceThePlatformStudyOnNedc) {
+  const auto nedc = load_cycle("nedc");
+  const auto ev = simulate_forward(model_of("vehicles/ev.yaml"), nedc);
+  EXPECT_NEAR(ev.aec_kwh_per_10km(), 1.64, 0.05);
+  const auto ice = simulate_forward(model_of("vehicles/ice.yaml"), nedc);
+  EXPECT_NEAR(ice.fuel_l_per_100km(), 6.24, 0.2);
+  EXPECT_NEAR(ev.distance_m, nedc.distance_m(), 5.0);
+}
+
+TEST(Simulation, EnergyBalanceClosesOnEveryCycle) {
+  for (const char* vehicle : {"vehicles/ev.yaml", "vehicles/ice.yaml"}) {
+    const auto m = model_of(vehicle);
+    for (const char* cycle : {"nedc", "wltc", "udds", "us06"}) {
+      for (bool forward : {true, false}) {
+        const auto c = load_cycle(cycle);
+        const auto r = forward ? simulate_forward(m, c) : simulate_replay(m, c);
+        SCOPED_TRACE(std::string(vehicle) + " " + cycle + (forward ? " forward" : " replay"));
+        EXPECT_LT(std::abs(r.energy.wheel_residual_j()) / r.energy.traction_j, 1e-3);
+        const double source_j = r.electric ? r.energy.battery_terminal_j : r.energy.fuel_j;
+        EXPECT_LT(std::abs(r.energy.powertrain_residual_j(r.electric)) / source_j, 1e-9);
+        EXPECT_GT(r.energy.rolling_j, 0.0);
+        EXPECT_GT(r.energy.aero_j, 0.0);
+      }
+    }
+  }
+}
+
+TEST(Simulation, ForwardAndReplayAgreeOnNedc) {
+  const auto nedc = load_cycle("nedc");
+  for (const char* vehicle : {"vehicles/ev.yaml", "vehicles/ice.yaml"}) {
+    const auto m = model_of(vehicle);
+    const auto f = simulate_forward(m, nedc);
+    const auto r = simulate_replay(m, nedc);
+    const double ef = f.electric ? f.energy.battery_terminal_j : f.fuel_volume_m3;
+    const double er = r.electric ? r.energy.battery_terminal_j : r.fuel_volume_m3;
+    EXPECT_LT(std::abs(ef / er - 1.0), 0.005) << vehicle;
+    EXPECT_LT(f.max_speed_error_mps * 3.6, 2.0) << vehicle;  // the regulation's tolerance
+    EXPECT_TRUE(f.shortfalls.empty()) << vehicle;
+  }
+}
+
+// Analytic limit: at constant speed on the flat with coast-down road load, the wheels deliver exactly
+// (A + B v + C v^2) times the distance.
+TEST(Simulation, ConstantSpeedMatchesCoastdownRoadLoadExactly) {
+  Vehicle v = load_vehicle_file(shipped("vehicles/ev.yaml"));
+  v.coastdown = CoastdownParams{150.0, 2.0, 0.4};
+  const auto m = VehicleModel::assemble(v);
+  const double speed_mps = 25.0;
+  const auto c = constant_speed_cycle(speed_mps, 600.0);
+  const double expected_j = (150.0 + 2.0 * speed_mps + 0.4 * speed_mps * speed_mps) * speed_mps * 600.0;
+  for (const auto& r : {simulate_forward(m, c), simulate_replay(m, c)}) {
+    EXPECT_NEAR(r.energy.traction_j / expected_j, 1.0, 1e-4) << r.mode;
+    EXPECT_NEAR(r.distance_m, speed_mps * 600.0, 0.05) << r.mode;
+  }
+}
+
+// At standstill only the auxiliaries draw: energy is aux power times time, and the tyres add nothing.
+TEST(Simulation, StandstillCostsOnlyAuxiliaries) {
+  const auto m = model_of("vehicles/ev.yaml");
+  const auto r = simulate_forward(m, constant_speed_cycle(0.0, 300.0));
+  const double aux_w = std::get<ElectricPowertrainParams>(load_vehicle_file(shipped("vehicles/ev.yaml")).powertrain).aux_power_w;
+  EXPECT_NEAR(r.energy.battery_terminal_j, aux_w * 300.0, 1e-6 * aux_w * 300.0);
+  EXPECT_EQ(r.energy.rolling_j, 0.0);
+}
+
+// Published trend: a higher pressure lowers RRC and so the car's energy; the rolling share moves most.
+TEST(Simulation, HigherTyrePressureLowersEnergy) {
+  Vehicle v = load_vehicle_file(shipped("vehicles/ev.yaml"));
+  const auto nedc = load_cycle("nedc");
+  const double low = simulate_replay(VehicleModel::assemble(v), nedc).energy.battery_terminal_j;
+  v.front_tyre->state.pressure_pa = v.rear_tyre->state.pressure_pa = 3.0e5;
+  const auto high = simulate_replay(VehicleModel::assemble(v), nedc);
+  EXPECT_LT(high.energy.battery_terminal_j, low);
+}
+
+// A larger tyre turns the motor slower at the same road speed: the gearing part of a tyre change.
+TEST(Simulation, WheelRadiusSetsMachineSpeed) {
+  Vehicle v = load_vehicle_file(shipped("vehicles/ev.yaml"));
+  const double r_small = driven_wheel_radius_m(v);
+  fit_tyres(v, load_tyre_file(shipped("tyres/low-rrc.yaml")));
+  const double r_large = driven_wheel_radius_m(v);
+  ASSERT_GT(r_large, r_small);
+  const ElectricPowertrain pt(std::get<ElectricPowertrainParams>(v.powertrain));
+  const double w_small = pt.deliver(500.0, 20.0, 0, r_small).machine_speed_radps;
+  const double w_large = pt.deliver(500.0, 20.0, 0, r_large).machine_speed_radps;
+  EXPECT_NEAR(w_small / w_large, r_large / r_small, 1e-12);
+}
+
+// A car too weak for the trace finishes and says where and by how much it fell behind.
+TEST(Simulation, UnderpoweredCarReportsShortfallAndFinishes) {
+  Vehicle v = load_vehicle_file(shipped("vehicles/ev.yaml"));
+  auto& e = std::get<ElectricPowertrainParams>(v.powertrain);
+  e.motor.max_power_w = 15e3;
+  const auto r = simulate_forward(VehicleModel::assemble(v), load_cycle("us06"));
+  ASSERT_FALSE(r.shortfalls.empty());
+  EXPECT_GT(r.shortfalls.front().max_deficit_mps * 3.6, 2.0);
+  EXPECT_GT(r.distance_m, 5000.0);
+}
+
+TEST(Simulation, BadVehicleFilesAreRejectedWithTheKey) {
+  const std::string good = [] {
+    std::ifstream in(shipped("vehicles/ev.yaml"));
+    return std::string((std::istreambuf_iterator<char>(in)), {});
+  }();
+  auto expect_error = [&](const std::string& from, const std::string& to, const std::string& key) {
+    std::string text = good;
+    const auto pos = text.find(from);
+    ASSERT_NE(pos, std::string::npos) << from;
+    text.replace(pos, from.size(), to);
+    std::string tyres = std::string("all: ") + shipped("tyres/nominal.yaml");
+    const auto tp = text.find("all: nominal.yaml");
+    if (tp != std::string::npos) text.replace(tp, std::string("all: nominal.yaml").size(), tyres);
+    const auto path = temp_file("bad_vehicle.yaml", text);
+    try {
+      load_vehicle_file(path);
+      FAIL() << "accepted " << to;
+    } catch (const InputError& err) {
+      EXPECT_NE(std::string(err.what()).find(key), std::string::npos) << err.what();
+    }
+  };
+  expect_error("test_mass_kg: 1631", "test_mas_kg: 1631", "test_mas_kg");          // misspelt key
+  expect_error("test_mass_kg: 1631", "test_mass_kg: -1631", "body.test_mass_kg");  // negative mass
+  expect_error("efficiency: 0.95", "efficiency: 1.2", "reduction.efficiency");     // efficiency above 1
+  expect_error("usable_capacity_kwh: 21.3", "usable_capacity_kwh: -5", "usable_capacity_kwh");
+  expect_error("max_torque_nm: 254", "max_torque_nm: .nan", "max_torque_nm");
+  expect_error("    ratio: 7.94", "    ratio_: 7.94", "reduction");                // missing required key
+  expect_error("type: electric", "type: steam", "powertrain.type");
+  EXPECT_THROW(load_vehicle_file("/no/such/vehicle.yaml"), InputError);
+}
+
+// A car too heavy for its tyres (73.5 kN per tyre deflects the nominal tyre, 200 kN/m at 2.1 bar, by 0.37 m,
+// past its 0.305 m radius) is an input error naming the tyre, never a NaN.
+TEST(Simulation, TyreThatCannotCarryTheCarIsRejected) {
+  std::ifstream in(shipped("vehicles/ev.yaml"));
+  std::string text((std::istreambuf_iterator<char>(in)), {});
+  text.replace(text.find("test_mass_kg: 1631"), 18, "test_mass_kg: 30000");
+  text.replace(text.find("all: nominal.yaml"), 17, "all: " + shipped("tyres/nominal.yaml"));
+  try {
+    load_vehicle_file(temp_file("heavy.yaml", text));
+    FAIL() << "a 30 t car on passenger tyres was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("nominal"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("deflects"), std::string::npos) << e.what();
+  }
+}
