@@ -4,12 +4,10 @@ namespace rollsim::cli {
 
 void register_commands(CLI::App& app) {
   register_tyre_command(app);
-  register_diagnose_command(app);
   register_compare_command(app);
   register_sweep_command(app);
   register_sensitivity_command(app);
   register_regress_command(app);
-  register_simulate_command(app);
 }
 
 }  // namespace rollsim::cli

@@ -1,0 +1,41 @@
+// The energy regression baseline: cases (vehicle, tyre, cycle) with expected energy or fuel, run and compared.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace rollsim::selection {
+
+struct RegressCase {
+  std::string name;
+  std::string vehicle;        ///< path or shipped name
+  std::string tyre;           ///< path or shipped name
+  std::string cycle;          ///< shipped name or path
+  std::string unit;           ///< "kwh_per_10km" or "l_per_100km"
+  double expected = 0.0;
+  double tolerance_pct = 0.5;
+};
+
+struct Baseline {
+  std::string file;
+  std::vector<RegressCase> cases;
+};
+
+/// Reads a baseline file (strict keys, see tests/energy_baseline.yaml). Throws InputError.
+Baseline load_baseline(const std::string& path);
+
+struct RegressOutcome {
+  RegressCase c;
+  double actual = 0.0;
+  double drift_pct = 0.0;  ///< (actual - expected) / expected, %
+  bool drifted = false;    ///< |drift| > tolerance
+};
+
+/// Runs every case forward. A missing vehicle, tyre or cycle, or a unit that does not match the car, throws
+/// InputError naming the file and the case.
+std::vector<RegressOutcome> run_baseline(const Baseline& baseline);
+
+/// The baseline text with every expected value replaced by the actual one (comments: how to regenerate).
+std::string baseline_yaml(const Baseline& baseline, const std::vector<RegressOutcome>& outcomes);
+
+}  // namespace rollsim::selection

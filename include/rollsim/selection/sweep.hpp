@@ -1,0 +1,77 @@
+// Parameter sweeps of a tyre (RRC, force, power) or of a car on a cycle (energy or fuel), one or two axes.
+#pragma once
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "rollsim/cycle/drive_cycle.hpp"
+#include "rollsim/tyre/tyre_model.hpp"
+#include "rollsim/tyre/tyre_spec.hpp"
+#include "rollsim/vehicle/vehicle.hpp"
+
+namespace rollsim::selection {
+
+/// What a sweep varies; values are in the user's units (bar, mm, mm, N, % of max load, km/h).
+enum class SweepParam { Pressure, Diameter, Width, Load, LoadPct, Speed };
+
+/// Parses "pressure", "diameter", "width", "load", "load-pct", "speed"; nullopt otherwise.
+std::optional<SweepParam> parse_sweep_param(const std::string& text);
+std::string sweep_param_key(SweepParam p);   ///< "pressure"
+std::string sweep_param_unit(SweepParam p);  ///< "bar"
+
+struct SweepAxis {
+  SweepParam param = SweepParam::Pressure;
+  double from = 0.0;  ///< user units
+  double to = 0.0;
+  int steps = 11;     ///< points including both ends, >= 2
+  std::vector<double> values() const;
+};
+
+/// Throws InputError (naming `option`) for an empty or reversed range or steps < 2.
+void check_axis(const SweepAxis& axis, const std::string& option);
+
+struct SweepOptions {
+  std::vector<SweepAxis> axes;         ///< one or two
+  std::optional<double> load_n;        ///< fixed load; default 80 % of the tyre's maximum load
+  double speed_kmh = 80.0;             ///< fixed speed
+  unsigned threads = 0;                ///< vehicle sweeps: 0 = every core
+  /// Called as points finish (done, total), possibly from worker threads; must be thread-safe.
+  std::function<void(std::size_t, std::size_t)> progress;
+};
+
+struct SweepPoint {
+  std::vector<double> values;          ///< one per axis, user units
+  double load_n = 0.0;
+  double speed_kmh = 0.0;
+  RollingResistance rr;                ///< the tyre at (load, speed)
+  double energy = 0.0;                 ///< vehicle sweeps: kWh/10 km or l/100 km
+};
+
+struct SweepResult {
+  std::vector<SweepAxis> axes;
+  bool vehicle = false;
+  std::string energy_unit;             ///< vehicle sweeps
+  std::vector<SweepPoint> points;      ///< valid points in sweep order
+  std::size_t planned_points = 0;
+  /// Set when the sweep left the model's domain: the point where it stopped and why.
+  std::optional<std::string> stopped;
+};
+
+/// The tyre with one parameter set (user units); load/speed parameters leave the tyre unchanged.
+TyreSpec with_parameter(const TyreSpec& tyre, SweepParam p, double value);
+
+/// Tyre alone: RRC, force, power at every point. Stops at the first point outside the model's domain
+/// (points are visited first axis outer, second inner, each axis from `from` to `to`).
+SweepResult sweep_tyre(const TyreSpec& tyre, const SweepOptions& options);
+
+/// The car on `cycle` with the swept tyre on all four wheels (pressure, diameter, width only): forward
+/// simulation per point, on every core, each thread with its own VehicleModel. Stops like sweep_tyre.
+SweepResult sweep_vehicle(const Vehicle& vehicle, const TyreSpec& tyre, const DriveCycle& cycle,
+                          const SweepOptions& options);
+
+/// The sweep as CSV (header + one line per point).
+std::string sweep_csv(const SweepResult& result);
+
+}  // namespace rollsim::selection

@@ -1,0 +1,184 @@
+// `rollsim compare`: tyre selection for a car: fit checks and a ranking by cycle energy or fuel per cycle.
+#include <algorithm>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "rollsim/common/units.hpp"
+#include "rollsim/report/table.hpp"
+#include "rollsim/selection/common.hpp"
+#include "rollsim/selection/compare.hpp"
+#include "selection_cli.hpp"
+
+namespace rollsim::cli {
+namespace {
+
+struct CompareOptionsText {
+  std::vector<std::string> vehicles, tyres, cycles;
+  std::string catalogue;
+  bool use_catalogue = false;
+  std::string diameter_tolerance_pct = "3";
+  bool json = false, csv = false;
+};
+
+std::string size_text(const TyreSpec& t) {
+  if (t.size) return t.size->designation;
+  return "R" + report::fixed(t.state.geometry.outer_radius_m * 1e3, 0) + " W" +
+         report::fixed(t.state.geometry.section_width_m * 1e3, 0);
+}
+
+std::string signed_fixed(double v, int d) { return (v > 0 ? "+" : "") + report::fixed(v, d); }
+
+void print_table(const selection::Comparison& c) {
+  const std::string unit = selection::energy_unit_label(c.unit);
+  std::cout << c.vehicle << " on " << c.cycle << ": tyres ranked by " << (c.electric ? "battery energy" : "fuel")
+            << " (forward simulation, tyre on all four wheels; RRC and RR power at 80 km/h and "
+            << report::fixed(c.ranked.empty() ? 0.0 : c.ranked.front().fit.wheel_load_n, 0) << " N per wheel)\n";
+  std::vector<std::string> h{"#", "tyre", "size", "p [bar]", "RRC x1000", "P_RR [W]", unit, "vs own [%]"};
+  if (c.electric) h.push_back("range chg [km]");
+  h.push_back("fit");
+  report::TextTable t(h);
+  t.set_left_aligned(1);
+  t.set_left_aligned(2);
+  t.set_left_aligned(h.size() - 1);
+  auto row = [&](const selection::CandidateResult& r, const std::string& rank) {
+    std::vector<std::string> cells{rank, r.tyre.name + (r.is_own ? " (own)" : ""), size_text(r.tyre),
+                                   report::fixed(units::pa_to_bar(r.tyre.state.pressure_pa), 1),
+                                   report::fixed(r.rrc_80 * 1e3, 3), report::fixed(r.rr_power_80_w, 1),
+                                   report::fixed(r.value, c.electric ? 4 : 3),
+                                   r.simulated ? signed_fixed(r.diff_pct, 2) : "-"};
+    if (c.electric) cells.push_back(r.simulated ? signed_fixed(r.range_change_km, 1) : "-");
+    cells.push_back(r.fit.fits ? "ok (" + signed_fixed(r.fit.diameter_change_pct, 1) + " % dia., load " +
+                                     report::fixed(100.0 * r.fit.wheel_load_n / r.fit.capacity_n, 0) + " %)"
+                               : r.fit.reason);
+    t.add_row(cells);
+  };
+  for (std::size_t i = 0; i < c.ranked.size(); ++i) row(c.ranked[i], std::to_string(i + 1));
+  for (const auto& r : c.unfit) row(r, "-");
+  std::cout << t.render();
+  if (c.electric) {
+    std::cout << "own tyre: " << report::fixed(c.own_value, 4) << " " << unit << ", range "
+              << report::fixed(c.own_range_km, 1) << " km; range column: gained (+) or lost (-) km\n";
+  }
+  std::cout << "\n";
+}
+
+void print_json(const selection::Comparison& c) {
+  auto emit = [&](const selection::CandidateResult& r, int rank) {
+    report::JsonObject j;
+    j.add("vehicle", c.vehicle).add("cycle", c.cycle).add("tyre", r.tyre.name).add("source", r.tyre.source);
+    j.add("size", size_text(r.tyre)).add("own", r.is_own);
+    if (rank > 0) j.add("rank", rank); else j.add_null("rank");
+    j.add("pressure_bar", units::pa_to_bar(r.tyre.state.pressure_pa))
+        .add("wheel_load_n", r.fit.wheel_load_n)
+        .add("capacity_n", r.fit.capacity_n)
+        .add("diameter_change_pct", r.fit.diameter_change_pct)
+        .add("rrc_80kmh", r.rrc_80)
+        .add("rr_power_80kmh_w", r.rr_power_80_w)
+        .add(c.unit, r.value)
+        .add("diff_pct", r.diff_pct);
+    if (c.electric) j.add("range_km", r.range_km).add("range_change_km", r.range_change_km);
+    j.add("fits", r.fit.fits).add("reason", r.fit.reason);
+    std::cout << j.str() << "\n";
+  };
+  for (std::size_t i = 0; i < c.ranked.size(); ++i) emit(c.ranked[i], static_cast<int>(i + 1));
+  for (const auto& r : c.unfit) emit(r, 0);
+}
+
+void print_csv(const selection::Comparison& c, bool header) {
+  if (header) {
+    std::cout << "vehicle,cycle,rank,tyre,size,pressure_bar,rrc_80kmh,rr_power_80kmh_w,value,unit,diff_pct,range_km,"
+                 "range_change_km,fits,reason\n";
+  }
+  auto q = [](const std::string& s) {
+    std::string o = "\"";
+    for (char ch : s) o += ch == '"' ? std::string("\"\"") : std::string(1, ch);
+    return o + "\"";
+  };
+  auto emit = [&](const selection::CandidateResult& r, int rank) {
+    std::cout << q(c.vehicle) << "," << c.cycle << "," << (rank > 0 ? std::to_string(rank) : "") << "," << q(r.tyre.name)
+              << "," << q(size_text(r.tyre)) << "," << report::fixed(units::pa_to_bar(r.tyre.state.pressure_pa), 2)
+              << "," << report::fixed(r.rrc_80, 6) << "," << report::fixed(r.rr_power_80_w, 2) << ","
+              << report::fixed(r.value, 5) << "," << c.unit << "," << report::fixed(r.diff_pct, 3) << ","
+              << (c.electric ? report::fixed(r.range_km, 2) : "") << ","
+              << (c.electric ? report::fixed(r.range_change_km, 2) : "") << "," << (r.fit.fits ? "yes" : "no") << ","
+              << q(r.fit.reason) << "\n";
+  };
+  for (std::size_t i = 0; i < c.ranked.size(); ++i) emit(c.ranked[i], static_cast<int>(i + 1));
+  for (const auto& r : c.unfit) emit(r, 0);
+}
+
+void run_compare(const CompareOptionsText& o) {
+  if (o.vehicles.empty()) throw InputError("--vehicle", "missing: give the car, e.g. --vehicle ev");
+  if (o.json && o.csv) throw InputError("--csv", "not allowed together with --json");
+  selection::CompareOptions copt;
+  copt.diameter_tolerance_pct =
+      parse_option_number(o.diameter_tolerance_pct, "--diameter-tolerance-pct", Range::open_low(0.0, 100.0));
+
+  // Candidates: --tyre files, then every *.yaml of the catalogue; a broken file is named and skipped.
+  bool broken = false;
+  std::vector<TyreSpec> candidates;
+  for (const auto& t : o.tyres) candidates.push_back(load_tyre_file(resolve_data_file(t, "tyres", ".yaml", "--tyre")));
+  if (o.use_catalogue || o.tyres.empty()) {
+    namespace fs = std::filesystem;
+    const std::string dir = o.catalogue.empty() ? data_root() + "/tyres/catalogue" : o.catalogue;
+    std::error_code ec;
+    if (!fs::is_directory(dir, ec)) throw InputError("--catalogue " + dir, "not a folder");
+    std::vector<std::string> files;
+    for (const auto& e : fs::directory_iterator(dir)) {
+      if (e.path().extension() == ".yaml" || e.path().extension() == ".yml") files.push_back(e.path().string());
+    }
+    std::sort(files.begin(), files.end());
+    if (files.empty()) throw InputError("--catalogue " + dir, "holds no *.yaml tyre files");
+    for (const auto& f : files) {
+      try {
+        candidates.push_back(load_tyre_file(f));
+      } catch (const std::exception& e) {
+        std::cerr << "error: skipped broken catalogue file: " << e.what() << "\n";
+        broken = true;
+      }
+    }
+  }
+  std::vector<std::string> cycles = o.cycles.empty() ? std::vector<std::string>{"nedc"} : o.cycles;
+  bool csv_header = true;
+  for (const auto& vname : o.vehicles) {
+    const Vehicle v = load_vehicle_file(resolve_data_file(vname, "vehicles", ".yaml", "--vehicle"));
+    for (const auto& cname : cycles) {
+      const DriveCycle cycle = load_cycle(cname, "--cycle");
+      const auto cmp = selection::compare_tyres(v, candidates, cycle, copt);
+      if (o.json) print_json(cmp);
+      else if (o.csv) print_csv(cmp, csv_header);
+      else print_table(cmp);
+      csv_header = false;
+    }
+  }
+  if (broken) throw InputError("--catalogue", "some catalogue files were broken (named above); the rest were compared");
+}
+
+}  // namespace
+
+void register_compare_command(CLI::App& app) {
+  auto o = std::make_shared<CompareOptionsText>();
+  CLI::App* sub = app.add_subcommand("compare", "Tyre selection: rank tyres for a car by cycle energy or fuel, with fit checks");
+  sub->add_option("--vehicle", o->vehicles, "Vehicle file or shipped name (repeatable)")->type_name("FILE");
+  sub->add_option("--tyre", o->tyres, "Candidate tyre file or shipped name (repeatable)")->type_name("FILE");
+  auto* cat = sub->add_option("--catalogue", o->catalogue,
+                              "Compare every *.yaml tyre of a folder (default tyres/catalogue when no --tyre)")
+                  ->type_name("DIR")
+                  ->expected(0, 1);
+  sub->add_option("--cycle", o->cycles, "Drive cycle name or CSV (repeatable; default nedc)")->type_name("CYCLE");
+  sub->add_option("--diameter-tolerance-pct", o->diameter_tolerance_pct,
+                  "Allowed outer-diameter change from the car's own tyre [%] (default 3)")
+      ->type_name("PCT");
+  sub->add_flag("--json", o->json, "One JSON object per tyre per line");
+  sub->add_flag("--csv", o->csv, "CSV with a header line");
+  sub->callback([o, cat] {
+    o->use_catalogue = cat->count() > 0;
+    run_compare(*o);
+  });
+}
+
+}  // namespace rollsim::cli

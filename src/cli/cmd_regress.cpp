@@ -1,0 +1,80 @@
+// `rollsim regress`: runs the energy baseline's cases and fails naming each drifted case; --update rewrites it.
+#include <iostream>
+#include <memory>
+#include <string>
+
+#include "commands.hpp"
+#include "rollsim/report/table.hpp"
+#include "rollsim/selection/common.hpp"
+#include "rollsim/selection/regress.hpp"
+#include "selection_cli.hpp"
+
+namespace rollsim::cli {
+namespace {
+
+struct RegressOptionsText {
+  std::string file;
+  bool update = false;
+};
+
+std::string signed_pct(double v) { return (v > 0 ? "+" : "") + report::fixed(v, 3); }
+
+int run_regress(const RegressOptionsText& o) {
+  const selection::Baseline b = selection::load_baseline(o.file);
+  const auto outcomes = selection::run_baseline(b);
+  report::TextTable t({"case", "vehicle", "tyre", "cycle", "expected", "actual", "unit", "drift [%]", "tol [%]", "status"});
+  for (std::size_t c : {0u, 1u, 2u, 3u, 6u, 9u}) t.set_left_aligned(c);
+  std::size_t drifted = 0;
+  for (const auto& r : outcomes) {
+    t.add_row({r.c.name, r.c.vehicle, r.c.tyre, r.c.cycle, report::fixed(r.c.expected, 4), report::fixed(r.actual, 4),
+               selection::energy_unit_label(r.c.unit), signed_pct(r.drift_pct), format_value(r.c.tolerance_pct),
+               r.drifted ? "DRIFTED" : "ok"});
+    drifted += r.drifted;
+  }
+  std::cout << t.render();
+  if (o.update) {
+    selection::write_file_atomically(o.file, selection::baseline_yaml(b, outcomes), "--update");
+    std::size_t changed = 0;
+    for (const auto& r : outcomes) {
+      if (r.actual != r.c.expected) {
+        ++changed;
+        std::cout << "updated " << r.c.name << ": " << report::fixed(r.c.expected, 4) << " -> "
+                  << report::fixed(r.actual, 4) << " " << selection::energy_unit_label(r.c.unit) << " ("
+                  << signed_pct(r.drift_pct) << " %)\n";
+      }
+    }
+    std::cout << "baseline " << o.file << " rewritten: " << changed << " of " << outcomes.size()
+              << " values changed\n";
+    return 0;
+  }
+  for (const auto& r : outcomes) {
+    if (r.drifted) {
+      std::cerr << "error: case '" << r.c.name << "' drifted " << signed_pct(r.drift_pct) << " % ("
+                << (r.drift_pct > 0 ? "up" : "down") << ": expected " << report::fixed(r.c.expected, 4) << ", got "
+                << report::fixed(r.actual, 4) << " " << selection::energy_unit_label(r.c.unit) << ", tolerance "
+                << format_value(r.c.tolerance_pct) << " %)\n";
+    }
+  }
+  if (drifted) {
+    std::cerr << "error: " << drifted << " of " << outcomes.size() << " cases drifted; if the change is deliberate, "
+              << "run 'rollsim regress " << o.file << " --update'\n";
+    return 1;
+  }
+  std::cout << "all " << outcomes.size() << " cases within tolerance\n";
+  return 0;
+}
+
+}  // namespace
+
+void register_regress_command(CLI::App& app) {
+  auto o = std::make_shared<RegressOptionsText>();
+  CLI::App* sub = app.add_subcommand("regress", "Energy regression: run a baseline's cases, fail on drift (--update rewrites it)");
+  sub->add_option("baseline", o->file, "Baseline YAML file (e.g. tests/energy_baseline.yaml)")->required()->type_name("FILE");
+  sub->add_flag("--update", o->update, "Rewrite the baseline with the new values and print the differences");
+  sub->callback([o] {
+    const int rc = run_regress(*o);
+    if (rc != 0) throw CLI::RuntimeError(rc);
+  });
+}
+
+}  // namespace rollsim::cli

@@ -1,0 +1,125 @@
+// `rollsim sensitivity`: elasticities of RR power and of a car's energy or fuel per tyre parameter.
+#include <cmath>
+#include <iostream>
+#include <memory>
+#include <string>
+
+#include "commands.hpp"
+#include "rollsim/common/units.hpp"
+#include "rollsim/report/table.hpp"
+#include "rollsim/selection/common.hpp"
+#include "rollsim/selection/sensitivity.hpp"
+#include "selection_cli.hpp"
+
+namespace rollsim::cli {
+namespace {
+
+struct SensitivityOptionsText {
+  std::string tyre, vehicle, cycle = "nedc", load_n, speed_kmh = "80";
+  bool json = false;
+};
+
+std::string value_text(const selection::SensitivityRow& r) {
+  switch (r.parameter) {
+    case TyreParameter::OuterDiameter:
+    case TyreParameter::SectionWidth: return report::fixed(r.value_si * 1e3, 1) + " mm";
+    case TyreParameter::Pressure: return report::fixed(units::pa_to_bar(r.value_si), 2) + " bar";
+    case TyreParameter::Load: return report::fixed(r.value_si, 0) + " N";
+    case TyreParameter::Speed: return report::fixed(units::mps_to_kmh(r.value_si), 1) + " km/h";
+  }
+  return "";
+}
+
+void run_sensitivity(const SensitivityOptionsText& o) {
+  if (o.tyre.empty() && o.vehicle.empty()) throw InputError("--tyre", "missing: give a tyre and/or --vehicle");
+  const double speed_mps =
+      units::kmh_to_mps(parse_option_number(o.speed_kmh, "--speed-kmh", Range::open_low(0.0, 500.0)));
+  std::optional<Vehicle> vehicle;
+  if (!o.vehicle.empty()) vehicle = load_vehicle_file(resolve_data_file(o.vehicle, "vehicles", ".yaml", "--vehicle"));
+  TyreSpec tyre;
+  if (!o.tyre.empty()) tyre = load_tyre_file(resolve_data_file(o.tyre, "tyres", ".yaml", "--tyre"));
+  else if (vehicle && vehicle->front_tyre) tyre = *vehicle->front_tyre;
+  else throw InputError("--tyre", "missing: the car has no tyre model (coast-down road load); give --tyre");
+
+  // Operating point: --load-n, else the car's heaviest wheel load, else 80 % of the tyre's maximum load.
+  double load_n = 0.0;
+  if (!o.load_n.empty()) {
+    load_n = parse_option_number(o.load_n, "--load-n", Range::open_low(0.0, 1e6));
+  } else if (vehicle) {
+    const auto w = wheel_loads(vehicle->body, 0.0);
+    load_n = std::max(w.front_n, w.rear_n);
+  } else if (tyre.max_load_n > 0.0) {
+    load_n = 0.8 * tyre.max_load_n;
+  } else {
+    throw InputError("--load-n", "missing: the tyre's maximum load is unknown; give --load-n N");
+  }
+  selection::Sensitivity s;
+  try {
+    if (vehicle) {
+      s = selection::vehicle_sensitivity(*vehicle, tyre, load_cycle(o.cycle, "--cycle"), load_n, speed_mps);
+    } else {
+      s = selection::tyre_sensitivity(tyre, load_n, speed_mps);
+    }
+  } catch (const ModelDomainError& e) {
+    throw InputError(tyre.source + " at " + report::fixed(load_n, 0) + " N", e.what());
+  }
+
+  if (o.json) {
+    report::JsonObject j;
+    j.add("tyre", s.tyre).add("load_n", s.load_n).add("speed_kmh", units::mps_to_kmh(s.speed_mps))
+        .add("relative_step", s.relative_step).add("rr_power_w", s.rr_power_w);
+    if (vehicle) j.add("vehicle", s.vehicle).add("cycle", s.cycle).add(s.energy_unit, s.energy);
+    for (const auto& r : s.rows) {
+      j.add("elasticity_rr_power_" + r.key, r.power_elasticity);
+      if (r.energy_elasticity) j.add("elasticity_" + s.energy_unit + "_" + r.key, *r.energy_elasticity);
+    }
+    j.add("dominant_rr_power", s.dominant_power);
+    if (vehicle) j.add("dominant_energy", s.dominant_energy);
+    std::cout << j.str() << "\n";
+    return;
+  }
+  std::cout << "Sensitivity of tyre " << s.tyre << " at " << report::fixed(s.load_n, 0) << " N, "
+            << report::fixed(units::mps_to_kmh(s.speed_mps), 0) << " km/h (RR power " << report::fixed(s.rr_power_w, 1)
+            << " W)";
+  if (vehicle) {
+    std::cout << "; " << s.vehicle << " on " << s.cycle << ": " << report::fixed(s.energy, 4) << " "
+              << selection::energy_unit_label(s.energy_unit);
+  }
+  std::cout << "\nElasticities: % change of the output per % change of the parameter (central differences +-"
+            << format_value(s.relative_step * 100) << " %)\n";
+  std::vector<std::string> h{"parameter", "value", "RR power", "RRC"};
+  if (vehicle) h.push_back(s.energy_unit == "kwh_per_10km" ? "car energy" : "car fuel");
+  report::TextTable t(h);
+  t.set_left_aligned(0);
+  for (const auto& r : s.rows) {
+    std::vector<std::string> cells{r.name, value_text(r), report::fixed(r.power_elasticity, 3),
+                                   report::fixed(r.rrc_elasticity, 3)};
+    if (vehicle) cells.push_back(report::fixed(*r.energy_elasticity, 4));
+    t.add_row(cells);
+  }
+  std::cout << t.render();
+  std::cout << "Matters most for RR power: " << s.dominant_power;
+  if (vehicle) std::cout << "; for the car's " << (vehicle->is_electric() ? "energy" : "fuel") << ": " << s.dominant_energy;
+  std::cout << "\n";
+  if (vehicle) {
+    std::cout << "(car: load = test mass, all wheel loads scaled together; diameter also changes the gearing)\n";
+  }
+}
+
+}  // namespace
+
+void register_sensitivity_command(CLI::App& app) {
+  auto o = std::make_shared<SensitivityOptionsText>();
+  CLI::App* sub = app.add_subcommand("sensitivity", "Elasticities of RR power and of a car's energy/fuel per tyre parameter");
+  sub->add_option("--tyre", o->tyre, "Tyre file or shipped name (default: the car's own tyre)")->type_name("FILE");
+  sub->add_option("--vehicle", o->vehicle, "Also the car's energy/fuel elasticities on --cycle")->type_name("FILE");
+  sub->add_option("--cycle", o->cycle, "Drive cycle (default nedc)")->type_name("CYCLE");
+  sub->add_option("--load-n", o->load_n, "Normal load per tyre [N] (default: the car's heaviest wheel load, or 80 % of "
+                                         "the tyre's maximum load)")
+      ->type_name("N");
+  sub->add_option("--speed-kmh", o->speed_kmh, "Speed for the RR power elasticities [km/h] (default 80)")->type_name("KMH");
+  sub->add_flag("--json", o->json, "One JSON object");
+  sub->callback([o] { run_sensitivity(*o); });
+}
+
+}  // namespace rollsim::cli

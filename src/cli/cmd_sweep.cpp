@@ -1,0 +1,245 @@
+// `rollsim sweep`: one or two tyre parameters swept, tyre alone or in a car on a cycle; CSV and gnuplot figures.
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "rollsim/common/units.hpp"
+#include "rollsim/report/table.hpp"
+#include "rollsim/selection/common.hpp"
+#include "rollsim/selection/sweep.hpp"
+#include "selection_cli.hpp"
+
+namespace rollsim::cli {
+namespace {
+
+struct SweepOptionsText {
+  std::string tyre, vehicle, cycle = "nedc";
+  std::vector<std::string> params, from, to, steps;
+  std::string load_n, speed_kmh = "80", output, plot, threads;
+  bool base100 = false, json = false;
+};
+
+std::string find_gnuplot() {
+  const char* path = std::getenv("PATH");
+  std::stringstream ss(path ? path : "");
+  for (std::string dir; std::getline(ss, dir, ':');) {
+    const std::string p = (dir.empty() ? "." : dir) + "/gnuplot";
+    if (access(p.c_str(), X_OK) == 0) return p;
+  }
+  return "";
+}
+
+std::string axis_label(selection::SweepParam p) {
+  switch (p) {
+    case selection::SweepParam::Pressure: return "inflation pressure [bar]";
+    case selection::SweepParam::Diameter: return "outer diameter [mm]";
+    case selection::SweepParam::Width: return "section width [mm]";
+    case selection::SweepParam::Load: return "normal load [N]";
+    case selection::SweepParam::LoadPct: return "normal load [% of maximum load]";
+    case selection::SweepParam::Speed: return "speed [km/h]";
+  }
+  return "";
+}
+
+std::string shell_quote(const std::string& s) {
+  std::string o = "'";
+  for (char c : s) o += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return o + "'";
+}
+
+std::string display_unit(selection::SweepParam p) {
+  const std::string u = selection::sweep_param_unit(p);
+  return u == "kmh" ? "km/h" : u == "pct" ? "%" : u;
+}
+
+// gnuplot single-quoted strings: a quote is doubled.
+std::string gp_escape(const std::string& s) {
+  std::string o;
+  for (char c : s) o += c == '\'' ? std::string("''") : std::string(1, c);
+  return o;
+}
+
+// Draws RRC against the first swept parameter (one line per value of the second) with gnuplot.
+void plot(const selection::SweepResult& r, const std::string& tyre_name, const std::string& file, bool base100) {
+  namespace fs = std::filesystem;
+  if (r.points.empty()) throw InputError("--plot " + file, "no valid point to draw");
+  const std::string ext = fs::path(file).extension().string();
+  if (ext != ".svg" && ext != ".png") throw InputError("--plot " + file, "must end in .svg or .png");
+  const std::string gnuplot = find_gnuplot();
+  if (gnuplot.empty()) {
+    throw InputError("--plot " + file, "gnuplot is not installed or not on PATH (Debian: apt-get install gnuplot-nox); "
+                                       "the CSV output does not need it");
+  }
+  const fs::path target(file);
+  const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec) || access(dir.c_str(), W_OK) != 0) {
+    throw InputError("--plot " + file, "cannot write here (folder missing or not writable)");
+  }
+  const fs::path work = fs::temp_directory_path() / ("rollsim_plot_" + std::to_string(getpid()));
+  fs::create_directories(work);
+  // Series: one per value of the second axis (or one), x = first axis, y = RRC (or base 100 of its first point).
+  std::map<double, std::vector<std::pair<double, double>>> series;
+  for (const auto& p : r.points) series[p.values.size() > 1 ? p.values[1] : 0.0].push_back({p.values[0], p.rr.rrc});
+  std::ofstream data(work / "data.dat");
+  for (auto& [key, pts] : series) {
+    const double ref = pts.front().second;
+    for (auto& [x, y] : pts) data << format_value(x) << " " << (base100 ? 100.0 * y / ref : 1000.0 * y) << "\n";
+    data << "\n\n";
+  }
+  data.close();
+  const auto& a0 = r.axes[0];
+  std::string load_text = report::fixed(r.points.front().load_n, 0) + " N";
+  std::string title = "RRC of " + tyre_name;
+  if (a0.param != selection::SweepParam::Load && a0.param != selection::SweepParam::LoadPct &&
+      (r.axes.size() < 2 || (r.axes[1].param != selection::SweepParam::Load &&
+                             r.axes[1].param != selection::SweepParam::LoadPct))) {
+    title += " at " + load_text;
+  }
+  if (a0.param != selection::SweepParam::Speed && (r.axes.size() < 2 || r.axes[1].param != selection::SweepParam::Speed)) {
+    title += ", " + report::fixed(r.points.front().speed_kmh, 0) + " km/h";
+  }
+  const fs::path tmp_out = dir / ("." + target.filename().string() + ".tmp" + std::to_string(getpid()) + ext);
+  std::ofstream gp(work / "plot.gp");
+  gp << (ext == ".svg" ? "set terminal svg size 800,500 dynamic font 'Sans,12'\n"
+                       : "set terminal pngcairo size 800,500 font 'Sans,11'\n")
+     << "set output '" << gp_escape(tmp_out.string()) << "'\n"
+     << "set title \"" << title << " (rollsim tyre model)\"\n"
+     << "set xlabel \"" << axis_label(a0.param) << "\"\n"
+     << "set ylabel \"" << (base100 ? "RRC, base 100 at " + format_value(r.points.front().values[0]) + " " +
+                                          display_unit(a0.param)
+                                    : std::string("RRC x 1000 [-]"))
+     << "\"\nset grid\nset key top right\n";
+  gp << "plot ";
+  std::size_t i = 0;
+  for (auto& [key, pts] : series) {
+    std::string label = r.axes.size() > 1 ? selection::sweep_param_key(r.axes[1].param) + " " + format_value(key) + " " +
+                                                display_unit(r.axes[1].param)
+                                          : tyre_name;
+    gp << (i ? ", " : "") << "'" << gp_escape((work / "data.dat").string()) << "' index " << i << " with linespoints lw 2 pt 7 ps 0.6 title \""
+       << label << "\"";
+    ++i;
+  }
+  gp << "\n";
+  gp.close();
+  const std::string cmd = shell_quote(gnuplot) + " " + shell_quote((work / "plot.gp").string()) + " 2>" +
+                          shell_quote((work / "gnuplot.err").string());
+  const int status = std::system(cmd.c_str());
+  if (status != 0) {
+    std::ifstream err(work / "gnuplot.err");
+    std::stringstream ss;
+    ss << err.rdbuf();
+    fs::remove(tmp_out, ec);
+    fs::remove_all(work, ec);
+    throw InputError("--plot " + file, "gnuplot failed: " + ss.str());
+  }
+  fs::rename(tmp_out, target, ec);
+  fs::remove_all(work);
+  if (ec) throw InputError("--plot " + file, "cannot replace the file: " + ec.message());
+}
+
+void run_sweep(const SweepOptionsText& o) {
+  if (o.tyre.empty()) throw InputError("--tyre", "missing: give the tyre to sweep, e.g. --tyre 175-70R14");
+  if (o.params.empty()) throw InputError("--param", "missing: pressure, diameter, width, load, load-pct or speed");
+  if (o.params.size() > 2) throw InputError("--param", "at most two parameters (a grid)");
+  if (o.from.size() != o.params.size() || o.to.size() != o.params.size()) {
+    throw InputError("--from/--to", "give one --from and one --to per --param");
+  }
+  if (o.steps.size() > o.params.size()) throw InputError("--steps", "more --steps than --param");
+  selection::SweepOptions so;
+  for (std::size_t i = 0; i < o.params.size(); ++i) {
+    const auto p = selection::parse_sweep_param(o.params[i]);
+    const std::string opt = "--param " + o.params[i];
+    if (!p) throw InputError(opt, "unknown: must be pressure, diameter, width, load, load-pct or speed");
+    selection::SweepAxis a;
+    a.param = *p;
+    a.from = parse_option_number(o.from[i], "--from", Range{});
+    a.to = parse_option_number(o.to[i], "--to", Range{});
+    a.steps = i < o.steps.size() ? static_cast<int>(parse_option_number(o.steps[i], "--steps", Range::closed(-1e9, 1e6)))
+                                 : 11;
+    selection::check_axis(a, opt);
+    so.axes.push_back(a);
+  }
+  if (!o.load_n.empty()) so.load_n = parse_option_number(o.load_n, "--load-n", Range::open_low(0.0, 1e6));
+  so.speed_kmh = parse_option_number(o.speed_kmh, "--speed-kmh", Range::closed(0.0, 500.0));
+  if (!o.threads.empty()) so.threads = static_cast<unsigned>(parse_option_number(o.threads, "--threads", Range::closed(1, 1024)));
+  if (!o.plot.empty()) {
+    const std::string ext = std::filesystem::path(o.plot).extension().string();
+    if (ext != ".svg" && ext != ".png") throw InputError("--plot " + o.plot, "must end in .svg or .png");
+  }
+
+  const TyreSpec tyre = load_tyre_file(resolve_data_file(o.tyre, "tyres", ".yaml", "--tyre"));
+  Progress progress(!o.json);
+  so.progress = [&progress](std::size_t d, std::size_t t) { progress(d, t); };
+  selection::SweepResult r;
+  if (!o.vehicle.empty()) {
+    const Vehicle v = load_vehicle_file(resolve_data_file(o.vehicle, "vehicles", ".yaml", "--vehicle"));
+    const DriveCycle c = load_cycle(o.cycle, "--cycle");
+    r = selection::sweep_vehicle(v, tyre, c, so);
+  } else {
+    so.progress = nullptr;  // the tyre alone takes milliseconds
+    r = selection::sweep_tyre(tyre, so);
+  }
+
+  if (o.json) {
+    std::ostringstream out;
+    for (const auto& p : r.points) {
+      report::JsonObject j;
+      for (std::size_t i = 0; i < r.axes.size(); ++i) {
+        j.add(selection::sweep_param_key(r.axes[i].param) + "_" + selection::sweep_param_unit(r.axes[i].param), p.values[i]);
+      }
+      j.add("load_n", p.load_n).add("speed_kmh", p.speed_kmh).add("rrc", p.rr.rrc).add("rr_force_n", p.rr.rr_force_n)
+          .add("rr_power_w", p.rr.rr_power_w);
+      if (r.vehicle) j.add(r.energy_unit, p.energy);
+      out << j.str() << "\n";
+    }
+    if (o.output.empty()) std::cout << out.str();
+    else selection::write_file_atomically(o.output, out.str(), "--output");
+  } else if (o.output.empty()) {
+    std::cout << selection::sweep_csv(r);
+  } else {
+    selection::write_file_atomically(o.output, selection::sweep_csv(r), "--output");
+  }
+  if (!o.plot.empty()) plot(r, tyre.name, o.plot, o.base100);
+  if (r.stopped) {
+    throw InputError("--param", *r.stopped + " (the " + std::to_string(r.points.size()) + " valid points of " +
+                                    std::to_string(r.planned_points) + " were written)");
+  }
+}
+
+}  // namespace
+
+void register_sweep_command(CLI::App& app) {
+  auto o = std::make_shared<SweepOptionsText>();
+  CLI::App* sub = app.add_subcommand(
+      "sweep", "Sweep one or two tyre parameters: RRC, force and power, or a car's energy/fuel on a cycle (CSV)");
+  sub->add_option("--tyre", o->tyre, "Tyre file or shipped name")->type_name("FILE");
+  sub->add_option("--param", o->params, "pressure (bar), diameter (mm), width (mm), load (N), load-pct or speed (km/h); "
+                                        "twice for a grid")
+      ->type_name("P");
+  sub->add_option("--from", o->from, "First value of the range (one per --param)")->type_name("X");
+  sub->add_option("--to", o->to, "Last value of the range (one per --param)")->type_name("X");
+  sub->add_option("--steps", o->steps, "Points per range including both ends (default 11)")->type_name("N");
+  sub->add_option("--load-n", o->load_n, "Fixed normal load per tyre [N] (default 80 % of maximum load)")->type_name("N");
+  sub->add_option("--speed-kmh", o->speed_kmh, "Fixed speed [km/h] (default 80)")->type_name("KMH");
+  sub->add_option("--vehicle", o->vehicle, "Run this car with the swept tyre on all four wheels")->type_name("FILE");
+  sub->add_option("--cycle", o->cycle, "Drive cycle for --vehicle (default nedc)")->type_name("CYCLE");
+  sub->add_option("--threads", o->threads, "Worker threads for vehicle sweeps (default: every core)")->type_name("N");
+  sub->add_option("--output", o->output, "Write the CSV here (atomically) instead of stdout")->type_name("FILE.csv");
+  sub->add_option("--plot", o->plot, "Draw RRC against the swept parameter with gnuplot")->type_name("FILE.svg|.png");
+  sub->add_flag("--base100", o->base100, "Plot RRC as base 100 at the first point of each line");
+  sub->add_flag("--json", o->json, "JSON lines instead of CSV (no progress display)");
+  sub->callback([o] { run_sweep(*o); });
+}
+
+}  // namespace rollsim::cli

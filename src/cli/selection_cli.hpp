@@ -1,0 +1,45 @@
+// Option parsing and progress shared by the tyre-selection commands (compare, sweep, sensitivity, regress).
+#pragma once
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+#include <mutex>
+#include <string>
+
+#include "rollsim/common/error.hpp"
+#include "rollsim/common/yaml_reader.hpp"
+
+namespace rollsim::cli {
+
+// Options arrive as text so that every bad value gets a message naming option, value and what is allowed.
+inline double parse_option_number(const std::string& text, const std::string& option, Range range) {
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  if (text.empty() || end != text.c_str() + text.size()) {
+    throw InputError(option, "'" + text + "' is not a number; " + range.describe());
+  }
+  if (!range.contains(v)) throw InputError(option, format_value(v) + " is not allowed: " + range.describe());
+  return v;
+}
+
+/// Progress on stderr, only when stderr is a terminal (pipes and logs stay clean). Thread-safe.
+class Progress {
+ public:
+  explicit Progress(bool wanted) : on_(wanted && isatty(STDERR_FILENO)) {}
+  void operator()(std::size_t done, std::size_t total) {
+    if (!on_) return;
+    std::lock_guard<std::mutex> lock(m_);
+    std::fprintf(stderr, "\r%zu/%zu points", done, total);
+    if (done == total) std::fprintf(stderr, "\n");
+    std::fflush(stderr);
+  }
+
+ private:
+  bool on_;
+  std::mutex m_;
+};
+
+}  // namespace rollsim::cli

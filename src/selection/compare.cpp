@@ -1,0 +1,117 @@
+// Tyre selection: fit checks against the car and its own tyre, and a ranking by forward-simulated energy or fuel.
+#include "rollsim/selection/compare.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "rollsim/common/error.hpp"
+#include "rollsim/common/units.hpp"
+#include "rollsim/report/table.hpp"
+#include "rollsim/selection/common.hpp"
+#include "rollsim/tyre/tyre_model.hpp"
+
+namespace rollsim::selection {
+
+double reference_pressure_pa(const TyreSpec& tyre) {
+  const bool xl = tyre.size && tyre.size->extra_load;
+  return units::bar_to_pa(xl ? 2.9 : 2.5);
+}
+
+double load_capacity_at_pressure_n(const TyreSpec& tyre) {
+  if (!(tyre.max_load_n > 0.0)) return 0.0;
+  const double ratio = tyre.state.pressure_pa / reference_pressure_pa(tyre);
+  // Above the reference pressure the rating does not grow: the load index is the tyre's ceiling.
+  return ratio >= 1.0 ? tyre.max_load_n : tyre.max_load_n * std::pow(ratio, 0.585);
+}
+
+FitCheck check_fit(const Vehicle& vehicle, const TyreSpec& own, const TyreSpec& candidate,
+                   double diameter_tolerance_pct) {
+  FitCheck f;
+  const AxleWheelLoads loads = wheel_loads(vehicle.body, 0.0);
+  f.wheel_load_n = std::max(loads.front_n, loads.rear_n);
+  f.capacity_n = load_capacity_at_pressure_n(candidate);
+  const double d_own = 2.0 * own.state.geometry.outer_radius_m;
+  const double d_new = 2.0 * candidate.state.geometry.outer_radius_m;
+  f.diameter_change_pct = (d_new / d_own - 1.0) * 100.0;
+  std::vector<std::string> reasons;
+  if (f.capacity_n <= 0.0) {
+    reasons.push_back("load capacity unknown (no load index or max load)");
+  } else if (f.wheel_load_n > f.capacity_n) {
+    reasons.push_back("load " + report::fixed(f.wheel_load_n, 0) + " N > " + report::fixed(f.capacity_n, 0) +
+                      " N capacity at " + report::fixed(units::pa_to_bar(candidate.state.pressure_pa), 1) + " bar");
+  }
+  if (std::abs(f.diameter_change_pct) > diameter_tolerance_pct) {
+    reasons.push_back("diameter " + report::fixed(d_new * 1e3, 0) + " mm is " +
+                      (f.diameter_change_pct > 0 ? "+" : "") + report::fixed(f.diameter_change_pct, 1) + " % from " +
+                      report::fixed(d_own * 1e3, 0) + " mm (tolerance " + format_value(diameter_tolerance_pct) + " %)");
+  }
+  f.fits = reasons.empty();
+  if (!f.fits) {
+    f.reason = "does not fit: ";
+    for (std::size_t i = 0; i < reasons.size(); ++i) f.reason += (i ? "; " : "") + reasons[i];
+  }
+  return f;
+}
+
+namespace {
+
+CandidateResult evaluate(const Vehicle& vehicle, const TyreSpec& own, const TyreSpec& tyre, const DriveCycle& cycle,
+                         const CompareOptions& o) {
+  CandidateResult c;
+  c.tyre = tyre;
+  c.fit = check_fit(vehicle, own, tyre, o.diameter_tolerance_pct);
+  try {
+    const RollingResistance rr = evaluate_rolling_resistance(tyre.state, c.fit.wheel_load_n, o.reference_speed_mps);
+    c.rrc_80 = rr.rrc;
+    c.rr_power_80_w = rr.rr_power_w;
+    Vehicle v = vehicle;
+    fit_tyres(v, tyre);
+    const EnergyFigure e = run_forward(v, cycle);
+    c.value = e.value;
+    c.range_km = e.range_km;
+    c.simulated = true;
+  } catch (const std::exception& e) {
+    // An overloaded tyre may have no solution at all; it is reported, not ranked.
+    c.error = e.what();
+    c.rrc_80 = c.rr_power_80_w = NAN;
+    c.value = c.range_km = NAN;
+  }
+  return c;
+}
+
+}  // namespace
+
+Comparison compare_tyres(const Vehicle& vehicle, const std::vector<TyreSpec>& candidates, const DriveCycle& cycle,
+                         const CompareOptions& o) {
+  if (!vehicle.front_tyre) {
+    throw InputError(vehicle.source, "the car has no tyres of its own (coast-down road load): nothing to compare with");
+  }
+  const TyreSpec& own = *vehicle.front_tyre;
+  Comparison cmp;
+  cmp.vehicle = vehicle.name;
+  cmp.cycle = cycle.name;
+  cmp.electric = vehicle.is_electric();
+  cmp.unit = energy_unit(vehicle);
+
+  CandidateResult own_result = evaluate(vehicle, own, own, cycle, o);
+  if (!own_result.simulated) throw InputError(vehicle.source, "cannot run the car on its own tyre: " + own_result.error);
+  own_result.is_own = true;
+  cmp.own_value = own_result.value;
+  cmp.own_range_km = own_result.range_km;
+
+  std::vector<CandidateResult> all{own_result};
+  for (const auto& t : candidates) all.push_back(evaluate(vehicle, own, t, cycle, o));
+  for (auto& c : all) {
+    c.diff_pct = (c.value / cmp.own_value - 1.0) * 100.0;
+    c.range_change_km = c.range_km - cmp.own_range_km;
+    const bool rankable = c.simulated && (c.fit.fits || c.is_own);
+    if (!c.simulated && c.fit.fits) c.fit = {false, c.fit.wheel_load_n, c.fit.capacity_n, c.fit.diameter_change_pct,
+                                            "does not fit: " + c.error};
+    (rankable ? cmp.ranked : cmp.unfit).push_back(c);
+  }
+  std::stable_sort(cmp.ranked.begin(), cmp.ranked.end(),
+                   [](const CandidateResult& a, const CandidateResult& b) { return a.value < b.value; });
+  return cmp;
+}
+
+}  // namespace rollsim::selection

@@ -1,0 +1,104 @@
+// The energy regression baseline: strict reading, forward runs of every case, and the rewritten file for --update.
+#include "rollsim/selection/regress.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "rollsim/common/error.hpp"
+#include "rollsim/common/yaml_reader.hpp"
+#include "rollsim/cycle/drive_cycle.hpp"
+#include "rollsim/selection/common.hpp"
+#include "rollsim/vehicle/vehicle.hpp"
+
+namespace rollsim::selection {
+
+Baseline load_baseline(const std::string& path) {
+  YamlMap root = YamlMap::load_file(path);
+  Baseline b;
+  b.file = path;
+  if (!root.has("cases") || !root.node()["cases"].IsSequence()) {
+    throw InputError(root.where("cases"), "missing: a baseline needs a list 'cases' of {name, vehicle, tyre, cycle, "
+                                          "unit, expected, tolerance_pct}");
+  }
+  root.accept("cases");
+  root.finish();
+  const YAML::Node list = root.node()["cases"];
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    YamlMap m(list[i], path, "cases[" + std::to_string(i) + "]");
+    RegressCase c;
+    c.name = m.string("name");
+    c.vehicle = m.string("vehicle");
+    c.tyre = m.string("tyre");
+    c.cycle = m.string("cycle");
+    c.unit = m.string("unit");
+    if (c.unit != "kwh_per_10km" && c.unit != "l_per_100km") {
+      throw InputError(m.where("unit"), "'" + c.unit + "' is not allowed: must be kwh_per_10km or l_per_100km");
+    }
+    c.expected = m.number("expected", Range::positive());
+    c.tolerance_pct = m.number("tolerance_pct", Range::open_low(0.0, 100.0));
+    m.finish();
+    for (const auto& other : b.cases) {
+      if (other.name == c.name) throw InputError(m.where("name"), "case '" + c.name + "' appears twice");
+    }
+    b.cases.push_back(c);
+  }
+  if (b.cases.empty()) throw InputError(root.where("cases"), "the list is empty: nothing to check");
+  return b;
+}
+
+std::vector<RegressOutcome> run_baseline(const Baseline& b) {
+  std::vector<RegressOutcome> out;
+  for (const auto& c : b.cases) {
+    const std::string where = b.file + ": case '" + c.name + "'";
+    try {
+      Vehicle v = load_vehicle_file(resolve_data_file(c.vehicle, "vehicles", ".yaml", "vehicle"));
+      fit_tyres(v, load_tyre_file(resolve_data_file(c.tyre, "tyres", ".yaml", "tyre")));
+      const DriveCycle cycle = load_cycle(c.cycle, "cycle");
+      if (energy_unit(v) != c.unit) {
+        throw InputError("unit", "'" + c.unit + "' does not match the car (" + energy_unit(v) + ")");
+      }
+      RegressOutcome o;
+      o.c = c;
+      o.actual = run_forward(v, cycle).value;
+      o.drift_pct = (o.actual / c.expected - 1.0) * 100.0;
+      o.drifted = !(std::abs(o.drift_pct) <= c.tolerance_pct);
+      out.push_back(o);
+    } catch (const InputError& e) {
+      throw InputError(where, e.what());
+    } catch (const std::exception& e) {
+      throw InputError(where, e.what());
+    }
+  }
+  return out;
+}
+
+namespace {
+std::string number_text(double v, int digits) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*g", digits, v);
+  return buf;
+}
+}  // namespace
+
+std::string baseline_yaml(const Baseline& b, const std::vector<RegressOutcome>& outcomes) {
+  std::ostringstream y;
+  y << "# Energy regression baseline for `rollsim regress` (forward simulation). Each case: the car, the tyre fitted\n"
+       "# on all four wheels, the cycle, and the expected battery energy (kwh_per_10km) or fuel (l_per_100km).\n"
+       "# Written by `rollsim regress FILE --update`: regenerate it only for a deliberate change of the results.\n"
+       "cases:\n";
+  for (std::size_t i = 0; i < b.cases.size(); ++i) {
+    const RegressCase& c = b.cases[i];
+    const double value = i < outcomes.size() ? outcomes[i].actual : c.expected;
+    y << "  - name: " << c.name << "\n"
+      << "    vehicle: " << c.vehicle << "\n"
+      << "    tyre: " << c.tyre << "\n"
+      << "    cycle: " << c.cycle << "\n"
+      << "    unit: " << c.unit << "\n"
+      << "    expected: " << number_text(value, 6) << "\n"
+      << "    tolerance_pct: " << number_text(c.tolerance_pct, 6) << "\n";
+  }
+  return y.str();
+}
+
+}  // namespace rollsim::selection

@@ -1,0 +1,270 @@
+// Sweeps of tyre parameters: the tyre model point by point, or the car on a cycle on every core.
+#include "rollsim/selection/sweep.hpp"
+
+#include <atomic>
+#include <cmath>
+#include <exception>
+#include <sstream>
+#include <thread>
+
+#include "rollsim/common/error.hpp"
+#include "rollsim/common/units.hpp"
+#include "rollsim/report/table.hpp"
+#include "rollsim/selection/common.hpp"
+
+namespace rollsim::selection {
+
+std::optional<SweepParam> parse_sweep_param(const std::string& t) {
+  if (t == "pressure") return SweepParam::Pressure;
+  if (t == "diameter") return SweepParam::Diameter;
+  if (t == "width") return SweepParam::Width;
+  if (t == "load") return SweepParam::Load;
+  if (t == "load-pct") return SweepParam::LoadPct;
+  if (t == "speed") return SweepParam::Speed;
+  return std::nullopt;
+}
+
+std::string sweep_param_key(SweepParam p) {
+  switch (p) {
+    case SweepParam::Pressure: return "pressure";
+    case SweepParam::Diameter: return "diameter";
+    case SweepParam::Width: return "width";
+    case SweepParam::Load: return "load";
+    case SweepParam::LoadPct: return "load-pct";
+    case SweepParam::Speed: return "speed";
+  }
+  return "";
+}
+
+std::string sweep_param_unit(SweepParam p) {
+  switch (p) {
+    case SweepParam::Pressure: return "bar";
+    case SweepParam::Diameter: return "mm";
+    case SweepParam::Width: return "mm";
+    case SweepParam::Load: return "N";
+    case SweepParam::LoadPct: return "pct";
+    case SweepParam::Speed: return "kmh";
+  }
+  return "";
+}
+
+std::vector<double> SweepAxis::values() const {
+  std::vector<double> v;
+  for (int i = 0; i < steps; ++i) v.push_back(i + 1 == steps ? to : from + (to - from) * i / (steps - 1));
+  return v;
+}
+
+void check_axis(const SweepAxis& a, const std::string& option) {
+  if (a.steps < 2) throw InputError(option, "--steps " + std::to_string(a.steps) + " is not allowed: must be >= 2");
+  if (!std::isfinite(a.from) || !std::isfinite(a.to)) throw InputError(option, "--from/--to must be finite numbers");
+  if (a.from == a.to) {
+    throw InputError(option, "empty range: --from " + format_value(a.from) + " equals --to " + format_value(a.to));
+  }
+  if (a.from > a.to) {
+    throw InputError(option, "reversed range: --from " + format_value(a.from) + " is above --to " +
+                                 format_value(a.to) + " (sweeps run upwards; swap them)");
+  }
+  // Lower limits of each quantity's physical meaning; the upper ones are the model's domain, found as we go.
+  // A speed of 0 is a valid point (RRC 0); every other quantity must be positive.
+  const bool open = a.param != SweepParam::Speed;
+  if (open ? !(a.from > 0.0) : !(a.from >= 0.0)) {
+    throw InputError(option, "--from " + format_value(a.from) + " " + sweep_param_unit(a.param) + " is not allowed: " +
+                                 sweep_param_key(a.param) + (open ? " must be > 0" : " must be >= 0"));
+  }
+}
+
+TyreSpec with_parameter(const TyreSpec& tyre, SweepParam p, double value) {
+  TyreSpec t = tyre;
+  switch (p) {
+    case SweepParam::Pressure: t.state.pressure_pa = units::bar_to_pa(value); break;
+    case SweepParam::Diameter: t.state.geometry.outer_radius_m = value * units::kMPerMm / 2.0; break;
+    case SweepParam::Width: t.state.geometry.section_width_m = value * units::kMPerMm; break;
+    default: break;
+  }
+  return t;
+}
+
+namespace {
+
+std::vector<std::vector<double>> grid(const std::vector<SweepAxis>& axes) {
+  std::vector<std::vector<double>> pts{{}};
+  for (const auto& a : axes) {
+    std::vector<std::vector<double>> next;
+    for (const auto& p : pts) {
+      for (double v : a.values()) {
+        auto q = p;
+        q.push_back(v);
+        next.push_back(q);
+      }
+    }
+    pts = next;
+  }
+  return pts;
+}
+
+std::string describe_point(const std::vector<SweepAxis>& axes, const std::vector<double>& values) {
+  std::string s;
+  for (std::size_t i = 0; i < axes.size(); ++i) {
+    s += (i ? ", " : "") + sweep_param_key(axes[i].param) + " = " + format_value(values[i]) + " " +
+         sweep_param_unit(axes[i].param);
+  }
+  return s;
+}
+
+// The tyre and operating point of one grid point.
+struct PointSetup {
+  TyreSpec tyre;
+  double load_n = 0.0;
+  double speed_kmh = 0.0;
+};
+
+double default_load_n(const TyreSpec& tyre, const SweepOptions& o) {
+  if (o.load_n) return *o.load_n;
+  return 0.8 * tyre.max_load_n;
+}
+
+PointSetup setup(const TyreSpec& tyre, const SweepOptions& o, const std::vector<double>& values) {
+  PointSetup s{tyre, default_load_n(tyre, o), o.speed_kmh};
+  for (std::size_t i = 0; i < o.axes.size(); ++i) {
+    const SweepParam p = o.axes[i].param;
+    if (p == SweepParam::Load) s.load_n = values[i];
+    else if (p == SweepParam::LoadPct) s.load_n = values[i] / 100.0 * tyre.max_load_n;
+    else if (p == SweepParam::Speed) s.speed_kmh = values[i];
+    else s.tyre = with_parameter(s.tyre, p, values[i]);
+  }
+  return s;
+}
+
+void check_options(const TyreSpec& tyre, const SweepOptions& o) {
+  if (o.axes.empty() || o.axes.size() > 2) throw InputError("--param", "give one or two parameters to sweep");
+  if (o.axes.size() == 2 && o.axes[0].param == o.axes[1].param) {
+    throw InputError("--param " + sweep_param_key(o.axes[1].param), "the same parameter cannot be swept twice");
+  }
+  bool load_swept = false;
+  for (std::size_t i = 0; i < o.axes.size(); ++i) {
+    const SweepParam p = o.axes[i].param;
+    if (p == SweepParam::Load || p == SweepParam::LoadPct) {
+      if (load_swept) throw InputError("--param", "load and load-pct cannot both be swept");
+      load_swept = true;
+    }
+    if (p == SweepParam::LoadPct && !(tyre.max_load_n > 0.0)) {
+      throw InputError("--param load-pct", "the tyre's maximum load is unknown (no load index): sweep 'load' in N");
+    }
+  }
+  if (!load_swept && !o.load_n && !(tyre.max_load_n > 0.0)) {
+    throw InputError("--load-n", "missing: the tyre's maximum load is unknown, so the default 80 % of it cannot be "
+                                 "used; give --load-n N");
+  }
+}
+
+std::string stop_message(const std::vector<SweepAxis>& axes, const std::vector<double>& at, const std::string& why,
+                         const std::vector<SweepPoint>& valid) {
+  std::string s = "sweep stopped at " + describe_point(axes, at) + ": " + why;
+  s += valid.empty() ? "; no valid point" : "; last valid point " + describe_point(axes, valid.back().values);
+  return s;
+}
+
+}  // namespace
+
+SweepResult sweep_tyre(const TyreSpec& tyre, const SweepOptions& o) {
+  check_options(tyre, o);
+  SweepResult r;
+  r.axes = o.axes;
+  const auto pts = grid(o.axes);
+  r.planned_points = pts.size();
+  for (const auto& values : pts) {
+    const PointSetup s = setup(tyre, o, values);
+    try {
+      SweepPoint p;
+      p.values = values;
+      p.load_n = s.load_n;
+      p.speed_kmh = s.speed_kmh;
+      p.rr = evaluate_rolling_resistance(s.tyre.state, s.load_n, units::kmh_to_mps(s.speed_kmh));
+      r.points.push_back(p);
+    } catch (const ModelDomainError& e) {
+      r.stopped = stop_message(o.axes, values, e.what(), r.points);
+      break;
+    }
+    if (o.progress) o.progress(r.points.size(), pts.size());
+  }
+  return r;
+}
+
+SweepResult sweep_vehicle(const Vehicle& vehicle, const TyreSpec& tyre, const DriveCycle& cycle,
+                          const SweepOptions& o) {
+  check_options(tyre, o);
+  for (const auto& a : o.axes) {
+    if (a.param != SweepParam::Pressure && a.param != SweepParam::Diameter && a.param != SweepParam::Width) {
+      throw InputError("--param " + sweep_param_key(a.param),
+                       "not allowed with --vehicle: the car's wheel loads and speeds come from the car and the "
+                       "cycle; sweep pressure, diameter or width");
+    }
+  }
+  SweepResult r;
+  r.axes = o.axes;
+  r.vehicle = true;
+  r.energy_unit = energy_unit(vehicle);
+  const auto pts = grid(o.axes);
+  r.planned_points = pts.size();
+
+  struct Slot {
+    SweepPoint point;
+    std::string error;
+    bool done = false;
+  };
+  std::vector<Slot> slots(pts.size());
+  std::atomic<std::size_t> next{0}, finished{0};
+  auto worker = [&] {
+    for (std::size_t i = next++; i < pts.size(); i = next++) {
+      Slot& s = slots[i];
+      const PointSetup ps = setup(tyre, o, pts[i]);
+      try {
+        s.point.values = pts[i];
+        s.point.load_n = ps.load_n;
+        s.point.speed_kmh = ps.speed_kmh;
+        s.point.rr = evaluate_rolling_resistance(ps.tyre.state, ps.load_n, units::kmh_to_mps(ps.speed_kmh));
+        Vehicle v = vehicle;
+        fit_tyres(v, ps.tyre);
+        s.point.energy = run_forward(v, cycle).value;  // own VehicleModel per point, so per thread
+      } catch (const std::exception& e) {
+        s.error = e.what();
+      }
+      s.done = true;
+      const std::size_t n = ++finished;
+      if (o.progress) o.progress(n, pts.size());
+    }
+  };
+  unsigned n_threads = o.threads ? o.threads : std::max(1u, std::thread::hardware_concurrency());
+  n_threads = static_cast<unsigned>(std::min<std::size_t>(n_threads, pts.size()));
+  std::vector<std::thread> threads;
+  for (unsigned t = 0; t < n_threads; ++t) threads.emplace_back(worker);
+  for (auto& t : threads) t.join();
+
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    if (!slots[i].error.empty()) {
+      r.stopped = stop_message(o.axes, pts[i], slots[i].error, r.points);
+      break;
+    }
+    r.points.push_back(slots[i].point);
+  }
+  return r;
+}
+
+std::string sweep_csv(const SweepResult& r) {
+  std::ostringstream out;
+  for (const auto& a : r.axes) out << sweep_param_key(a.param) << "_" << sweep_param_unit(a.param) << ",";
+  out << "load_n,speed_kmh,rrc,rr_force_n,rr_power_w,deflection_m";
+  if (r.vehicle) out << "," << r.energy_unit;
+  out << "\n";
+  for (const auto& p : r.points) {
+    for (double v : p.values) out << format_value(v) << ",";
+    out << format_value(p.load_n) << "," << format_value(p.speed_kmh) << "," << report::fixed(p.rr.rrc, 7) << ","
+        << report::fixed(p.rr.rr_force_n, 4) << "," << report::fixed(p.rr.rr_power_w, 3) << ","
+        << report::fixed(p.rr.deflection_m, 6);
+    if (r.vehicle) out << "," << report::fixed(p.energy, 5);
+    out << "\n";
+  }
+  return out.str();
+}
+
+}  // namespace rollsim::selection
