@@ -8,6 +8,7 @@ void register_commands(CLI::App& app) {
   register_sweep_command(app);
   register_sensitivity_command(app);
   register_regress_command(app);
+  register_simulate_command(app);
 }
 
 }  // namespace rollsim::cli

@@ -6,6 +6,7 @@
 namespace rollsim::cli {
 
 void register_commands(CLI::App& app);
+void register_simulate_command(CLI::App& app);
 void register_tyre_command(CLI::App& app);
 void register_compare_command(CLI::App& app);
 void register_sweep_command(CLI::App& app);
