@@ -8,6 +8,7 @@ namespace rollsim::cli {
 void register_commands(CLI::App& app);
 void register_simulate_command(CLI::App& app);
 void register_tyre_command(CLI::App& app);
+void register_diagnose_command(CLI::App& app);
 void register_compare_command(CLI::App& app);
 void register_sweep_command(CLI::App& app);
 void register_sensitivity_command(CLI::App& app);

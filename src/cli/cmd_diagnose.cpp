@@ -1,0 +1,69 @@
+// `rollsim diagnose`: replays recordings through a vehicle, locates the mismatch, names and fits missing physics.
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "rollsim/common/error.hpp"
+#include "rollsim/common/yaml_reader.hpp"
+#include "rollsim/diagnose/diagnose.hpp"
+#include "rollsim/recording/recording.hpp"
+#include "rollsim/tyre/tyre_spec.hpp"
+
+namespace rollsim::cli {
+namespace {
+
+struct DiagnoseCliOptions {
+  std::string vehicle, tyre, preset, json, write_vehicle;
+  std::vector<std::string> recordings, columns, scales;
+};
+
+void write_file(const std::string& path, const std::string& text, const std::string& option) {
+  std::ofstream out(path);
+  if (!out) throw InputError(option + " '" + path + "'", "cannot write");
+  out << text;
+  if (!out) throw InputError(option + " '" + path + "'", "write failed");
+}
+
+void run_diagnose(const DiagnoseCliOptions& o) {
+  const std::string vehicle_path = resolve_data_file(o.vehicle, "vehicles", ".yaml", "--vehicle");
+  Vehicle v = load_vehicle_file(vehicle_path);
+  if (!o.tyre.empty()) fit_tyres(v, load_tyre_file(resolve_data_file(o.tyre, "tyres", ".yaml", "--tyre")));
+  ColumnMapping mapping;
+  if (!o.preset.empty()) mapping = preset_mapping(o.preset);
+  ColumnMapping overrides;
+  for (const auto& c : o.columns) parse_column_option(c, overrides);
+  for (const auto& s : o.scales) parse_scale_option(s, overrides);
+  mapping = merge_mapping(mapping, overrides);
+  std::vector<Recording> recs;
+  for (const auto& r : o.recordings) recs.push_back(load_recording(r, mapping));
+  for (const auto& r : recs)
+    for (const auto& rep : r.repairs) std::cout << r.source << ": " << rep << "\n";
+  const Diagnosis d = diagnose(v, recs);
+  std::cout << diagnosis_text(d);
+  if (!o.json.empty()) write_file(o.json, diagnosis_json(d), "--json");
+  if (!o.write_vehicle.empty()) {
+    write_file(o.write_vehicle, fitted_vehicle_yaml(vehicle_path, d), "--write-vehicle");
+    std::cout << "fitted vehicle written to " << o.write_vehicle << "\n";
+  }
+}
+
+}  // namespace
+
+void register_diagnose_command(CLI::App& app) {
+  auto o = std::make_shared<DiagnoseCliOptions>();
+  CLI::App* sub = app.add_subcommand("diagnose", "Compare recordings with the model: locate the mismatch, name and fit missing physics");
+  sub->add_option("--vehicle", o->vehicle, "Vehicle YAML file or shipped name")->required()->type_name("FILE");
+  sub->add_option("--tyre", o->tyre, "Tyre YAML fitted to all four wheels")->type_name("FILE");
+  sub->add_option("--recording", o->recordings, "Recording CSV (repeatable)")->required()->type_name("CSV");
+  sub->add_option("--preset", o->preset, "Column mapping preset: anl_d3, rsk_twizy")->type_name("NAME");
+  sub->add_option("--column", o->columns, "CANONICAL=SOURCE column mapping (repeatable)")->type_name("C=S");
+  sub->add_option("--scale", o->scales, "CANONICAL=FACTOR scale (repeatable)")->type_name("C=F");
+  sub->add_option("--json", o->json, "Write the diagnosis as JSON")->type_name("FILE");
+  sub->add_option("--write-vehicle", o->write_vehicle, "Write the vehicle with the fitted effects switched on")->type_name("FILE");
+  sub->callback([o] { run_diagnose(*o); });
+}
+
+}  // namespace rollsim::cli
