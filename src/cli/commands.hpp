@@ -9,6 +9,7 @@ void register_commands(CLI::App& app);
 void register_simulate_command(CLI::App& app);
 void register_tyre_command(CLI::App& app);
 void register_diagnose_command(CLI::App& app);
+void register_diagnose_bench_command(CLI::App& app);
 void register_compare_command(CLI::App& app);
 void register_sweep_command(CLI::App& app);
 void register_sensitivity_command(CLI::App& app);
