@@ -1,0 +1,229 @@
+// compare, sweep, sensitivity and regress end to end: runs the built binary on shipped and broken inputs.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CmdResult {
+  int exit_code = -1;
+  std::string out;
+  std::string err;
+};
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+fs::path temp_dir() {
+  const auto dir = fs::temp_directory_path() / ("rollsim_test_cli_sel_" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  return dir;
+}
+
+// Runs `[env] rollsim <args>` through the shell from the source folder (args are shell words).
+CmdResult run(const std::string& args, const std::string& env = "") {
+  const auto dir = temp_dir();
+  const auto out = dir / "stdout.txt";
+  const auto err = dir / "stderr.txt";
+  const std::string cmd = "cd '" + std::string(ROLLSIM_SOURCE_DIR) + "' && " + env + " '" + ROLLSIM_BINARY + "' " +
+                          args + " >'" + out.string() + "' 2>'" + err.string() + "'";
+  const int status = std::system(cmd.c_str());
+  CmdResult r;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = slurp(out);
+  r.err = slurp(err);
+  return r;
+}
+
+bool has(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+
+std::vector<std::string> lines(const std::string& text) {
+  std::vector<std::string> out;
+  std::istringstream in(text);
+  for (std::string l; std::getline(in, l);)
+    if (!l.empty()) out.push_back(l);
+  return out;
+}
+
+}  // namespace
+
+TEST(CliSelection, CompareCatalogueRanksFittingTyresAndMarksTheRest) {
+  const CmdResult r = run("compare --vehicle ev --catalogue tyres/catalogue --cycle nedc --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto ls = lines(r.out);
+  ASSERT_GE(ls.size(), 13u);  // own tyre + 12 catalogue sizes
+  bool seen_unfit = false;
+  for (const auto& l : ls) {
+    const bool fits = has(l, "\"fits\": true");
+    if (!fits) {
+      seen_unfit = true;
+      EXPECT_TRUE(has(l, "does not fit")) << l;
+      EXPECT_TRUE(has(l, "\"rank\": null")) << l;
+    } else {
+      EXPECT_FALSE(seen_unfit) << "a fitting tyre listed after an unfit one: " << l;
+    }
+  }
+}
+
+TEST(CliSelection, CompareBrokenCatalogueFileIsNamedAndTheRestCompared) {
+  const auto dir = temp_dir() / "catalogue";
+  fs::create_directories(dir);
+  fs::copy_file(fs::path(ROLLSIM_SOURCE_DIR) / "tyres/catalogue/205-55R16.yaml", dir / "205-55R16.yaml",
+                fs::copy_options::overwrite_existing);
+  std::ofstream(dir / "broken.yaml") << "size: \"205/55 R16 91V\"\npresure_bar: 2.3\n";
+  const CmdResult r = run("compare --vehicle ev --catalogue '" + dir.string() + "'");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_TRUE(has(r.err, "broken.yaml")) << r.err;
+  EXPECT_TRUE(has(r.out, "205-55R16")) << r.out;
+  fs::remove_all(dir);
+}
+
+TEST(CliSelection, SweepRrcFallsWithPressureInTheCsv) {
+  const CmdResult r = run("sweep --tyre 175-70R14 --param pressure --from 1.6 --to 3.2 --steps 5");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto ls = lines(r.out);
+  ASSERT_EQ(ls.size(), 6u);
+  double last = 1.0;
+  for (std::size_t i = 1; i < ls.size(); ++i) {
+    std::vector<std::string> cells;
+    std::stringstream ss(ls[i]);
+    for (std::string c; std::getline(ss, c, ',');) cells.push_back(c);
+    const double rrc = std::stod(cells.at(3));
+    EXPECT_LT(rrc, last);
+    last = rrc;
+  }
+  EXPECT_TRUE(r.err.empty()) << "no progress in a pipe: " << r.err;
+}
+
+TEST(CliSelection, SweepBadRangesAreClearErrors) {
+  for (const std::string& args : {"--param pressure --from 3 --to 2", "--param pressure --from 2 --to 2",
+                                  "--param pressure --from 2 --to 3 --steps 1", "--param colour --from 1 --to 2",
+                                  "--param width --from abc --to 200"}) {
+    const CmdResult r = run("sweep --tyre 175-70R14 " + args);
+    EXPECT_NE(r.exit_code, 0) << args;
+    EXPECT_TRUE(r.out.empty()) << args;
+    EXPECT_TRUE(has(r.err, "error: ")) << args << ": " << r.err;
+  }
+}
+
+TEST(CliSelection, SweepOutOfDomainReportsTheLastValidPoint) {
+  const CmdResult r = run("sweep --tyre 175-70R14 --param load --from 1000 --to 40000 --steps 40");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_TRUE(has(r.err, "rim")) << r.err;
+  EXPECT_TRUE(has(r.err, "last valid point load = ")) << r.err;
+  const auto ls = lines(r.out);
+  EXPECT_GT(ls.size(), 2u);
+  EXPECT_LT(ls.size(), 41u);
+}
+
+TEST(CliSelection, SweepUnwritableOutputWritesNothing) {
+  const CmdResult r = run("sweep --tyre 175-70R14 --param pressure --from 2 --to 3 --output /nonexistent-dir/x.csv");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_TRUE(has(r.err, "/nonexistent-dir/x.csv")) << r.err;
+  EXPECT_FALSE(fs::exists("/nonexistent-dir/x.csv"));
+  // A written file is complete and no temporary file is left beside it.
+  const auto dir = temp_dir() / "out";
+  fs::create_directories(dir);
+  const CmdResult ok = run("sweep --tyre 175-70R14 --param pressure --from 2 --to 3 --steps 3 --output '" +
+                           (dir / "s.csv").string() + "'");
+  ASSERT_EQ(ok.exit_code, 0) << ok.err;
+  EXPECT_EQ(lines(slurp(dir / "s.csv")).size(), 4u);
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator{}), 1);
+  fs::remove_all(dir);
+}
+
+TEST(CliSelection, SweepPlotNeedsGnuplotAndSaysSo) {
+  const auto svg = temp_dir() / "p.svg";
+  const CmdResult missing = run("sweep --tyre 175-70R14 --param pressure --from 2 --to 3 --plot '" + svg.string() + "'",
+                                "PATH=/nonexistent");
+  EXPECT_NE(missing.exit_code, 0);
+  EXPECT_TRUE(has(missing.err, "gnuplot")) << missing.err;
+  EXPECT_FALSE(fs::exists(svg));
+  if (std::system("command -v gnuplot >/dev/null 2>&1") == 0) {
+    const CmdResult r = run("sweep --tyre 175-70R14 --param pressure --from 2 --to 3 --base100 --plot '" +
+                            svg.string() + "'");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_TRUE(has(slurp(svg), "<svg"));
+    fs::remove(svg);
+  }
+}
+
+TEST(CliSelection, VehicleSweepWritesEnergyPerPoint) {
+  const CmdResult r = run("sweep --tyre nominal --vehicle ev --cycle nedc --param width --from 175 --to 235 --steps 4");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto ls = lines(r.out);
+  ASSERT_EQ(ls.size(), 5u);
+  EXPECT_TRUE(has(ls[0], "kwh_per_10km"));
+}
+
+TEST(CliSelection, SensitivityNamesWhatMattersMostAndSignsHold) {
+  const CmdResult r = run("sensitivity --tyre 175-70R14 --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto num = [&](const std::string& key) {
+    const auto pos = r.out.find("\"" + key + "\": ");
+    return pos == std::string::npos ? std::nan("") : std::strtod(r.out.c_str() + pos + key.size() + 4, nullptr);
+  };
+  EXPECT_LT(num("elasticity_rr_power_outer_diameter"), 0.0);
+  EXPECT_LT(num("elasticity_rr_power_pressure"), 0.0);
+  EXPECT_GT(num("elasticity_rr_power_load"), 0.0);
+  EXPECT_TRUE(has(r.out, "\"dominant_rr_power\"")) << r.out;
+  const CmdResult table = run("sensitivity --vehicle ice --cycle nedc");
+  ASSERT_EQ(table.exit_code, 0) << table.err;
+  EXPECT_TRUE(has(table.out, "Matters most")) << table.out;
+}
+
+TEST(Regress, CommittedBaselinePasses) {
+  const CmdResult r = run("regress tests/energy_baseline.yaml");
+  EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_TRUE(has(r.out, "within tolerance")) << r.out;
+}
+
+TEST(Regress, DeliberatelyBrokenBaselineFailsNamingTheCase) {
+  // Red CI on purpose: one expected value moved by 5 % must fail and be named with its drift and direction.
+  const std::string text = slurp(fs::path(ROLLSIM_SOURCE_DIR) / "tests/energy_baseline.yaml");
+  const std::regex case_re("(- name: ev-nominal-nedc[\\s\\S]*?expected: )([0-9.eE+-]+)");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(text, m, case_re));
+  const double expected = std::stod(m[2].str());
+  const std::string broken = m.prefix().str() + m[1].str() + std::to_string(expected * 1.05) + m.suffix().str();
+  const auto file = temp_dir() / "broken_baseline.yaml";
+  std::ofstream(file) << broken;
+  const CmdResult r = run("regress '" + file.string() + "'");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_TRUE(has(r.err, "ev-nominal-nedc")) << r.err;
+  EXPECT_TRUE(has(r.err, "drifted -4.7")) << r.err;  // actual / (1.05 expected) - 1 = -4.76 %
+  EXPECT_TRUE(has(r.err, "down")) << r.err;
+  EXPECT_EQ(lines(r.err).size(), 2u) << "only the broken case (plus the summary): " << r.err;
+  // --update repairs it atomically and says what changed.
+  const CmdResult u = run("regress '" + file.string() + "' --update");
+  EXPECT_EQ(u.exit_code, 0) << u.err;
+  EXPECT_TRUE(has(u.out, "updated ev-nominal-nedc")) << u.out;
+  EXPECT_EQ(run("regress '" + file.string() + "'").exit_code, 0);
+  fs::remove(file);
+}
+
+TEST(Regress, MissingCycleIsAClearErrorNamingTheCase) {
+  const auto file = temp_dir() / "missing_cycle.yaml";
+  std::ofstream(file) << "cases:\n  - name: lost-cycle\n    vehicle: ev\n    tyre: nominal\n    cycle: no-such-cycle\n"
+                         "    unit: kwh_per_10km\n    expected: 1.6\n    tolerance_pct: 0.5\n";
+  const CmdResult r = run("regress '" + file.string() + "'");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_TRUE(has(r.err, "lost-cycle")) << r.err;
+  EXPECT_TRUE(has(r.err, "no-such-cycle")) << r.err;
+  fs::remove(file);
+}
