@@ -141,13 +141,30 @@ struct Fit {
   double rss = 0.0;
 };
 
-Fit least_squares(const Eigen::MatrixXd& x, const Eigen::VectorXd& y) {
+// Gaussian priors on calibration coefficients, as extra rows (ridge towards 0): weight = noise sd / prior sd.
+struct Prior {
+  std::vector<std::pair<Eigen::Index, double>> rows;  // column, weight
+};
+
+void augment(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, const Prior& p, Eigen::MatrixXd& xa, Eigen::VectorXd& ya) {
+  const auto np = static_cast<Eigen::Index>(p.rows.size());
+  xa = Eigen::MatrixXd::Zero(x.rows() + np, x.cols());
+  ya = Eigen::VectorXd::Zero(x.rows() + np);
+  xa.topRows(x.rows()) = x;
+  ya.head(x.rows()) = y;
+  for (Eigen::Index k = 0; k < np; ++k) xa(x.rows() + k, p.rows[static_cast<std::size_t>(k)].first) = p.rows[static_cast<std::size_t>(k)].second;
+}
+
+Fit least_squares(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, const Prior& prior = {}) {
   Fit f;
-  f.coef = x.colPivHouseholderQr().solve(y);
+  Eigen::MatrixXd xa;
+  Eigen::VectorXd ya;
+  augment(x, y, prior, xa, ya);
+  f.coef = xa.colPivHouseholderQr().solve(ya);
   const Eigen::VectorXd r = y - x * f.coef;
   f.rss = r.squaredNorm();
   const double dof = std::max<double>(1.0, static_cast<double>(x.rows() - x.cols()));
-  f.cov = (x.transpose() * x).completeOrthogonalDecomposition().pseudoInverse() * (f.rss / dof);
+  f.cov = (xa.transpose() * xa).completeOrthogonalDecomposition().pseudoInverse() * (f.rss / dof);
   return f;
 }
 
@@ -163,7 +180,7 @@ double lag1_autocorrelation(const Eigen::VectorXd& r) {
 }
 
 // Out-of-fold prediction: each window predicted by a fit on the other fold (alternating blocks of windows).
-Eigen::VectorXd heldout_prediction(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, int block) {
+Eigen::VectorXd heldout_prediction(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, int block, const Prior& prior) {
   const Eigen::Index n = x.rows();
   Eigen::VectorXd pred(n);
   for (int fold = 0; fold < 2; ++fold) {
@@ -176,7 +193,7 @@ Eigen::VectorXd heldout_prediction(const Eigen::MatrixXd& x, const Eigen::Vector
       xt.row(static_cast<Eigen::Index>(k)) = x.row(train[k]);
       yt[static_cast<Eigen::Index>(k)] = y[train[k]];
     }
-    const Eigen::VectorXd c = xt.colPivHouseholderQr().solve(yt);
+    const Eigen::VectorXd c = least_squares(xt, yt, prior).coef;
     for (Eigen::Index i : test) pred[i] = x.row(i).dot(c);
   }
   return pred;
@@ -288,7 +305,16 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
   xc.col(0) = base.window_j;
   xc.col(1) = rrc.window_j - base.window_j;
   xc.col(2) = drag.window_j - base.window_j;
-  const Fit cal = least_squares(xc, d.measured_j);
+  // RRC level and aero C are known to within about +-15 % from the vehicle data (coast-down repeatability, tyre
+  // spread): a prior at that width keeps short trips, where scale, RRC and C are nearly collinear, physical.
+  Prior prior;
+  {
+    const Fit free = least_squares(xc, d.measured_j);
+    const double noise_sd = std::sqrt(free.rss / std::max<double>(1.0, static_cast<double>(n - 3)));
+    const double prior_sd = opt.calibration_prior_fraction / 0.1;  // coefficients are per 10 % change
+    prior.rows = {{1, noise_sd / prior_sd}, {2, noise_sd / prior_sd}};
+  }
+  const Fit cal = least_squares(xc, d.measured_j, prior);
   out.channel_scale = cal.coef[0];
   out.rrc_level_change = 0.1 * cal.coef[1] / cal.coef[0];
   out.drag_change = 0.1 * cal.coef[2] / cal.coef[0];
@@ -297,7 +323,7 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
   const double rho = std::clamp(out.lag1_autocorrelation, 0.0, 0.95);
   const double n_eff = std::max(4.0, static_cast<double>(n) * (1.0 - rho) / (1.0 + rho));
   out.effective_windows = n_eff;
-  const Eigen::VectorXd cal_pred = heldout_prediction(xc, d.measured_j, opt.block_windows);
+  const Eigen::VectorXd cal_pred = heldout_prediction(xc, d.measured_j, opt.block_windows, prior);
   out.heldout_rmse_calibrated_j = rmse(cal_pred, d.measured_j);
   out.heldout_energy_error_pct_calibrated = energy_error_pct(cal_pred, d.measured_j);
 
@@ -350,12 +376,12 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
     for (std::size_t k = 0; k < cands.size(); ++k) {
       if (std::find(chosen_ids.begin(), chosen_ids.end(), cands[k].id) != chosen_ids.end()) continue;
       const Eigen::MatrixXd xk = hcat(x, cands[k].signature);
-      const Fit f = least_squares(xk, d.measured_j);
+      const Fit f = least_squares(xk, d.measured_j, prior);
       if (f.rss <= 0.0) continue;
       const double dbic = n_eff * std::log(rss / f.rss) - std::log(n_eff);
       const double amp = f.coef[f.coef.size() - 1] / f.coef[0];  // in the simulated channel's scale
       if (dbic < opt.bic_threshold || amp < cands[k].amp_min || amp > cands[k].amp_max) continue;
-      Eigen::VectorXd pred = heldout_prediction(xk, d.measured_j, opt.block_windows);
+      Eigen::VectorXd pred = heldout_prediction(xk, d.measured_j, opt.block_windows, prior);
       if (rmse(pred, d.measured_j) >= rmse(pred_before, d.measured_j)) continue;
       passing.push_back({k, dbic, f, pred});
     }

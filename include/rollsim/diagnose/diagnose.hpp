@@ -17,6 +17,7 @@ struct DiagnoseOptions {
   double bic_threshold = 10.0;     ///< "very strong" evidence on the Kass-Raftery scale
   double collinear_corr = 0.9;     ///< |corr| of calibration-cleaned signatures above which effects are confounded
   int max_effects = 2;
+  double calibration_prior_fraction = 0.15;  ///< prior sd of the RRC-level and aero-C calibration changes
 };
 
 struct ParameterEstimate {
