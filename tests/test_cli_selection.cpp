@@ -112,7 +112,7 @@ TEST(CliSelection, SweepRrcFallsWithPressureInTheCsv) {
 
 TEST(CliSelection, SweepBadRangesAreClearErrors) {
   for (const std::string& args : {"--param pressure --from 3 --to 2", "--param pressure --from 2 --to 2",
-                                  "--param pressure --from 2 --to 3 --steps 1", "--param colour --from 1 --to 2",
+                                  "--param pressure --from 2 --to 3 --steps 1", "--param pressure --from 2 --to 3 --steps 2.5", "--param colour --from 1 --to 2",
                                   "--param width --from abc --to 200"}) {
     const CmdResult r = run("sweep --tyre 175-70R14 " + args);
     EXPECT_NE(r.exit_code, 0) << args;

@@ -2,6 +2,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -165,8 +166,11 @@ void run_sweep(const SweepOptionsText& o) {
     a.param = *p;
     a.from = parse_option_number(o.from[i], "--from", Range{});
     a.to = parse_option_number(o.to[i], "--to", Range{});
-    a.steps = i < o.steps.size() ? static_cast<int>(parse_option_number(o.steps[i], "--steps", Range::closed(-1e9, 1e6)))
-                                 : 11;
+    if (i < o.steps.size()) {
+      const double n = parse_option_number(o.steps[i], "--steps", Range::closed(-1e9, 1e6));
+      if (n != std::floor(n)) throw InputError("--steps", format_value(n) + " is not allowed: must be a whole number >= 2");
+      a.steps = static_cast<int>(n);
+    }
     selection::check_axis(a, opt);
     so.axes.push_back(a);
   }
