@@ -1,6 +1,6 @@
 #include "rollsim/sim/ode_integrator.hpp"
 
-#include <cvode/cvode.h>
+#include <cvodes/cvodes.h>
 #include <nvector/nvector_serial.h>
 #include <sundials/sundials_context.h>
 #include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
@@ -15,6 +15,9 @@ struct CvodeIntegrator::Impl {
   void* mem = nullptr;
   N_Vector y = nullptr;
   N_Vector abstol = nullptr;
+  N_Vector q = nullptr;
+  N_Vector q_abstol = nullptr;
+  N_Vector scratch = nullptr;  // for dense output, allocated once
   SUNNonlinearSolver nls = nullptr;
   OdeSystem* system = nullptr;
   std::string last_error;
@@ -22,20 +25,23 @@ struct CvodeIntegrator::Impl {
   ~Impl() {
     if (mem) CVodeFree(&mem);
     if (nls) SUNNonlinSolFree(nls);
-    if (y) N_VDestroy(y);
-    if (abstol) N_VDestroy(abstol);
+    for (N_Vector v : {y, abstol, q, q_abstol, scratch}) {
+      if (v) N_VDestroy(v);
+    }
     if (ctx) SUNContext_Free(&ctx);
   }
 
   static int rhs(realtype t, N_Vector y, N_Vector ydot, void* user) {
-    auto* self = static_cast<Impl*>(user);
-    return self->system->rhs(t, N_VGetArrayPointer(y), N_VGetArrayPointer(ydot));
+    return static_cast<Impl*>(user)->system->rhs(t, N_VGetArrayPointer(y), N_VGetArrayPointer(ydot));
+  }
+  static int quad_rhs(realtype t, N_Vector y, N_Vector qdot, void* user) {
+    return static_cast<Impl*>(user)->system->quadrature_rhs(t, N_VGetArrayPointer(y), N_VGetArrayPointer(qdot));
   }
   static int roots(realtype t, N_Vector y, realtype* g, void* user) {
     static_cast<Impl*>(user)->system->roots(t, N_VGetArrayPointer(y), g);
     return 0;
   }
-  // CVODE reports through this instead of printing; the message becomes part of the SolverError.
+  // CVODES reports through this instead of printing; the message becomes part of the SolverError.
   static void on_error(int, const char*, const char* function, char* msg, void* user) {
     static_cast<Impl*>(user)->last_error = std::string(function) + ": " + msg;
   }
@@ -49,16 +55,18 @@ struct CvodeIntegrator::Impl {
 };
 
 CvodeIntegrator::CvodeIntegrator(OdeSystem& system, double t0, const std::vector<double>& y0,
-                                 const OdeTolerances& tol)
-    : impl_(std::make_unique<Impl>()), t_(t0), y_(y0) {
+                                 const std::vector<double>& q0, const OdeTolerances& tol)
+    : impl_(std::make_unique<Impl>()), t_(t0), y_(y0), q_(q0) {
   auto& s = *impl_;
   s.system = &system;
   const int n = system.size();
+  const int nq = system.num_quadratures();
   s.check(SUNContext_Create(nullptr, &s.ctx), "SUNContext_Create", t0);
   s.y = N_VNew_Serial(n, s.ctx);
   s.abstol = N_VNew_Serial(n, s.ctx);
+  s.scratch = N_VNew_Serial(n, s.ctx);
   for (int i = 0; i < n; ++i) {
-    NV_Ith_S(s.y, i) = y0[i];
+    NV_Ith_S(s.y, i) = y0.at(i);
     NV_Ith_S(s.abstol, i) = tol.absolute.at(i);
   }
   s.mem = CVodeCreate(CV_ADAMS, s.ctx);
@@ -68,10 +76,20 @@ CvodeIntegrator::CvodeIntegrator(OdeSystem& system, double t0, const std::vector
   s.check(CVodeSVtolerances(s.mem, tol.relative, s.abstol), "CVodeSVtolerances", t0);
   s.check(CVodeSetUserData(s.mem, &s), "CVodeSetUserData", t0);
   s.check(CVodeSetMaxNumSteps(s.mem, 100000), "CVodeSetMaxNumSteps", t0);
-  // Newton with a dense difference-quotient Jacobian: the driver's PI loop makes the system mildly stiff, and
-  // BDF then steps over whole trace segments where Adams would be held to fractions of a second.
   s.nls = SUNNonlinSol_FixedPoint(s.y, 0, s.ctx);
   s.check(CVodeSetNonlinearSolver(s.mem, s.nls), "CVodeSetNonlinearSolver", t0);
+  if (nq > 0) {
+    s.q = N_VNew_Serial(nq, s.ctx);
+    s.q_abstol = N_VNew_Serial(nq, s.ctx);
+    q_offset_ = q0;
+    for (int i = 0; i < nq; ++i) {
+      NV_Ith_S(s.q, i) = 0.0;
+      NV_Ith_S(s.q_abstol, i) = tol.quadrature_absolute.at(i);
+    }
+    s.check(CVodeQuadInit(s.mem, &Impl::quad_rhs, s.q), "CVodeQuadInit", t0);
+    s.check(CVodeQuadSVtolerances(s.mem, tol.quadrature_relative, s.q_abstol), "CVodeQuadSVtolerances", t0);
+    s.check(CVodeSetQuadErrCon(s.mem, SUNTRUE), "CVodeSetQuadErrCon", t0);
+  }
   if (system.num_roots() > 0) {
     s.check(CVodeRootInit(s.mem, system.num_roots(), &Impl::roots), "CVodeRootInit", t0);
     s.check(CVodeSetNoInactiveRootWarn(s.mem), "CVodeSetNoInactiveRootWarn", t0);
@@ -81,20 +99,21 @@ CvodeIntegrator::CvodeIntegrator(OdeSystem& system, double t0, const std::vector
 
 CvodeIntegrator::~CvodeIntegrator() = default;
 
-bool CvodeIntegrator::advance(double t_out, double t_stop) {
+bool CvodeIntegrator::step(double t_stop) {
   auto& s = *impl_;
-  // CVODE may already stand at the stop time, having stepped there while answering an earlier, nearer t_out;
-  // setting the same stop again would be rejected, so it is set once per stop.
+  // CVODES may already stand at the stop time; setting the same stop again would be rejected, so it is set
+  // once per stop (and again after a restart, which clears it).
   if (t_stop != stop_time_) {
     s.check(CVodeSetStopTime(s.mem, t_stop), "CVodeSetStopTime", t_);
     stop_time_ = t_stop;
   }
   realtype t_reached = t_;
-  const int flag = CVode(s.mem, t_out, s.y, &t_reached, CV_NORMAL);
+  const int flag = CVode(s.mem, t_stop, s.y, &t_reached, CV_ONE_STEP);
   s.check(flag, "CVode", t_reached);
   t_ = t_reached;
   const double* data = N_VGetArrayPointer(s.y);
   y_.assign(data, data + y_.size());
+  q_current_ = false;
   if (flag == CV_ROOT_RETURN) {
     s.check(CVodeGetRootInfo(s.mem, root_flags_.data()), "CVodeGetRootInfo", t_);
     return true;
@@ -102,12 +121,51 @@ bool CvodeIntegrator::advance(double t_out, double t_stop) {
   return false;
 }
 
+std::vector<double> CvodeIntegrator::state_at(double t) const {
+  auto& s = *impl_;
+  s.check(CVodeGetDky(s.mem, t, 0, s.scratch), "CVodeGetDky", t);
+  const double* d = N_VGetArrayPointer(s.scratch);
+  return std::vector<double>(d, d + y_.size());
+}
+
+std::vector<double> CvodeIntegrator::quadratures_at(double t) const {
+  auto& s = *impl_;
+  std::vector<double> q(q_offset_);
+  if (!s.q) return q;
+  N_Vector out = N_VClone(s.q);
+  const int flag = CVodeGetQuadDky(s.mem, t, 0, out);
+  for (std::size_t i = 0; i < q.size(); ++i) q[i] += NV_Ith_S(out, i);
+  N_VDestroy(out);
+  s.check(flag, "CVodeGetQuadDky", t);
+  return q;
+}
+
+const std::vector<double>& CvodeIntegrator::quadratures() {
+  auto& s = *impl_;
+  if (s.q && !q_current_) {
+    // CVodeGetQuadDky at the last reached time: after a root return that is the root, not the internal tn.
+    s.check(CVodeGetQuadDky(s.mem, t_, 0, s.q), "CVodeGetQuadDky", t_);
+    const double* qd = N_VGetArrayPointer(s.q);
+    for (std::size_t i = 0; i < q_.size(); ++i) q_[i] = q_offset_[i] + qd[i];
+  }
+  q_current_ = true;
+  return q_;
+}
+
 void CvodeIntegrator::restart(double t, const std::vector<double>& y) {
   auto& s = *impl_;
-  const OdeStats so_far = stats();
-  before_restarts_ = so_far;
+  before_restarts_ = stats();
+  quadratures();  // the sums up to t, before the method forgets its history
   for (std::size_t i = 0; i < y.size(); ++i) NV_Ith_S(s.y, i) = y[i];
   s.check(CVodeReInit(s.mem, t, s.y), "CVodeReInit", t);
+  if (s.q) {
+    // Quadratures restart from zero and their running sums are kept here: CVODES' relative tolerance then
+    // bounds each interval's integral, not the ever-growing total (whose step errors would add up).
+    q_offset_ = q_;
+    N_VConst(0.0, s.q);
+    q_current_ = true;
+    s.check(CVodeQuadReInit(s.mem, s.q), "CVodeQuadReInit", t);
+  }
   stop_time_ = std::numeric_limits<double>::quiet_NaN();
   t_ = t;
   y_ = y;
@@ -122,8 +180,10 @@ OdeStats CvodeIntegrator::stats() const {
   CVodeGetNumErrTestFails(mem, &st.error_test_failures);
   CVodeGetNumNonlinSolvConvFails(mem, &st.nonlinear_failures);
   if (!root_flags_.empty()) CVodeGetNumGEvals(mem, &st.root_evals);
+  if (impl_->q) CVodeGetQuadNumRhsEvals(mem, &st.quadrature_evals);
   st.steps += before_restarts_.steps;
   st.rhs_evals += before_restarts_.rhs_evals;
+  st.quadrature_evals += before_restarts_.quadrature_evals;
   st.error_test_failures += before_restarts_.error_test_failures;
   st.nonlinear_failures += before_restarts_.nonlinear_failures;
   st.root_evals += before_restarts_.root_evals;
