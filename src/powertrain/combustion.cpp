@@ -30,6 +30,17 @@ std::vector<double> CombustionPowertrain::shift_speeds_mps(int gear) const {
   return s;
 }
 
+double CombustionPowertrain::max_wheel_force_n(int gear, double speed_mps, double wheel_radius_m) const {
+  const auto& e = p_.engine;
+  const auto& g = p_.gearbox;
+  const double ratio = g.ratios[std::clamp(gear, 1, num_gears()) - 1] * g.final_drive_ratio;
+  const double v = std::max(speed_mps, 0.0);
+  if (v / wheel_radius_m * ratio > e.max_speed_radps) return 0.0;
+  double force_n = e.max_torque_nm * ratio * g.efficiency / wheel_radius_m;
+  if (v > 0.0) force_n = std::min(force_n, (e.max_power_w - p_.aux_power_w / p_.alternator_efficiency) * g.efficiency / v);
+  return force_n;
+}
+
 PowerFlow CombustionPowertrain::deliver(double wheel_force_n, double speed_mps, int gear,
                                         double wheel_radius_m) const {
   const auto& e = p_.engine;
@@ -49,6 +60,7 @@ PowerFlow CombustionPowertrain::deliver(double wheel_force_n, double speed_mps, 
   double brake_power_w = accessory_power_w;
 
   if (wheel_force_n >= 0.0) {
+    // The engine may run past its rated speed only in the gear the driver is in; the limit is torque and power.
     double max_force_n = e.max_torque_nm * ratio * eta / wheel_radius_m;
     if (v > 0.0) max_force_n = std::min(max_force_n, (e.max_power_w - accessory_power_w) * eta / v);
     const double force_n = std::min(wheel_force_n, max_force_n);

@@ -28,7 +28,17 @@ double ElectricPowertrain::battery_current_a(double terminal_power_w) const {
   return (voc - std::sqrt(disc)) / (2.0 * r);
 }
 
-PowerFlow ElectricPowertrain::deliver(double wheel_force_n, double speed_mps, int /*gear*/,
+double ElectricPowertrain::max_wheel_force_n(int /*gear*/, double speed_mps, double wheel_radius_m) const {
+  const double ratio = p_.reduction.ratio;
+  const double eta = p_.reduction.efficiency;
+  const double v = std::max(speed_mps, 0.0);
+  if (v / wheel_radius_m * ratio > p_.motor.max_speed_radps) return 0.0;
+  double force_n = p_.motor.max_torque_nm * ratio * eta / wheel_radius_m;
+  if (v > 0.0) force_n = std::min(force_n, p_.motor.max_power_w * eta / v);
+  return force_n;
+}
+
+PowerFlow ElectricPowertrain::deliver(double wheel_force_n, double speed_mps, int gear,
                                       double wheel_radius_m) const {
   const double ratio = p_.reduction.ratio;
   const double eta = p_.reduction.efficiency;
@@ -40,9 +50,7 @@ PowerFlow ElectricPowertrain::deliver(double wheel_force_n, double speed_mps, in
   double torque_nm = 0.0;
 
   if (wheel_force_n >= 0.0) {
-    double max_force_n = p_.motor.max_torque_nm * ratio * eta / wheel_radius_m;
-    if (v > 0.0) max_force_n = std::min(max_force_n, p_.motor.max_power_w * eta / v);
-    if (motor_speed_radps > p_.motor.max_speed_radps) max_force_n = 0.0;
+    const double max_force_n = max_wheel_force_n(gear, v, wheel_radius_m);
     const double force_n = std::min(wheel_force_n, max_force_n);
     out.force_limited = wheel_force_n > max_force_n * (1.0 + 1e-12);
     out.wheel_force_n = force_n;

@@ -152,6 +152,8 @@ struct Evaluator {
     double extra_electric_w = 0.0;
     for (std::size_t i = 0; i < m.effects.size(); ++i) extra_electric_w += m.effects[i]->extra_electric_power_w(in, x + effect_state_offset[i]);
     if (extra_electric_w != 0.0) add_electric_load(extra_electric_w, out.flow);
+    // Effects' battery loss (extra internal resistance) drains the cells, not the terminals: SOC sees it.
+    for (std::size_t i = 0; i < m.effects.size(); ++i) out.flow.battery_loss_w += m.effects[i]->battery_loss_w(in, out.flow.battery_terminal_power_w, x + effect_state_offset[i]);
   }
 
   // An extra electrical load: from the battery terminals (its own I^2 R is neglected: under 1 % of it at these
@@ -306,22 +308,50 @@ class ForwardSystem final : public OdeSystem {
   /// The accumulators integrated, by index: only those that can be non-zero for this car and trace. Every
   /// quadrature costs vector arithmetic in each step; the others are zero by construction.
   const std::vector<int>& active_accumulators() const { return active_; }
-  // Only gear shifts are roots: they switch the right-hand side discontinuously. Regen regime speeds are kinks
-  // (continuous force), which error control handles; as roots they chatter when the car hovers near them.
-  int num_roots() const override { return 2; }
+  // Roots are gear changes, which switch the right-hand side discontinuously: the speed schedule's up- and
+  // downshift speeds, and the kick-down pair (demand above what the gear gives; demand back below 90 % of what the
+  // next gear up gives). Single-speed drives have none. Regen regime speeds are only kinks (continuous force),
+  // which error control handles; as roots they chatter when the car hovers near them.
+  int num_roots() const override { return m_.powertrain->num_gears() > 1 ? 4 : 0; }
 
-  void roots(double, const double* y, double* g) override {
-    // Index 0: upshift speed, 1: downshift speed of the current gear (a constant 1 where there is none).
-    g[0] = shifts_up_ > 0.0 ? y[kSpeed] - shifts_up_ : 1.0;
-    g[1] = shifts_down_ > 0.0 ? y[kSpeed] - shifts_down_ : 1.0;
+  void roots(double t, const double* y, double* g) override {
+    const double v = y[kSpeed];
+    g[0] = shifts_up_ > 0.0 ? v - shifts_up_ : 1.0;
+    g[1] = shifts_down_ > 0.0 ? v - shifts_down_ : 1.0;
+    const double demand_n = force_request(t, y);
+    g[2] = gear > 1 ? max_force(gear, v) - demand_n : 1.0;
+    g[3] = gear < scheduled_gear_ ? kKickdownReturn * max_force(gear + 1, v) - demand_n : -1.0;
   }
 
-  void set_gear(int new_gear) {
-    gear = new_gear;
+  /// Sets the schedule's gear and the gear actually engaged (the schedule's, or lower where the demand needs it).
+  void set_gears(int scheduled, int engaged) {
+    scheduled_gear_ = scheduled;
+    gear = std::min(engaged, scheduled);
     shifts_up_ = shifts_down_ = -1.0;
-    const int n_up = m_.powertrain->select_gear(1e9, gear);
-    if (n_up != gear) shifts_up_ = upshift_speed(gear);
-    if (gear > 1) shifts_down_ = downshift_speed(gear);
+    if (m_.powertrain->num_gears() <= 1) return;
+    if (scheduled < m_.powertrain->num_gears()) shifts_up_ = m_.powertrain->shift_speeds_mps(scheduled).front();
+    if (scheduled > 1) shifts_down_ = m_.powertrain->shift_speeds_mps(scheduled).back();
+  }
+  int scheduled_gear() const { return scheduled_gear_; }
+
+  /// The highest gear from `from` down that delivers `demand_n` at `speed_mps`.
+  int kickdown_gear(int from, double speed_mps, double demand_n) const {
+    int g = from;
+    while (g > 1 && demand_n > max_force(g, speed_mps) && max_force(g - 1, speed_mps) > max_force(g, speed_mps)) --g;
+    return g;
+  }
+
+  /// The driver's wheel-force request at (t, y): feed-forward from the trace plus PI on the speed error.
+  double force_request(double t, const double* y) {
+    const std::size_t i = segment(t, true);
+    const double dt = c_.time_s[i + 1] - c_.time_s[i];
+    const double a_ref = (c_.speed_mps[i + 1] - c_.speed_mps[i]) / dt;
+    const double v_ref = c_.speed_mps[i] + a_ref * (t - c_.time_s[i]);
+    EffectInputs in{t, v_ref, a_ref, c_.grade.empty() ? 0.0 : c_.grade[i], y[kDistance], 0.0, 0.0};
+    Instant ff;
+    eval_.resistance(loads_.coeffs[loads_.of_segment[i]], in, y + kBaseStates, ff);
+    return m_.inertial_mass_kg() * (a_ref + o_.driver_kp_per_s * (v_ref - y[kSpeed]) + o_.driver_ki_per_s2 * y[kDriverIntegral]) +
+           ff.resistance_n();
   }
 
   int rhs(double t, const double* y, double* ydot) override { return rhs(t, y, ydot, true); }
@@ -339,9 +369,7 @@ class ForwardSystem final : public OdeSystem {
   // Evaluates the instant at (t, y); fills ydot when given. `left_continuous`: use the segment ending at the
   // window's end when t is on it (integration); otherwise the segment starting at t (reporting a sample).
   double evaluate(double t, const double* y, Instant& s, double* ydot, bool left_continuous = false) {
-    std::size_t i = c_.segment_index(t, hint_);
-    if (left_continuous && i > 0 && c_.time_s[i] >= window_end_) --i;
-    hint_ = i;
+    const std::size_t i = segment(t, left_continuous);
     const double dt = c_.time_s[i + 1] - c_.time_s[i];
     const double a_ref = (c_.speed_mps[i + 1] - c_.speed_mps[i]) / dt;
     const double v_ref = c_.speed_mps[i] + a_ref * (t - c_.time_s[i]);
@@ -392,8 +420,15 @@ class ForwardSystem final : public OdeSystem {
   bool last_limited_ = false;
 
  private:
-  double upshift_speed(int g) const { return m_.powertrain->shift_speeds_mps(g).front(); }
-  double downshift_speed(int g) const { return m_.powertrain->shift_speeds_mps(g).back(); }
+  static constexpr double kKickdownReturn = 0.9;  // hysteresis: back up only with 10 % reserve in the higher gear
+  double max_force(int g, double speed_mps) const { return m_.powertrain->max_wheel_force_n(g, speed_mps, m_.wheel_radius_m); }
+  std::size_t segment(double t, bool left_continuous) {
+    std::size_t i = c_.segment_index(t, hint_);
+    if (left_continuous && i > 0 && c_.time_s[i] >= window_end_) --i;
+    hint_ = i;
+    return i;
+  }
+  int scheduled_gear_ = 1;
 
   const VehicleModel& m_;
   const DriveCycle& c_;
@@ -426,7 +461,12 @@ SimulationResult simulate_forward(const VehicleModel& m, const DriveCycle& c, co
       off += eff->num_states();
     }
   }
-  sys.set_gear(m.powertrain->select_gear(y0[kSpeed], 1));
+  {
+    const int scheduled = m.powertrain->select_gear(y0[kSpeed], 1);
+    sys.set_gears(scheduled, scheduled);
+    sys.set_window_end(c.time_s.size() > 1 ? c.time_s[1] : c.time_s.front());
+    sys.set_gears(scheduled, sys.kickdown_gear(scheduled, y0[kSpeed], sys.force_request(c.time_s.front(), y0.data())));
+  }
 
   OdeTolerances tol;
   tol.relative = opt.relative_tolerance;
@@ -505,18 +545,33 @@ SimulationResult simulate_forward(const VehicleModel& m, const DriveCycle& c, co
       ++next_sample;
     }
     if (root) {
-      // A shift speed was crossed: change gear and restart there.
+      // A shift speed or a kick-down threshold was crossed: change gear and restart there.
       const auto& flags = integ.root_flags();
-      int gear = sys.gear;
-      if (flags[0] > 0) gear = m.powertrain->select_gear(integ.state()[kSpeed] + 1e-9, sys.gear);
-      if (flags[1] < 0) gear = m.powertrain->select_gear(integ.state()[kSpeed] - 1e-9, sys.gear);
-      sys.set_gear(gear);
+      const double v = integ.state()[kSpeed];
+      const double demand_n = sys.force_request(t, integ.state().data());
+      int scheduled = sys.scheduled_gear();
+      int engaged = sys.gear;
+      if (flags[0] > 0 || flags[1] < 0) {
+        scheduled = m.powertrain->select_gear(v + (flags[0] > 0 ? 1e-9 : -1e-9), scheduled);
+        engaged = sys.kickdown_gear(scheduled, v, demand_n);
+      } else if (flags[2] < 0) {
+        engaged = std::min(sys.kickdown_gear(engaged, v, demand_n), std::max(1, engaged - 1));
+      } else if (flags[3] > 0) {
+        engaged = sys.gear + 1;
+      }
+      sys.set_gears(scheduled, engaged);
       integ.restart(t, integ.state());
     } else if (t >= t_stop && t < t_end) {
       std::vector<double> y = integ.state();
       if (sys.standstill_segment(t)) {
         y[kSpeed] = 0.0;  // stopped and braked: the driver releases the pedal
         y[kDriverIntegral] = 0.0;
+      }
+      // The demand jumps at a kink of the trace: choose the gear for the segment that starts here.
+      if (m.powertrain->num_gears() > 1) {
+        sys.set_window_end(stops[std::min(next_stop + 1, stops.size() - 1)]);
+        const int scheduled = m.powertrain->select_gear(y[kSpeed], sys.scheduled_gear());
+        sys.set_gears(scheduled, sys.kickdown_gear(scheduled, y[kSpeed], sys.force_request(t, y.data())));
       }
       integ.restart(t, y);
     }
@@ -547,7 +602,8 @@ SimulationResult simulate_replay(const VehicleModel& m, const DriveCycle& c, con
   }
   std::array<double, kAccumulators> acc{}, rate{}, cruise_rate{};
   double distance_m = 0.0;
-  int gear = m.powertrain->select_gear(c.speed_mps.front(), 1);
+  int scheduled_gear = m.powertrain->select_gear(c.speed_mps.front(), 1);
+  int gear = scheduled_gear;
   // Without hidden states, a cruise segment like the previous one has the same powers: reuse them.
   const bool stateless = eval.effect_states == 0 && !opt.record_trace;
   bool cruise_valid = false, cruise_limited = false;
@@ -560,10 +616,14 @@ SimulationResult simulate_replay(const VehicleModel& m, const DriveCycle& c, con
   // Powers at one point of a segment into `rate` (and the effects' state rates into `xdot`).
   Instant s;
   auto evaluate_at = [&](double t, double v, double a, double grade, const RoadLoadCoeffs& rl, double dist_m) {
-    gear = m.powertrain->select_gear(v, gear);
+    scheduled_gear = m.powertrain->select_gear(v, scheduled_gear);
     EffectInputs in{t, v, a, grade, dist_m, 0.0, 0.0};
     eval.resistance(rl, in, x.data(), s);
     const double request_n = m_eff * a + s.resistance_n();
+    // Kick down, as in the forward simulation, where the scheduled gear cannot deliver the trace's demand.
+    gear = scheduled_gear;
+    auto max_force = [&](int g) { return m.powertrain->max_wheel_force_n(g, v, m.wheel_radius_m); };
+    while (gear > 1 && request_n > max_force(gear) && max_force(gear - 1) > max_force(gear)) --gear;
     eval.deliver(request_n, gear, in, x.data(), s);
     accumulate(s, v, rate.data());
     rate[kUnmet] = (request_n - s.flow.wheel_force_n) * v;

@@ -52,6 +52,8 @@ class CombustionPowertrain final : public Powertrain {
   int select_gear(double speed_mps, int current_gear) const override;
   std::vector<double> shift_speeds_mps(int gear) const override;
   std::vector<double> regime_speeds_mps() const override { return {}; }
+  int num_gears() const override { return static_cast<int>(p_.gearbox.ratios.size()); }
+  double max_wheel_force_n(int gear, double speed_mps, double wheel_radius_m) const override;
   double usable_battery_energy_j() const override { return 0.0; }
   bool is_electric() const override { return false; }
   const CombustionPowertrainParams& params() const { return p_; }

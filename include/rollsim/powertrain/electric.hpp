@@ -60,6 +60,7 @@ class ElectricPowertrain final : public Powertrain {
   int select_gear(double, int) const override { return 0; }
   std::vector<double> shift_speeds_mps(int) const override { return {}; }
   std::vector<double> regime_speeds_mps() const override;
+  double max_wheel_force_n(int gear, double speed_mps, double wheel_radius_m) const override;
   double usable_battery_energy_j() const override { return p_.battery.usable_capacity_j; }
   bool is_electric() const override { return true; }
   const ElectricPowertrainParams& params() const { return p_; }

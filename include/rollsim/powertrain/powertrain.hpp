@@ -37,8 +37,16 @@ class Powertrain {
   /// powertrain's limits. `wheel_radius_m` is the driven tyres' effective rolling radius (it sets the gearing).
   virtual PowerFlow deliver(double wheel_force_n, double speed_mps, int gear, double wheel_radius_m) const = 0;
 
-  /// The gear to use at `speed_mps` coming from `current_gear` (with hysteresis); 0 for single-speed drives.
+  /// The gear the speed schedule asks for at `speed_mps` coming from `current_gear` (with hysteresis); 0 for
+  /// single-speed drives.
   virtual int select_gear(double speed_mps, int current_gear) const = 0;
+
+  /// Number of gears; 1 for single-speed drives (which never shift).
+  virtual int num_gears() const { return 1; }
+
+  /// The largest propulsive wheel force [N] available in `gear` at `speed_mps`; 0 where the gear would
+  /// overspeed the machine. A driver (or an automatic gearbox) kicks down when the demand exceeds it.
+  virtual double max_wheel_force_n(int gear, double speed_mps, double wheel_radius_m) const = 0;
 
   /// Speeds [m/s] at which `select_gear` changes its answer from `gear`: the integrator finds these crossings as
   /// roots so it never steps over a shift. Empty for single-speed drives.
