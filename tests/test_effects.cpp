@@ -52,7 +52,81 @@ TEST(EffectCatalogue, EachEffectMovesEnergyInThePhysicalDirection) {
     EXPECT_GT(more("mass", {{"extra_mass_kg", 150}}), 0.0) << file;
     EXPECT_GT(more("rr_speed", {{"rrc_change_at_100kmh", 0.2}}), 0.0) << file;
     EXPECT_GT(more("ambient_rrc", {{"rrc_change_per_k", 0.008}, {"ambient_temp_c", 0}}), 0.0) << file;  // cold day
+    // Rotating mass: what accelerating stores comes back only partly (friction brakes), so the trip costs more.
+    EXPECT_GT(more("rotational_inertia", {{"extra_rotating_mass_kg", 80}}), 0.0) << file;
+    EXPECT_GT(more("tyre_slip", {{"slip_per_kn", 0.005}}), 0.0) << file;
+    EXPECT_GT(more("road_grade", {{"grade_offset", 0.005}}), 0.0) << file;  // a net climb
+    EXPECT_LT(more("road_grade", {{"grade_offset", -0.005}}), 0.0) << file;
   }
+}
+
+TEST(EffectCatalogue, RotationalInertiaCostsLessThanTheSameMass) {
+  // The same kilograms as rotating mass act on acceleration only; as payload they also roll: mass costs more.
+  const Vehicle v = vehicle("ev.yaml");
+  const double base = source_j(run(v, nullptr));
+  const double rot = source_j(run(v, make_effect("rotational_inertia", {{"extra_rotating_mass_kg", 100}}, context(v)))) - base;
+  const double mass = source_j(run(v, make_effect("mass", {{"extra_mass_kg", 100}}, context(v)))) - base;
+  EXPECT_GT(rot, 0.0);
+  EXPECT_GT(mass, rot);
+}
+
+TEST(EffectCatalogue, BatteryResistanceDrainsTheCellsNotTheTerminals) {
+  // dR I^2 inside the pack: terminal energy unchanged, internal loss up by about dR * sum(I^2) dt, which lies
+  // between dR (E_discharge)^2 / (V^2 T) (Cauchy-Schwarz) and dR * Pmax * E / V^2.
+  const Vehicle v = vehicle("ev.yaml");
+  SimulationOptions so;
+  so.record_trace = true;
+  VehicleModel m0 = VehicleModel::assemble(v), m1 = m0;
+  m1.effects.push_back(make_effect("battery_resistance", {{"extra_resistance_ohm", 0.1}, {"pack_voltage_v", 360}}, context(v)));
+  const DriveCycle c = load_cycle("wltc");
+  const SimulationResult a = simulate_replay(m0, c, so), b = simulate_replay(m1, c, so);
+  EXPECT_NEAR(b.energy.battery_terminal_j, a.energy.battery_terminal_j, 1e-9 * a.energy.battery_terminal_j);
+  const double extra = b.energy.battery_loss_j - a.energy.battery_loss_j;
+  double i2dt = 0.0;  // left Riemann sum of the terminal current squared, from the trace
+  for (std::size_t k = 0; k + 1 < a.trace.size(); ++k) {
+    const double i = a.trace[k].battery_power_w / 360.0;
+    i2dt += i * i * (a.trace[k + 1].time_s - a.trace[k].time_s);
+  }
+  EXPECT_NEAR(extra, 0.1 * i2dt, 0.05 * 0.1 * i2dt);
+  EXPECT_LT(b.final_soc, a.final_soc);
+  // A combustion car has no traction battery: nothing changes.
+  const Vehicle ice = vehicle("ice.yaml");
+  EXPECT_NEAR(source_j(run(ice, make_effect("battery_resistance", {{"extra_resistance_ohm", 0.1}}, context(ice)))),
+              source_j(run(ice, nullptr)), 1e-9 * source_j(run(ice, nullptr)));
+}
+
+TEST(EffectCatalogue, RegenLimitCostsOnlyAnElectricCarAndOnlyWhenBraking) {
+  const Vehicle ev = vehicle("ev.yaml");
+  const SimulationResult base = run(ev, nullptr);
+  const SimulationResult lim = run(ev, make_effect("regen_limit", {{"friction_share_above_limit", 1.0}, {"regen_limit_w", 3000}}, context(ev)));
+  EXPECT_GT(lim.energy.battery_terminal_j, base.energy.battery_terminal_j);  // less recovered
+  EXPECT_LT(lim.energy.regen_wheel_j, base.energy.regen_wheel_j);
+  EXPECT_NEAR(lim.energy.traction_j, base.energy.traction_j, 1e-9 * base.energy.traction_j);  // driving untouched
+  // The recovered braking energy cannot exceed what a 3 kW cap lets through over the braking time.
+  // A lower limit costs more.
+  const SimulationResult lower = run(ev, make_effect("regen_limit", {{"friction_share_above_limit", 1.0}, {"regen_limit_w", 1000}}, context(ev)));
+  EXPECT_GT(lower.energy.battery_terminal_j, lim.energy.battery_terminal_j);
+}
+
+TEST(EffectCatalogue, EngineWarmupCostsFuelEarlyAndNothingOnAnElectricCar) {
+  const Vehicle ice = vehicle("ice.yaml"), ev = vehicle("ev.yaml");
+  const auto warm = [](const Vehicle& v, double k) { return make_effect("engine_warmup", {{"cold_fuel_excess", k}}, context(v)); };
+  const double base = run(ice, nullptr).energy.fuel_j;
+  const double cold = run(ice, warm(ice, 0.2)).energy.fuel_j;
+  EXPECT_GT(cold, base);
+  EXPECT_LT(cold, 1.2 * base);  // the excess fades as the oil warms: less than the full 20 % over a WLTC
+  EXPECT_NEAR(source_j(run(ev, warm(ev, 0.2))), source_j(run(ev, nullptr)), 1e-9 * source_j(run(ev, nullptr)));
+}
+
+TEST(EffectCatalogue, EveryIssueIdentifierHasAModule) {
+  for (const char* id : {"tyre_warmup", "engine_warmup", "road_grade", "mass", "rotational_inertia", "wind", "aux_load",
+                         "battery_resistance", "tyre_slip", "regen_limit", "rr_speed", "ambient_rrc"}) {
+    EXPECT_NO_THROW(effect_info(id)) << id;
+    int amplitudes = 0;
+    for (const auto& p : effect_info(id).parameters) amplitudes += p.amplitude ? 1 : 0;
+    EXPECT_EQ(amplitudes, 1) << id;  // the diagnosis fits exactly one size per effect
+  }
+  EXPECT_TRUE(effects_not_implemented().empty());
 }
 
 TEST(EffectCatalogue, AuxLoadOnAnElectricCarCostsExactlyItsEnergy) {

@@ -37,6 +37,9 @@ class Effect {
   /// Extra electrical consumer [W] (HVAC, electronics), booked as auxiliary power: drawn from the battery of an
   /// electric car, or from the alternator (fuel at its marginal efficiency) of a combustion car.
   virtual double extra_electric_power_w(const EffectInputs&, const double* /*x*/) const { return 0.0; }
+  /// Extra loss inside the battery [W] at this terminal power (+ discharging): drains the cells (state of charge)
+  /// without changing the power at the terminals (extra internal resistance).
+  virtual double battery_loss_w(const EffectInputs&, double /*terminal_power_w*/, const double* /*x*/) const { return 0.0; }
 };
 
 }  // namespace rollsim
