@@ -27,10 +27,16 @@ DriveCycle constant_speed_cycle(double speed_mps, double duration_s) {
   return c;
 }
 
+// A per-process scratch folder, removed when the test program ends.
+struct ScratchDir {
+  std::filesystem::path path = std::filesystem::temp_directory_path() / ("rollsim_sim_test_" + std::to_string(::getpid()));
+  ScratchDir() { std::filesystem::create_directories(path); }
+  ~ScratchDir() { std::filesystem::remove_all(path); }
+};
+
 std::string temp_file(const std::string& name, const std::string& text) {
-  const auto dir = std::filesystem::temp_directory_path() / ("rollsim_sim_test_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  const auto p = dir / name;
+  static const ScratchDir dir;
+  const auto p = dir.path / name;
   std::ofstream(p) << text;
   return p.string();
 }

@@ -1,6 +1,7 @@
 #include "rollsim/tyre/tyre_model.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <string>
 
@@ -48,7 +49,12 @@ LeverSums lever_sums(const Patch& p, int n) {
   return s;
 }
 
-std::string v(double x) { return format_value(x); }
+// Figures in messages: four significant digits say what is wrong without false precision.
+std::string v(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, std::abs(x) >= 1e3 && std::abs(x) < 1e12 ? "%.0f" : "%.4g", x);
+  return buf;
+}
 
 }  // namespace
 
