@@ -6,9 +6,11 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "rollsim/common/atomic_file.hpp"
 #include "rollsim/common/error.hpp"
 #include "rollsim/common/yaml_reader.hpp"
 #include "rollsim/diagnose/diagnose.hpp"
+#include "rollsim/diagnose/report.hpp"
 #include "rollsim/recording/recording.hpp"
 #include "rollsim/tyre/tyre_spec.hpp"
 
@@ -16,8 +18,9 @@ namespace rollsim::cli {
 namespace {
 
 struct DiagnoseCliOptions {
-  std::string vehicle, tyre, preset, json, write_vehicle;
+  std::string vehicle, tyre, preset, json, write_vehicle, report;
   std::vector<std::string> recordings, columns, scales;
+  double window_s = 0.0;  // 0: the library default
 };
 
 void write_file(const std::string& path, const std::string& text, const std::string& option) {
@@ -41,9 +44,15 @@ void run_diagnose(const DiagnoseCliOptions& o) {
   for (const auto& r : o.recordings) recs.push_back(load_recording(r, mapping));
   for (const auto& r : recs)
     for (const auto& rep : r.repairs) std::cout << r.source << ": " << rep << "\n";
-  const Diagnosis d = diagnose(v, recs);
+  DiagnoseOptions dopt;
+  if (o.window_s > 0.0) dopt.window_s = o.window_s;
+  const Diagnosis d = diagnose(v, recs, dopt);
   std::cout << diagnosis_text(d);
-  if (!o.json.empty()) write_file(o.json, diagnosis_json(d), "--json");
+  if (!o.json.empty()) write_file_atomically(o.json, "--json", [&](std::ostream& os) { os << diagnosis_json(d); });
+  if (!o.report.empty()) {
+    const auto files = write_diagnosis_report(o.report, d, "rollsim diagnose: " + v.name);
+    std::cout << "report written to " << o.report << " (" << files.size() << " files, report.html)\n";
+  }
   if (!o.write_vehicle.empty()) {
     write_file(o.write_vehicle, fitted_vehicle_yaml(vehicle_path, d), "--write-vehicle");
     std::cout << "fitted vehicle written to " << o.write_vehicle << "\n";
@@ -62,6 +71,9 @@ void register_diagnose_command(CLI::App& app) {
   sub->add_option("--column", o->columns, "CANONICAL=SOURCE column mapping (repeatable)")->type_name("C=S");
   sub->add_option("--scale", o->scales, "CANONICAL=FACTOR scale (repeatable)")->type_name("C=F");
   sub->add_option("--json", o->json, "Write the diagnosis as JSON")->type_name("FILE");
+  sub->add_option("--window-s", o->window_s, "Energy window length [s] (default 60; SOC channels lengthen it by the quantum)")
+      ->check(CLI::Range(5.0, 3600.0));
+  sub->add_option("--report", o->report, "Write figures (SVG, gnuplot) and report.html into this folder")->type_name("DIR");
   sub->add_option("--write-vehicle", o->write_vehicle, "Write the vehicle with the fitted effects switched on")->type_name("FILE");
   sub->callback([o] { run_diagnose(*o); });
 }

@@ -5,11 +5,15 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <atomic>
 #include <map>
 #include <sstream>
+#include <mutex>
+#include <thread>
 
 #include "rollsim/common/error.hpp"
 #include "rollsim/cycle/drive_cycle.hpp"
+#include "rollsim/diagnose/elevation.hpp"
 #include "rollsim/sim/simulation.hpp"
 
 namespace rollsim {
@@ -40,6 +44,32 @@ class RrcLevel final : public Effect {
   double k_;
 };
 
+// Basis of the unexplained-residual description (not a catalogue effect): a force of one shape, per unit
+// amplitude, optionally decaying from the start of the trip. Run through the simulator so that the powertrain's
+// efficiency, regen and fuel cut weigh it as they would weigh a real force.
+enum class ForceShape { constant, speed, speed_squared, positive_accel };
+class SignatureForce final : public Effect {
+ public:
+  SignatureForce(ForceShape shape, double decay_s) : shape_(shape), decay_s_(decay_s) {}
+  std::string id() const override { return "signature_force"; }
+  double extra_resistance_n(const EffectInputs& in, const double*) const override {
+    constexpr double kV100 = 100.0 / 3.6;
+    const double v = std::max(in.speed_mps, 0.0);
+    double f = 0.0;
+    switch (shape_) {
+      case ForceShape::constant: f = v > 0.1 ? 1.0 : 0.0; break;  // 1 N while moving
+      case ForceShape::speed: f = v / kV100; break;               // 1 N at 100 km/h
+      case ForceShape::speed_squared: f = (v / kV100) * (v / kV100); break;
+      case ForceShape::positive_accel: f = std::max(in.accel_mps2, 0.0); break;  // 1 kg x a
+    }
+    return decay_s_ > 0.0 ? f * std::exp(-in.time_s / decay_s_) : f;
+  }
+
+ private:
+  ForceShape shape_;
+  double decay_s_;
+};
+
 EffectContext context_of(const Vehicle& v) {
   EffectContext c;
   c.mass_kg = v.body.test_mass_kg;
@@ -52,9 +82,13 @@ DriveCycle cycle_of(const Recording& r) {
   DriveCycle c;
   c.name = r.source;
   c.source = r.source;
+  // Time from the start of the recording: effects that decay from the start of a trip read it.
   c.time_s = r.time_s;
+  for (double& t : c.time_s) t -= r.time_s.front();
   c.speed_mps = r.speed_mps;
-  c.grade = r.grade ? *r.grade : std::vector<double>(r.time_s.size(), 0.0);
+  if (r.grade) c.grade = *r.grade;
+  else if (r.elevation_m) c.grade = grade_from_elevation(r.time_s, r.speed_mps, *r.elevation_m).grade;
+  else c.grade.assign(r.time_s.size(), 0.0);
   return c;
 }
 
@@ -107,8 +141,9 @@ struct Data {
   int lag_samples = 0;  // measured channel lags the simulation by this many samples (calibration)
 };
 
-Variant run_variant(const Vehicle& vehicle, const std::vector<DriveCycle>& cycles, const Data& d,
-                    const std::vector<std::shared_ptr<const Effect>>& extra) {
+// Simulated channel power per sample for one model variant (the base model plus `extra` effects).
+std::vector<std::vector<double>> simulate_power(const Vehicle& vehicle, const std::vector<DriveCycle>& cycles,
+                                                const std::vector<std::shared_ptr<const Effect>>& extra) {
   VehicleModel model = VehicleModel::assemble(vehicle);
   for (const auto& e : extra) model.effects.push_back(e);
   const bool electric = vehicle.is_electric();
@@ -117,21 +152,54 @@ Variant run_variant(const Vehicle& vehicle, const std::vector<DriveCycle>& cycle
     fuel_j_per_m3 = cp->fuel.density_kg_per_m3 * cp->fuel.lower_heating_value_j_per_kg;
   SimulationOptions so;
   so.record_trace = true;
-  Variant out;
+  std::vector<std::vector<double>> out;
   for (const auto& c : cycles) {
     const SimulationResult r = simulate_replay(model, c, so);
     std::vector<double> p(r.trace.size());
     for (std::size_t i = 0; i < p.size(); ++i) p[i] = sim_power_w(r.trace[i], electric, fuel_j_per_m3);
-    out.power_w.push_back(std::move(p));
+    out.push_back(std::move(p));
   }
-  out.window_j.resize(static_cast<Eigen::Index>(d.windows.size()));
+  return out;
+}
+
+// Window energies of per-sample powers, the simulation shifted by the channel lag.
+Eigen::VectorXd window_energies(const std::vector<std::vector<double>>& power_w, const Data& d) {
+  Eigen::VectorXd e(static_cast<Eigen::Index>(d.windows.size()));
+  const auto lag = static_cast<std::size_t>(d.lag_samples);
   for (std::size_t w = 0; w < d.windows.size(); ++w) {
     const auto& win = d.windows[w];
-    double e = 0.0;
-    const auto lag = static_cast<std::size_t>(d.lag_samples);
-    for (std::size_t i = win.begin; i < win.end; ++i) e += out.power_w[win.rec][i >= lag ? i - lag : 0] * d.dt_s[win.rec][i];
-    out.window_j[static_cast<Eigen::Index>(w)] = e;
+    double sum = 0.0;
+    for (std::size_t i = win.begin; i < win.end; ++i) sum += power_w[win.rec][i >= lag ? i - lag : 0] * d.dt_s[win.rec][i];
+    e[static_cast<Eigen::Index>(w)] = sum;
   }
+  return e;
+}
+
+// Many model variants: independent replays, so they run in parallel (each thread assembles its own model).
+std::vector<Variant> run_variants(const Vehicle& vehicle, const std::vector<DriveCycle>& cycles, const Data& d,
+                                  const std::vector<std::vector<std::shared_ptr<const Effect>>>& extras, unsigned threads) {
+  std::vector<Variant> out(extras.size());
+  std::atomic<std::size_t> next{0};
+  std::exception_ptr failure;
+  std::mutex failure_mutex;
+  auto work = [&] {
+    for (std::size_t k = next++; k < extras.size(); k = next++) {
+      try {
+        out[k].power_w = simulate_power(vehicle, cycles, extras[k]);
+        out[k].window_j = window_energies(out[k].power_w, d);
+      } catch (...) {
+        const std::lock_guard<std::mutex> lock(failure_mutex);
+        if (!failure) failure = std::current_exception();
+      }
+    }
+  };
+  const unsigned n = std::max(1u, std::min<unsigned>(threads ? threads : std::thread::hardware_concurrency(),
+                                                     static_cast<unsigned>(extras.size())));
+  std::vector<std::thread> pool;
+  for (unsigned t = 1; t < n; ++t) pool.emplace_back(work);
+  work();
+  for (auto& t : pool) t.join();
+  if (failure) std::rethrow_exception(failure);
   return out;
 }
 
@@ -179,13 +247,16 @@ double lag1_autocorrelation(const Eigen::VectorXd& r) {
   return den > 0.0 ? num / den : 0.0;
 }
 
-// Out-of-fold prediction: each window predicted by a fit on the other fold (alternating blocks of windows).
-Eigen::VectorXd heldout_prediction(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, int block, const Prior& prior) {
+// Out-of-fold prediction: each window predicted by a fit on the other folds (alternating blocks of windows within
+// one recording, or whole recordings when several are given).
+Eigen::VectorXd heldout_prediction(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, const std::vector<int>& fold_of,
+                                   const Prior& prior) {
   const Eigen::Index n = x.rows();
   Eigen::VectorXd pred(n);
-  for (int fold = 0; fold < 2; ++fold) {
+  const int folds = 1 + *std::max_element(fold_of.begin(), fold_of.end());
+  for (int fold = 0; fold < folds; ++fold) {
     std::vector<Eigen::Index> train, test;
-    for (Eigen::Index i = 0; i < n; ++i) ((i / block) % 2 == fold ? test : train).push_back(i);
+    for (Eigen::Index i = 0; i < n; ++i) (fold_of[static_cast<std::size_t>(i)] == fold ? test : train).push_back(i);
     if (train.empty()) train = test;
     Eigen::MatrixXd xt(static_cast<Eigen::Index>(train.size()), x.cols());
     Eigen::VectorXd yt(static_cast<Eigen::Index>(train.size()));
@@ -230,6 +301,32 @@ std::string num(double v) {
   return os.str();
 }
 
+// Median of the non-zero steps of a quantised signal (its quantum), 0 if it never changes.
+double quantum_of(const std::vector<double>& x) {
+  std::vector<double> steps;
+  for (std::size_t i = 1; i < x.size(); ++i)
+    if (x[i] != x[i - 1]) steps.push_back(std::abs(x[i] - x[i - 1]));
+  if (steps.empty()) return 0.0;
+  std::nth_element(steps.begin(), steps.begin() + static_cast<std::ptrdiff_t>(steps.size() / 2), steps.end());
+  return steps[steps.size() / 2];
+}
+
+std::string fixed(double v, int digits) {
+  std::ostringstream os;
+  os.setf(std::ios::fixed);
+  os.precision(digits);
+  os << v;
+  return os.str();
+}
+
+// A basis shape of the unexplained-residual description.
+struct BasisShape {
+  enum Kind { force, power } kind = force;
+  ForceShape shape = ForceShape::constant;
+  double decay_s = 0.0;  // 0: no decay
+  Eigen::VectorXd signature;
+};
+
 }  // namespace
 
 Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordings, const DiagnoseOptions& opt) {
@@ -239,10 +336,39 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
   std::vector<DriveCycle> cycles;
   double soc_capacity_j = 0.0;
   if (const auto* ep = std::get_if<ElectricPowertrainParams>(&vehicle.powertrain)) soc_capacity_j = ep->battery.usable_capacity_j;
+  for (const Recording& r : recordings) {
+    cycles.push_back(cycle_of(r));
+    if (!r.grade && r.elevation_m) {
+      const ElevationGrade eg = grade_from_elevation(r.time_s, r.speed_mps, *r.elevation_m);
+      out.notes.push_back(r.source + ": grade from recorded elevation (" + std::to_string(eg.rejected_steps) +
+                          " elevation steps rejected as glitches, filtered over 200 m)");
+    }
+  }
+  // SOC: lengthen the windows until the quantisation error is small against a window's energy.
+  double window_s = opt.window_s;
+  {
+    std::string ch;
+    measured_power_w(vehicle, recordings.front(), ch);
+    if (ch == "soc" && soc_capacity_j > 0.0) {
+      double q = 0.0, drop_j = 0.0, duration = 0.0;
+      for (const auto& r : recordings) {
+        q = std::max(q, quantum_of(*r.soc_fraction));
+        drop_j += (r.soc_fraction->front() - r.soc_fraction->back()) * soc_capacity_j;
+        duration += r.duration_s();
+      }
+      const double mean_power_w = drop_j / std::max(1.0, duration);
+      if (q > 0.0 && mean_power_w > 0.0) {
+        const double needed = q * soc_capacity_j / std::sqrt(6.0) / (opt.soc_quantisation_fraction * mean_power_w);
+        window_s = std::max(window_s, std::ceil(needed / 10.0) * 10.0);
+      }
+      out.notes.push_back("SOC quantum " + fixed(100.0 * q, 3) + " % (" + fixed(q * soc_capacity_j / 1e3, 1) +
+                          " kJ), mean power " + fixed(mean_power_w, 0) + " W: windows of " + fixed(window_s, 0) + " s");
+    }
+  }
+  out.window_s = window_s;
   std::vector<double> meas;
   for (std::size_t ri = 0; ri < recordings.size(); ++ri) {
     const Recording& r = recordings[ri];
-    cycles.push_back(cycle_of(r));
     std::string ch;
     d.measured_w.push_back(measured_power_w(vehicle, r, ch));
     if (!d.channel.empty() && d.channel != ch) throw InputError(r.source, "all recordings must carry the same energy channel");
@@ -252,8 +378,8 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
     d.dt_s.push_back(dt);
     std::size_t begin = 0;
     for (std::size_t i = 1; i < r.time_s.size(); ++i) {
-      if (r.time_s[i] - r.time_s[begin] >= opt.window_s || i + 1 == r.time_s.size()) {
-        if (r.time_s[i] - r.time_s[begin] >= 0.5 * opt.window_s) {
+      if (r.time_s[i] - r.time_s[begin] >= window_s || i + 1 == r.time_s.size()) {
+        if (r.time_s[i] - r.time_s[begin] >= 0.5 * window_s) {
           d.windows.push_back({ri, begin, i});
           double e = 0.0;
           if (ch == "soc") {
@@ -269,15 +395,19 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
     }
   }
   const Eigen::Index n = static_cast<Eigen::Index>(d.windows.size());
-  if (n < 8) throw InputError("--recording", "too short to diagnose: " + std::to_string(n) + " windows of " + num(opt.window_s) + " s, need 8");
+  if (n < 8) throw InputError("--recording", "too short to diagnose: " + std::to_string(n) + " windows of " + num(window_s) + " s, need 8");
   d.measured_j = Eigen::Map<Eigen::VectorXd>(meas.data(), n);
   out.channel = d.channel;
   out.windows = static_cast<int>(n);
+  // Held-out folds: whole recordings when several are given (the honest test of a model), else alternating blocks.
+  std::vector<int> fold_of(static_cast<std::size_t>(n));
+  for (Eigen::Index w = 0; w < n; ++w)
+    fold_of[static_cast<std::size_t>(w)] = recordings.size() > 1 ? static_cast<int>(d.windows[static_cast<std::size_t>(w)].rec)
+                                                                  : static_cast<int>((w / opt.block_windows) % 2);
 
   const EffectContext ctx = context_of(vehicle);
-  const Variant rrc = run_variant(vehicle, cycles, d, {std::make_shared<RrcLevel>(0.1)});
-  const Variant drag = run_variant(vehicle, cycles, d, {std::make_shared<DragScale>(0.1, ctx.rho_cda_kg_per_m)});
-  Variant base = run_variant(vehicle, cycles, d, {});
+  Variant base;
+  base.power_w = simulate_power(vehicle, cycles, {});
   // Channel lag (calibration): the shift of the simulated power, 0-10 samples, that best matches the measured.
   if (d.channel != "soc") {
     double best = 1e300;
@@ -295,10 +425,77 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
         d.lag_samples = lag;
       }
     }
-    base = run_variant(vehicle, cycles, d, {});
   }
+  base.window_j = window_energies(base.power_w, d);
   out.lag_samples = d.lag_samples;
   out.raw_trip_energy_error_pct = energy_error_pct(base.window_j, d.measured_j);
+
+  // Every other variant (calibration, catalogue candidates, unexplained basis) in one parallel batch.
+  std::vector<std::vector<std::shared_ptr<const Effect>>> extras;
+  extras.push_back({std::make_shared<RrcLevel>(0.1)});
+  extras.push_back({std::make_shared<DragScale>(0.1, ctx.rho_cda_kg_per_m)});
+  std::vector<Candidate> cands;
+  for (const auto& info : effect_catalogue()) {
+    if (info.id == "ambient_rrc") continue;  // within one trip it is the RRC level (a calibration quantity)
+    std::vector<EffectParameters> shapes{{}};
+    if (info.id == "tyre_warmup") shapes = {{{"heat_capacity_j_per_k", 20000.0}}, {{"heat_capacity_j_per_k", 50000.0}}, {{"heat_capacity_j_per_k", 120000.0}}};
+    const EffectParameterInfo* amp = nullptr;
+    for (const auto& p : info.parameters)
+      if (p.amplitude) amp = &p;
+    if (!amp) continue;
+    for (const auto& shape : shapes) {
+      Candidate c;
+      c.id = info.id;
+      c.shape = shape;
+      c.nominal = amp->nominal;
+      c.amplitude_name = amp->name;
+      c.amplitude_unit = amp->unit;
+      c.amp_min = amp->min;
+      c.amp_max = amp->max;
+      EffectParameters p = shape;
+      p[amp->name] = amp->nominal;
+      c.label = info.id;
+      for (const auto& [k, v] : shape) c.label += " (" + k + " " + num(v) + ")";
+      extras.push_back({make_effect(info.id, p, ctx)});
+      cands.push_back(std::move(c));
+    }
+  }
+  std::vector<BasisShape> basis;
+  std::vector<double> decays{0.0};
+  decays.insert(decays.end(), opt.unexplained_decay_s.begin(), opt.unexplained_decay_s.end());
+  for (double tau : decays) {
+    for (ForceShape fs : {ForceShape::constant, ForceShape::speed, ForceShape::speed_squared, ForceShape::positive_accel}) {
+      basis.push_back({BasisShape::force, fs, tau, {}});
+      extras.push_back({std::make_shared<SignatureForce>(fs, tau)});
+    }
+    basis.push_back({BasisShape::power, ForceShape::constant, tau, {}});  // computed directly below
+  }
+  const std::vector<Variant> vars = run_variants(vehicle, cycles, d, extras, opt.threads);
+  const Variant& rrc = vars[0];
+  const Variant& drag = vars[1];
+  {
+    std::size_t k = 2;
+    std::vector<Candidate> kept;
+    for (auto& c : cands) {
+      c.signature = (vars[k++].window_j - base.window_j) / c.nominal;
+      if (c.signature.norm() > 0.0) kept.push_back(std::move(c));
+    }
+    cands = std::move(kept);
+    for (auto& b : basis) {
+      if (b.kind == BasisShape::force) {
+        b.signature = vars[k++].window_j - base.window_j;
+      } else {  // 1 W at the measured channel, optionally decaying from the start of each recording
+        b.signature.resize(n);
+        for (Eigen::Index w = 0; w < n; ++w) {
+          const auto& win = d.windows[static_cast<std::size_t>(w)];
+          double e = 0.0;
+          for (std::size_t i = win.begin; i < win.end; ++i)
+            e += (b.decay_s > 0.0 ? std::exp(-cycles[win.rec].time_s[i] / b.decay_s) : 1.0) * d.dt_s[win.rec][i];
+          b.signature[w] = e;
+        }
+      }
+    }
+  }
 
   // Calibration: measured = s * sim + a * S_rrc + b * S_drag (RRC level and CdA as nuisances, per 10 %).
   Eigen::MatrixXd xc(n, 3);
@@ -323,48 +520,22 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
   const double rho = std::clamp(out.lag1_autocorrelation, 0.0, 0.95);
   const double n_eff = std::max(4.0, static_cast<double>(n) * (1.0 - rho) / (1.0 + rho));
   out.effective_windows = n_eff;
-  const Eigen::VectorXd cal_pred = heldout_prediction(xc, d.measured_j, opt.block_windows, prior);
+  const Eigen::VectorXd cal_pred = heldout_prediction(xc, d.measured_j, fold_of, prior);
   out.heldout_rmse_calibrated_j = rmse(cal_pred, d.measured_j);
   out.heldout_energy_error_pct_calibrated = energy_error_pct(cal_pred, d.measured_j);
-
-  // Signatures: every catalogue effect at its nominal size, through the whole simulator.
-  std::vector<Candidate> cands;
-  for (const auto& info : effect_catalogue()) {
-    if (info.id == "ambient_rrc") continue;  // within one trip it is the RRC level (a calibration quantity)
-    std::vector<EffectParameters> shapes{{}};
-    if (info.id == "tyre_warmup") shapes = {{{"heat_capacity_j_per_k", 20000.0}}, {{"heat_capacity_j_per_k", 50000.0}}, {{"heat_capacity_j_per_k", 120000.0}}};
-    const EffectParameterInfo* amp = nullptr;
-    for (const auto& p : info.parameters)
-      if (p.amplitude) amp = &p;
-    for (const auto& shape : shapes) {
-      Candidate c;
-      c.id = info.id;
-      c.shape = shape;
-      c.nominal = amp->nominal;
-      c.amplitude_name = amp->name;
-      c.amplitude_unit = amp->unit;
-      c.amp_min = amp->min;
-      c.amp_max = amp->max;
-      EffectParameters p = shape;
-      p[amp->name] = amp->nominal;
-      c.label = info.id;
-      for (const auto& [k, v] : shape) c.label += " (" + k + " " + num(v) + ")";
-      const Variant var = run_variant(vehicle, cycles, d, {make_effect(info.id, p, ctx)});
-      c.signature = (var.window_j - base.window_j) / amp->nominal;
-      if (c.signature.norm() > 0.0) cands.push_back(std::move(c));
-    }
-  }
 
   // Forward selection: add the candidate with the largest BIC gain while it passes the threshold and improves
   // the held-out fit; confounded if another candidate's cleaned signature is nearly collinear and also passes.
   Eigen::MatrixXd x = xc;
   double rss = cal.rss;
+  Eigen::VectorXd coef_final = cal.coef;
   std::vector<std::string> chosen_ids;
   Eigen::VectorXd pred_before = cal_pred;
-  auto cleaned = [&](const Eigen::MatrixXd& basis, const Eigen::VectorXd& s) {
-    const Eigen::VectorXd c = basis.colPivHouseholderQr().solve(s);
-    return Eigen::VectorXd(s - basis * c);
+  auto cleaned = [&](const Eigen::MatrixXd& basis_m, const Eigen::VectorXd& s) {
+    const Eigen::VectorXd c = basis_m.colPivHouseholderQr().solve(s);
+    return Eigen::VectorXd(s - basis_m * c);
   };
+  const double inflate = std::sqrt(static_cast<double>(n) / n_eff);  // autocorrelated windows carry less information
   for (int round = 0; round < opt.max_effects; ++round) {
     struct Scored {
       std::size_t idx;
@@ -381,7 +552,7 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
       const double dbic = n_eff * std::log(rss / f.rss) - std::log(n_eff);
       const double amp = f.coef[f.coef.size() - 1] / f.coef[0];  // in the simulated channel's scale
       if (dbic < opt.bic_threshold || amp < cands[k].amp_min || amp > cands[k].amp_max) continue;
-      Eigen::VectorXd pred = heldout_prediction(xk, d.measured_j, opt.block_windows, prior);
+      Eigen::VectorXd pred = heldout_prediction(xk, d.measured_j, fold_of, prior);
       if (rmse(pred, d.measured_j) >= rmse(pred_before, d.measured_j)) continue;
       passing.push_back({k, dbic, f, pred});
     }
@@ -393,7 +564,6 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
     fnd.effect = c.id;
     fnd.delta_bic = best.dbic;
     const Eigen::Index j = best.fit.coef.size() - 1;
-    const double inflate = std::sqrt(static_cast<double>(n) / n_eff);  // autocorrelated windows carry less information
     const double se = std::sqrt(std::max(0.0, best.fit.cov(j, j))) * inflate;
     // The signature is per unit amplitude of the measured channel's scale 1; divide by the channel scale.
     const double s = best.fit.coef[0];
@@ -422,12 +592,138 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
     fnd.heldout_energy_error_pct_after = energy_error_pct(best.pred, d.measured_j);
     x = hcat(x, c.signature);
     rss = best.fit.rss;
+    coef_final = best.fit.coef;
     pred_before = best.pred;
     chosen_ids.push_back(c.id);
     out.findings.push_back(std::move(fnd));
   }
+
+  // Unexplained: what the catalogue left, if still significant by the same BIC threshold and held-out test,
+  // described by the basis shape that explains most of it.
+  {
+    int best_k = -1;
+    double best_dbic = opt.bic_threshold;
+    Fit best_fit;
+    Eigen::VectorXd best_pred;
+    for (std::size_t k = 0; k < basis.size(); ++k) {
+      if (basis[k].signature.norm() <= 0.0) continue;
+      const Eigen::MatrixXd xk = hcat(x, basis[k].signature);
+      const Fit f = least_squares(xk, d.measured_j, prior);
+      if (f.rss <= 0.0) continue;
+      const double dbic = n_eff * std::log(rss / f.rss) - std::log(n_eff);
+      if (dbic <= best_dbic) continue;
+      Eigen::VectorXd pred = heldout_prediction(xk, d.measured_j, fold_of, prior);
+      if (rmse(pred, d.measured_j) >= rmse(pred_before, d.measured_j)) continue;
+      best_k = static_cast<int>(k);
+      best_dbic = dbic;
+      best_fit = f;
+      best_pred = pred;
+    }
+    if (best_k >= 0) {
+      const BasisShape& b = basis[static_cast<std::size_t>(best_k)];
+      Finding fnd;
+      fnd.effect = "unexplained";
+      fnd.delta_bic = best_dbic;
+      const Eigen::Index j = best_fit.coef.size() - 1;
+      const double s = best_fit.coef[0];
+      const double value = best_fit.coef[j] / s;
+      const double se = std::sqrt(std::max(0.0, best_fit.cov(j, j))) * inflate / std::abs(s);
+      double vmax = 0.0;
+      for (const auto& r : recordings)
+        for (double v : r.speed_mps) vmax = std::max(vmax, v);
+      const double vref_kmh = vmax > 90.0 / 3.6 ? 100.0 : 50.0;
+      const double at_ref = [&] {
+        const double u = vref_kmh / 100.0;
+        return b.shape == ForceShape::speed ? u : b.shape == ForceShape::speed_squared ? u * u : 1.0;
+      }();
+      std::string what, size_text, name, unit;
+      const double share_pct = 100.0 * best_fit.coef[j] * b.signature.sum() / std::max(1e-9, std::abs(d.measured_j.sum()));
+      if (b.kind == BasisShape::power) {
+        what = "a constant power at the " + d.channel + " channel";
+        size_text = "about " + fixed(value, 0) + " W";
+        name = "power";
+        unit = "W";
+      } else if (b.shape == ForceShape::positive_accel) {
+        what = "a force proportional to acceleration, when accelerating only";
+        size_text = "about " + fixed(value, 0) + " N at 1 m/s^2 (as if " + fixed(value, 0) + " kg more mass had to be accelerated but none came back in braking)";
+        name = "force_per_positive_accel";
+        unit = "N s^2/m";
+      } else if (b.shape == ForceShape::constant) {
+        what = "a constant force while moving";
+        size_text = "about " + fixed(value, 0) + " N";
+        name = "force";
+        unit = "N";
+      } else {
+        what = b.shape == ForceShape::speed ? "a force proportional to speed" : "a force proportional to speed squared";
+        size_text = "about " + fixed(value * at_ref, 0) + " N at " + fixed(vref_kmh, 0) + " km/h";
+        name = "force_at_100kmh";
+        unit = "N";
+      }
+      fnd.parameters.push_back({name, unit, value, value - 1.96 * se, value + 1.96 * se});
+      std::string when;
+      if (b.decay_s > 0.0) {
+        fnd.parameters.push_back({"decay_time_constant_s", "s", b.decay_s, b.decay_s, b.decay_s});
+        // "Mostly in the first N minutes": when 80 % of the signature's energy has accrued (windows by end time).
+        std::vector<std::pair<double, double>> by_end;
+        for (Eigen::Index w = 0; w < n; ++w)
+          by_end.push_back({d.windows[static_cast<std::size_t>(w)].end < cycles[d.windows[static_cast<std::size_t>(w)].rec].time_s.size()
+                                ? cycles[d.windows[static_cast<std::size_t>(w)].rec].time_s[d.windows[static_cast<std::size_t>(w)].end]
+                                : 0.0,
+                            std::abs(b.signature[w])});
+        std::sort(by_end.begin(), by_end.end());
+        double total = 0.0, cum = 0.0, t80 = 0.0;
+        for (const auto& p : by_end) total += p.second;
+        for (const auto& p : by_end) {
+          cum += p.second;
+          t80 = p.first;
+          if (cum >= 0.8 * total) break;
+        }
+        when = ", decaying from the start of the trip with a time constant of about " + fixed(b.decay_s / 60.0, 0) +
+               " min: mostly (80 %) in the first " + fixed(std::ceil(t80 / 60.0), 0) + " min";
+      }
+      fnd.description = what + ", " + size_text + when + "; " + fixed(share_pct, 1) + " % of the measured energy, beside a channel scale of " +
+                        fixed(s, 3);
+      if (!vehicle.is_electric() && b.decay_s == 0.0)
+        fnd.description += ". The combustion engine is a Willans line with no efficiency map: efficiency changing with "
+                           "load and speed (enrichment at high load, pumping loss at low load) has no module to name, and shows up this way";
+      fnd.heldout_rmse_before_j = rmse(pred_before, d.measured_j);
+      fnd.heldout_rmse_after_j = rmse(best_pred, d.measured_j);
+      fnd.heldout_energy_error_pct_before = energy_error_pct(pred_before, d.measured_j);
+      fnd.heldout_energy_error_pct_after = energy_error_pct(best_pred, d.measured_j);
+      x = hcat(x, b.signature);
+      coef_final = best_fit.coef;
+      out.findings.push_back(std::move(fnd));
+    }
+  }
   if (out.findings.empty()) out.verdict = "nothing_missing";
   else out.verdict = out.findings.front().confounded_with.empty() ? "missing_physics" : "confounded";
+
+  // Per-window series for figures.
+  {
+    const Eigen::VectorXd calibrated = xc * cal.coef, fitted = x * coef_final;
+    for (Eigen::Index w = 0; w < n; ++w) {
+      const auto& win = d.windows[static_cast<std::size_t>(w)];
+      const Recording& r = recordings[win.rec];
+      DiagnosisWindow dw;
+      dw.recording = static_cast<int>(win.rec);
+      dw.start_s = r.time_s[win.begin] - r.time_s.front();
+      dw.end_s = r.time_s[win.end] - r.time_s.front();
+      double sv = 0.0, sa = 0.0, T = 0.0;
+      for (std::size_t i = win.begin; i < win.end; ++i) {
+        const double dt = d.dt_s[win.rec][i];
+        sv += 0.5 * (r.speed_mps[i] + r.speed_mps[i + 1]) * dt;
+        sa += std::max(0.0, r.speed_mps[i + 1] - r.speed_mps[i]);
+        T += dt;
+      }
+      dw.mean_speed_mps = sv / std::max(1e-9, T);
+      dw.mean_positive_accel_mps2 = sa / std::max(1e-9, T);
+      dw.measured_j = d.measured_j[w];
+      dw.simulated_j = base.window_j[w];
+      dw.calibrated_j = calibrated[w];
+      dw.fitted_j = fitted[w];
+      out.series.push_back(dw);
+    }
+  }
 
   // Locate: per-sample residual of the calibrated model, by regime, with a normal interval on an effective n.
   if (d.channel != "soc") {
@@ -470,6 +766,18 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
   return out;
 }
 
+namespace {
+std::string json_escape(const std::string& s) {
+  std::string o;
+  for (char c : s) {
+    if (c == '"' || c == '\\') o += '\\';
+    if (c == '\n') { o += "\\n"; continue; }
+    o += c;
+  }
+  return o;
+}
+}  // namespace
+
 std::string diagnosis_json(const Diagnosis& d) {
   std::ostringstream os;
   os << "{\n  \"verdict\": \"" << d.verdict << "\",\n  \"channel\": \"" << d.channel << "\",\n";
@@ -483,7 +791,9 @@ std::string diagnosis_json(const Diagnosis& d) {
   os << "  \"findings\": [";
   for (std::size_t i = 0; i < d.findings.size(); ++i) {
     const auto& f = d.findings[i];
-    os << (i ? "," : "") << "\n    {\"effect\": \"" << f.effect << "\", \"parameters\": {";
+    os << (i ? "," : "") << "\n    {\"effect\": \"" << f.effect << "\", ";
+    if (!f.description.empty()) os << "\"description\": \"" << json_escape(f.description) << "\", ";
+    os << "\"parameters\": {";
     for (std::size_t k = 0; k < f.parameters.size(); ++k) {
       const auto& p = f.parameters[k];
       os << (k ? ", " : "") << "\"" << p.name << "\": {\"value\": " << num(p.value) << ", \"ci_low\": " << num(p.ci_low)
@@ -512,6 +822,7 @@ std::string diagnosis_text(const Diagnosis& d) {
   os.precision(3);
   os << "channel " << d.channel << ", " << d.windows << " windows (effective " << d.effective_windows
      << ", lag-1 autocorrelation " << d.lag1_autocorrelation << ")\n";
+  for (const auto& note : d.notes) os << note << "\n";
   os << "channel lag: " << d.lag_samples << " samples\n";
   os << "uncalibrated trip energy error: " << d.raw_trip_energy_error_pct << " %\n";
   os << "calibration: channel scale " << d.channel_scale << ", RRC level " << 100 * d.rrc_level_change << " %, aero C "
@@ -526,6 +837,7 @@ std::string diagnosis_text(const Diagnosis& d) {
       for (const auto& c : f.confounded_with) os << " " << c;
     }
     os << "\n";
+    if (!f.description.empty()) os << "    " << f.description << "\n";
     for (const auto& p : f.parameters)
       os << "    " << p.name << " = " << p.value << " [" << p.ci_low << ", " << p.ci_high << "] " << p.unit << "\n";
     os << "    held-out RMSE " << f.heldout_rmse_before_j / 1e3 << " -> " << f.heldout_rmse_after_j / 1e3
@@ -549,7 +861,8 @@ std::string fitted_vehicle_yaml(const std::string& vehicle_path, const Diagnosis
   for (std::string line; std::getline(lines, line);)
     if (line.rfind("effects:", 0) == 0) throw InputError(vehicle_path, "already has an effects: block; remove it to write a fitted one");
   std::vector<std::pair<std::string, EffectParameters>> eff;
-  for (const auto& f : d.findings) eff.emplace_back(f.effect, f.fitted);
+  for (const auto& f : d.findings)
+    if (f.effect != "unexplained") eff.emplace_back(f.effect, f.fitted);  // described, not a module
   if (!text.empty() && text.back() != '\n') text += '\n';
   text += "# effects fitted by rollsim diagnose (verdict: " + d.verdict + ")\n";
   if (eff.empty()) return text;

@@ -18,6 +18,12 @@ struct DiagnoseOptions {
   double collinear_corr = 0.9;     ///< |corr| of calibration-cleaned signatures above which effects are confounded
   int max_effects = 2;
   double calibration_prior_fraction = 0.15;  ///< prior sd of the RRC-level and aero-C calibration changes
+  /// SOC channels: windows are lengthened until the SOC quantisation error of a window's energy (sd q / sqrt 6
+  /// for two quantised readings) is at most this fraction of the mean window energy.
+  double soc_quantisation_fraction = 0.02;
+  /// Unexplained-residual basis: time constants of the early-trip decay shapes [s].
+  std::vector<double> unexplained_decay_s{300.0, 900.0, 1800.0};
+  unsigned threads = 0;  ///< simulator runs in parallel (0: hardware concurrency)
 };
 
 struct ParameterEstimate {
@@ -26,7 +32,8 @@ struct ParameterEstimate {
 };
 
 struct Finding {
-  std::string effect;  ///< catalogue identifier
+  std::string effect;  ///< catalogue identifier, or "unexplained" (described by its signature)
+  std::string description;  ///< in words, with the fitted numbers (unexplained findings)
   std::vector<ParameterEstimate> parameters;
   std::vector<std::string> confounded_with;
   double delta_bic = 0.0;
@@ -39,6 +46,18 @@ struct RegimeResidual {
   std::string regime;
   int samples = 0;
   double mean_w = 0.0, ci_low_w = 0.0, ci_high_w = 0.0;  ///< measured minus calibrated model, 95 % (effective n)
+};
+
+/// One energy window, for figures: what was measured and what the model said before and after the findings.
+struct DiagnosisWindow {
+  int recording = 0;
+  double start_s = 0.0, end_s = 0.0;  ///< since the start of its recording
+  double mean_speed_mps = 0.0;
+  double mean_positive_accel_mps2 = 0.0;  ///< mean of max(0, a) over the window
+  double measured_j = 0.0;
+  double simulated_j = 0.0;   ///< uncalibrated model
+  double calibrated_j = 0.0;  ///< calibrated model (in-sample)
+  double fitted_j = 0.0;      ///< calibrated model with the findings' effects (in-sample)
 };
 
 struct Diagnosis {
@@ -56,6 +75,9 @@ struct Diagnosis {
   double heldout_energy_error_pct_calibrated = 0.0;
   std::vector<Finding> findings;
   std::vector<RegimeResidual> located;
+  double window_s = 0.0;            ///< window length used (SOC: lengthened by the quantum)
+  std::vector<std::string> notes;   ///< preparation done on the data (grade from elevation, SOC quantum)
+  std::vector<DiagnosisWindow> series;
 };
 
 /// Replays each recording's speed (and grade) through the vehicle, compares energies per window, calibrates,

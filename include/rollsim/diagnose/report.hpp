@@ -1,0 +1,19 @@
+// `rollsim diagnose --report DIR`: figures (gnuplot SVG) of a diagnosis and a self-contained HTML page.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "rollsim/diagnose/diagnose.hpp"
+
+namespace rollsim {
+
+/// Files written into DIR, each atomically (temporary + rename): energy.svg (measured against simulated mean
+/// power per window), cumulative.svg (cumulative residual over time), residual_speed.svg, residual_accel.svg,
+/// residual_time.svg (window residual against each signature variable), each before and after the findings'
+/// effects, and report.html embedding the SVGs inline with the text and JSON summaries. Creates DIR if missing.
+/// Throws InputError (naming `--report` and DIR) when DIR cannot be created or written, or gnuplot is missing
+/// or fails. Returns the paths written.
+std::vector<std::string> write_diagnosis_report(const std::string& dir, const Diagnosis& d, const std::string& title);
+
+}  // namespace rollsim

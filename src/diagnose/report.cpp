@@ -1,0 +1,167 @@
+// Diagnosis report: per-window data to gnuplot (SVG), and one HTML page with the SVGs inline.
+#include "rollsim/diagnose/report.hpp"
+
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "rollsim/common/atomic_file.hpp"
+#include "rollsim/common/error.hpp"
+
+namespace rollsim {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string find_gnuplot() {
+  const char* path = std::getenv("PATH");
+  std::stringstream ss(path ? path : "");
+  for (std::string dir; std::getline(ss, dir, ':');) {
+    const std::string p = (dir.empty() ? "." : dir) + "/gnuplot";
+    if (access(p.c_str(), X_OK) == 0) return p;
+  }
+  return "";
+}
+
+std::string shell_quote(const std::string& s) {
+  std::string o = "'";
+  for (char c : s) o += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return o + "'";
+}
+
+std::string gp_escape(const std::string& s) {
+  std::string o;
+  for (char c : s) o += c == '\'' ? std::string("''") : std::string(1, c);
+  return o;
+}
+
+std::string html_escape(const std::string& s) {
+  std::string o;
+  for (char c : s) {
+    if (c == '<') o += "&lt;";
+    else if (c == '>') o += "&gt;";
+    else if (c == '&') o += "&amp;";
+    else o += c;
+  }
+  return o;
+}
+
+std::string read_all(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+struct Figure {
+  std::string file, caption, script;
+};
+
+}  // namespace
+
+std::vector<std::string> write_diagnosis_report(const std::string& dir, const Diagnosis& d, const std::string& title) {
+  const std::string where = "--report '" + dir + "'";
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (!fs::is_directory(dir) || access(dir.c_str(), W_OK) != 0)
+    throw InputError(where, "cannot create or write to this folder" + (ec ? ": " + ec.message() : std::string()));
+  const std::string gnuplot = find_gnuplot();
+  if (gnuplot.empty())
+    throw InputError(where, "gnuplot is not installed or not on PATH (Debian: apt-get install gnuplot-nox); "
+                            "the text and --json output do not need it");
+  if (d.series.empty()) throw InputError(where, "the diagnosis has no windows to draw");
+
+  const fs::path work = fs::temp_directory_path() / ("rollsim_report_" + std::to_string(getpid()) + "_" +
+                                                     std::to_string(reinterpret_cast<std::uintptr_t>(&d)));
+  fs::create_directories(work);
+  // Columns: 1 time on a concatenated axis [min], 2 measured, 3 simulated, 4 calibrated, 5 fitted mean power [W],
+  // 6 cumulative residual before [kJ], 7 after [kJ], 8 mean speed [km/h], 9 mean positive accel [m/s^2],
+  // 10 time since the start of its recording [min], 11 residual power before [W], 12 after [W].
+  {
+    std::ofstream data(work / "windows.dat");
+    double offset_s = 0.0, prev_end = 0.0, cum_before = 0.0, cum_after = 0.0;
+    int rec = d.series.front().recording;
+    for (const auto& w : d.series) {
+      if (w.recording != rec) {
+        offset_s += prev_end;
+        rec = w.recording;
+      }
+      prev_end = w.end_s;
+      const double dur = std::max(1e-9, w.end_s - w.start_s);
+      cum_before += (w.measured_j - w.calibrated_j) / 1e3;
+      cum_after += (w.measured_j - w.fitted_j) / 1e3;
+      data << (offset_s + 0.5 * (w.start_s + w.end_s)) / 60.0 << " " << w.measured_j / dur << " " << w.simulated_j / dur << " "
+           << w.calibrated_j / dur << " " << w.fitted_j / dur << " " << cum_before << " " << cum_after << " "
+           << 3.6 * w.mean_speed_mps << " " << w.mean_positive_accel_mps2 << " " << 0.5 * (w.start_s + w.end_s) / 60.0 << " "
+           << (w.measured_j - w.calibrated_j) / dur << " " << (w.measured_j - w.fitted_j) / dur << "\n";
+    }
+  }
+  const std::string dat = "'" + gp_escape((work / "windows.dat").string()) + "'";
+  const std::string after = d.findings.empty() ? "after (no findings: same as before)" : "after the findings' effects";
+  std::vector<Figure> figs{
+      {"energy.svg", "Measured against simulated mean power per window (" + d.channel + " channel)",
+       "set xlabel 'time, recordings one after another [min]'\nset ylabel 'mean power per window [W]'\nplot " + dat +
+           " u 1:2 w lp pt 7 ps 0.5 lw 2 t 'measured', " + dat + " u 1:3 w l lw 1 dt 2 t 'simulated (nominal)', " + dat +
+           " u 1:4 w l lw 2 t 'calibrated', " + dat + " u 1:5 w l lw 2 t '" + after + "'\n"},
+      {"cumulative.svg", "Cumulative residual (measured minus model) over time",
+       "set xlabel 'time, recordings one after another [min]'\nset ylabel 'cumulative residual energy [kJ]'\nplot " + dat +
+           " u 1:6 w l lw 2 t 'before (calibrated)', " + dat + " u 1:7 w l lw 2 t '" + after + "'\n"},
+      {"residual_speed.svg", "Window residual against mean speed",
+       "set xlabel 'mean speed in the window [km/h]'\nset ylabel 'residual mean power [W]'\nplot " + dat +
+           " u 8:11 w p pt 7 ps 0.6 t 'before', " + dat + " u 8:12 w p pt 6 ps 0.6 t '" + after + "', 0 w l lc 'black' notitle\n"},
+      {"residual_accel.svg", "Window residual against mean positive acceleration",
+       "set xlabel 'mean of max(0, a) in the window [m/s^2]'\nset ylabel 'residual mean power [W]'\nplot " + dat +
+           " u 9:11 w p pt 7 ps 0.6 t 'before', " + dat + " u 9:12 w p pt 6 ps 0.6 t '" + after + "', 0 w l lc 'black' notitle\n"},
+      {"residual_time.svg", "Window residual against time since the start of its recording",
+       "set xlabel 'time since the start of the recording [min]'\nset ylabel 'residual mean power [W]'\nplot " + dat +
+           " u 10:11 w p pt 7 ps 0.6 t 'before', " + dat + " u 10:12 w p pt 6 ps 0.6 t '" + after + "', 0 w l lc 'black' notitle\n"},
+  };
+  std::vector<std::string> svgs;
+  for (const auto& f : figs) {
+    const fs::path out = work / f.file;
+    {
+      std::ofstream gp(work / "plot.gp");
+      gp << "set terminal svg size 800,450 dynamic font 'Sans,11'\nset output '" << gp_escape(out.string()) << "'\n"
+         << "set title '" << gp_escape(f.caption) << "'\nset grid\nset key outside bottom center horizontal\n" << f.script;
+    }
+    const std::string cmd = shell_quote(gnuplot) + " " + shell_quote((work / "plot.gp").string()) + " 2>" +
+                            shell_quote((work / "gnuplot.err").string());
+    if (std::system(cmd.c_str()) != 0) {
+      const std::string err = read_all(work / "gnuplot.err");
+      fs::remove_all(work, ec);
+      throw InputError(where, "gnuplot failed on " + f.file + ": " + err);
+    }
+    svgs.push_back(read_all(out));
+  }
+  fs::remove_all(work, ec);
+
+  std::vector<std::string> written;
+  for (std::size_t k = 0; k < figs.size(); ++k) {
+    const std::string path = (fs::path(dir) / figs[k].file).string();
+    write_file_atomically(path, "--report", [&](std::ostream& os) { os << svgs[k]; });
+    written.push_back(path);
+  }
+  const std::string html_path = (fs::path(dir) / "report.html").string();
+  write_file_atomically(html_path, "--report", [&](std::ostream& os) {
+    os << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>" << html_escape(title)
+       << "</title>\n<style>body{font-family:sans-serif;max-width:900px;margin:auto}pre{background:#f4f4f4;padding:8px;"
+          "overflow-x:auto}figure{margin:1em 0}</style></head><body>\n<h1>"
+       << html_escape(title) << "</h1>\n<h2>Verdict: " << html_escape(d.verdict) << "</h2>\n<pre>" << html_escape(diagnosis_text(d))
+       << "</pre>\n";
+    for (std::size_t k = 0; k < figs.size(); ++k) {
+      // Inline SVG: drop the XML prolog and doctype, which are not allowed inside HTML.
+      const std::string& s = svgs[k];
+      const auto at = s.find("<svg");
+      os << "<figure>\n" << (at == std::string::npos ? s : s.substr(at)) << "\n<figcaption>" << html_escape(figs[k].caption)
+         << "</figcaption></figure>\n";
+    }
+    os << "<h2>JSON</h2>\n<pre>" << html_escape(diagnosis_json(d)) << "</pre>\n</body></html>\n";
+  });
+  written.push_back(html_path);
+  return written;
+}
+
+}  // namespace rollsim
