@@ -1,7 +1,12 @@
-// Synthetic recordings with a concealed effect: the truth is a richer model than the catalogue's, on its own code.
+// Synthetic recordings with concealed effects: each truth is a richer model than the catalogue's, on its own code.
+#include "rollsim/diagnose/generate.hpp"
+
+#include <algorithm>
 #include <cmath>
 #include <random>
 
+#include "rollsim/common/error.hpp"
+#include "rollsim/common/units.hpp"
 #include "rollsim/cycle/drive_cycle.hpp"
 #include "rollsim/diagnose/diagnose.hpp"
 #include "rollsim/sim/simulation.hpp"
@@ -9,14 +14,27 @@
 namespace rollsim {
 namespace {
 
+constexpr double kG = units::kStandardGravity_mps2;
+constexpr double kTwoPi = 6.283185307179586;
+
+// The truth's RRC level (within the tyres' spec tolerance): a calibration quantity, never a discovery.
+class RrcLevelTruth final : public Effect {
+ public:
+  explicit RrcLevelTruth(double level) : level_(level) {}
+  std::string id() const override { return "truth_rrc_level"; }
+  double rolling_resistance_factor(const EffectInputs&, const double*) const override { return level_; }
+
+ private:
+  double level_;
+};
+
 // Truth tyre: two thermal nodes (tread, carcass). Hysteresis loss heats both (60/40); the tread convects to air
 // with h ~ (1 + v/v0)^0.8 (turbulent forced convection) and conducts to the carcass; the carcass loses little.
 // RRC follows an exponential law in a weighted temperature (not the catalogue's linear-to-warm law). The
 // time_reversed option warms the tyre at the start and lets it cool (RRC rises) towards the end instead.
 class TwoNodeTyreTruth final : public Effect {
  public:
-  TwoNodeTyreTruth(double excess, double rrc_level, bool reversed, double duration_s)
-      : excess_(excess), level_(rrc_level), reversed_(reversed), duration_s_(duration_s) {}
+  TwoNodeTyreTruth(double excess, bool reversed, double duration_s) : excess_(excess), reversed_(reversed), duration_s_(duration_s) {}
   std::string id() const override { return "truth_two_node_tyre"; }
   int num_states() const override { return 2; }
   void state_derivatives(const EffectInputs& in, const double* x, double* xdot) const override {
@@ -31,37 +49,249 @@ class TwoNodeTyreTruth final : public Effect {
     double cold = std::exp(-(0.4 * x[0] + 0.6 * x[1]) / 12.0);
     // Reversed null: the same-sized transient mirrored in time (decay placed at the end).
     if (reversed_) cold = std::exp(-std::max(0.0, duration_s_ - in.time_s) / 700.0);
-    return level_ * (1.0 + excess_ * cold);
+    return 1.0 + excess_ * cold;
   }
 
  private:
-  double excess_, level_;
+  double excess_;
   bool reversed_;
   double duration_s_;
 };
 
-}  // namespace
+// Truth auxiliary load: an A/C compressor cycling on and off (period 240-360 s, 40 % duty, random phase) plus a
+// blower at a quarter of the mean, not the catalogue's constant load. `mean_w` is the time-averaged power.
+class CompressorTruth final : public Effect {
+ public:
+  CompressorTruth(double mean_w, double period_s, double phase_s)
+      : blower_w_(0.25 * mean_w), on_w_(0.75 * mean_w / 0.4), period_s_(period_s), phase_s_(phase_s) {}
+  std::string id() const override { return "truth_compressor"; }
+  double extra_electric_power_w(const EffectInputs& in, const double*) const override {
+    const double u = std::fmod(in.time_s + phase_s_, period_s_) / period_s_;
+    return blower_w_ + (u < 0.4 ? on_w_ : 0.0);
+  }
 
-Recording generate_recording(const Vehicle& vehicle, const SyntheticOptions& o) {
-  std::mt19937 rng(o.seed);
-  std::uniform_real_distribution<double> unit(-1.0, 1.0);
-  const DriveCycle one = load_cycle(o.cycle);
-  DriveCycle c;
-  c.name = o.cycle + " x" + std::to_string(o.repeats);
-  for (int k = 0; k < o.repeats; ++k) {
-    const double t0 = c.time_s.empty() ? 0.0 : c.time_s.back() + 1.0;
-    for (std::size_t i = 0; i < one.time_s.size(); ++i) {
-      c.time_s.push_back(t0 + one.time_s[i] - one.time_s.front());
-      c.speed_mps.push_back(one.speed_mps[i]);
-      c.grade.push_back(0.0);
+ private:
+  double blower_w_, on_w_, period_s_, phase_s_;
+};
+
+// Truth wind: a mean headwind with gusts (Ornstein-Uhlenbeck, sd 1.5 m/s, correlation time 15 s) sampled on a 1 s
+// grid, at a road heading that turns slowly (the headwind component is u cos(psi)).
+class GustyWindTruth final : public Effect {
+ public:
+  GustyWindTruth(double mean_mps, double rho_cda, double duration_s, std::mt19937& rng) : k_(0.5 * rho_cda) {
+    std::normal_distribution<double> n(0.0, 1.0);
+    const double tau = 15.0, sd = 1.5, a = std::exp(-1.0 / tau);
+    const double heading_period_s = 1500.0 + 1000.0 * std::uniform_real_distribution<double>(0.0, 1.0)(rng);
+    double gust = 0.0;
+    for (int i = 0; i <= static_cast<int>(duration_s) + 2; ++i) {
+      gust = a * gust + sd * std::sqrt(1.0 - a * a) * n(rng);
+      const double heading = 0.5 * std::sin(kTwoPi * i / heading_period_s);  // +-0.5 rad of road bends
+      u_.push_back((mean_mps + gust) * std::cos(heading));
     }
   }
-  VehicleModel model = VehicleModel::assemble(vehicle);
+  std::string id() const override { return "truth_gusty_wind"; }
+  double extra_resistance_n(const EffectInputs& in, const double*) const override {
+    const double v = std::max(in.speed_mps, 0.0);
+    if (v <= 0.0) return 0.0;
+    const auto i = static_cast<std::size_t>(std::clamp(in.time_s, 0.0, static_cast<double>(u_.size() - 1)));
+    const double rel = v + u_[i];
+    return k_ * (rel * std::abs(rel) - v * v);
+  }
+
+ private:
+  double k_;
+  std::vector<double> u_;
+};
+
+// Truth payload: `extra_kg` aboard until the standstill nearest mid-trip, where 60 % of it gets out. Its rolling
+// share follows the tyres' load law RR ~ Fz^0.9 (rolling resistance grows less than linearly with load).
+class PayloadTruth final : public Effect {
+ public:
+  PayloadTruth(double extra_kg, double mass_kg, double drop_time_s) : dm_(extra_kg), m_(mass_kg), drop_s_(drop_time_s) {}
+  std::string id() const override { return "truth_payload"; }
+  double extra_resistance_n(const EffectInputs& in, const double*) const override {
+    const double dm = in.time_s < drop_s_ ? dm_ : 0.4 * dm_;
+    const double rolling = in.base_rolling_force_n * (std::pow(1.0 + dm / m_, 0.9) - 1.0);
+    return dm * (in.accel_mps2 + kG * std::sin(std::atan(in.grade))) + rolling;
+  }
+
+ private:
+  double dm_, m_, drop_s_;
+};
+
+// Truth rotating parts: wheels (60 %) act at the road; the motor rotor (40 %) is spun through the reduction, so its
+// kinetic energy passes the gear losses both ways (1/eta accelerating, eta braking).
+class RotatingPartsTruth final : public Effect {
+ public:
+  RotatingPartsTruth(double equivalent_kg, double gear_eff) : wheels_(0.6 * equivalent_kg), rotor_(0.4 * equivalent_kg), eta_(gear_eff) {}
+  std::string id() const override { return "truth_rotating_parts"; }
+  double extra_resistance_n(const EffectInputs& in, const double*) const override {
+    const double a = in.accel_mps2;
+    return wheels_ * a + rotor_ * a * (a > 0.0 ? 1.0 / eta_ : eta_);
+  }
+
+ private:
+  double wheels_, rotor_, eta_;
+};
+
+// Truth tyre slip: a Pacejka-like magic formula per tyre, F = D sin(C atan(B s)) (C = 1.65, D = mu Fz, mu = 1),
+// saturating, inverted for the slip s at each force; traction on the two driven tyres, braking on all four.
+// `compliance_per_kn` is the car's initial slip per kN on the driven axle (the catalogue's slope at F -> 0).
+class MagicFormulaSlipTruth final : public Effect {
+ public:
+  MagicFormulaSlipTruth(double compliance_per_kn, double axle_load_n, double total_load_n)
+      : cx_per_tyre_n_(1000.0 / (2.0 * compliance_per_kn)), fz_driven_(axle_load_n / 2.0), fz_all_(total_load_n / 4.0) {}
+  std::string id() const override { return "truth_magic_formula_slip"; }
+  double wheel_loss_w(const EffectInputs& in, const double*) const override {
+    const double f = in.wheel_force_demand_n, v = std::max(in.speed_mps, 0.0);
+    if (f == 0.0 || v <= 0.0) return 0.0;
+    const int tyres = f > 0.0 ? 2 : 4;
+    const double fz = f > 0.0 ? fz_driven_ : fz_all_;
+    const double s = slip(std::abs(f) / tyres, fz);
+    return std::abs(f) * s * v;
+  }
+
+ private:
+  double slip(double fx, double fz) const {
+    constexpr double c = 1.65;
+    const double d = fz, b = cx_per_tyre_n_ / (c * d);
+    const double s_peak = std::tan(kTwoPi / 4.0 / c) / b;  // C atan(B s) = pi/2
+    if (fx >= d) return s_peak;
+    double lo = 0.0, hi = s_peak;
+    for (int k = 0; k < 40; ++k) {
+      const double mid = 0.5 * (lo + hi);
+      (d * std::sin(c * std::atan(b * mid)) < fx ? lo : hi) = mid;
+    }
+    return 0.5 * (lo + hi);
+  }
+  double cx_per_tyre_n_, fz_driven_, fz_all_;
+};
+
+DriveCycle steady_cruise(std::mt19937& rng) {
+  // An hour at 90 km/h with a slow +-1 km/h drift, 60 s ramps at both ends: speed hardly varies.
+  DriveCycle c;
+  c.name = "steady";
+  const double v0 = 25.0, phase = std::uniform_real_distribution<double>(0.0, kTwoPi)(rng);
+  for (int t = 0; t <= 3720; ++t) {
+    double v = v0 + (1.0 / 3.6) * std::sin(kTwoPi * t / 600.0 + phase);
+    if (t < 60) v *= t / 60.0;
+    if (t > 3660) v *= (3720 - t) / 60.0;
+    c.time_s.push_back(t);
+    c.speed_mps.push_back(std::max(0.0, v));
+    c.grade.push_back(0.0);
+  }
+  return c;
+}
+
+// The time of the standstill nearest the middle of the trace (the middle itself when it never stops).
+double middle_stop_s(const DriveCycle& c) {
+  const double mid = 0.5 * (c.time_s.front() + c.time_s.back());
+  double best = mid, dist = 1e300;
+  for (std::size_t i = 0; i < c.time_s.size(); ++i)
+    if (c.speed_mps[i] <= 0.0 && std::abs(c.time_s[i] - mid) < dist) dist = std::abs(c.time_s[i] - mid), best = c.time_s[i];
+  return best;
+}
+
+}  // namespace
+
+const std::vector<ConcealedTruthInfo>& concealed_truths() {
+  static const std::vector<ConcealedTruthInfo> kTruths{
+      {"tyre_two_node", "tyre_warmup", "1 (cold RRC excess)",
+       "two-node (tread, carcass) heat network, convection ~ (1 + v/8)^0.8, exponential RRC law", {0.05, 0.1, 0.2, 0.3}},
+      {"aux_compressor", "aux_load", "W (mean)", "A/C compressor cycling 40 % duty (period 240-360 s) plus blower", {150, 300, 600}},
+      {"wind_gusty", "wind", "m/s (mean headwind)", "mean headwind + OU gusts (sd 1.5 m/s, 15 s) on a slowly turning road", {1.5, 3, 5}},
+      {"payload_drop", "mass", "kg (before the drop)", "payload, 60 % leaves at the mid-trip stop; rolling share ~ load^0.9", {75, 150, 300}},
+      {"rotating_parts", "rotational_inertia", "kg (equivalent)", "wheels 60 %, rotor 40 % through the reduction (gear loss both ways)", {40, 80, 160}},
+      {"magic_formula_slip", "tyre_slip", "1/kN (initial compliance)", "Pacejka sin(C atan(B s)) per tyre, saturating; braking on four tyres", {0.005, 0.01, 0.02}},
+      {"underinflated", "rr_speed", "bar (pressure change)", "tyre pressure lowered in the tyre model (level and speed curve change)", {-0.3, -0.6, -0.9}},
+      {"regen_cap", "regen_limit", "W (regen power limit)", "the powertrain's own regen limit lowered from 20 kW", {12000, 8000, 4000}},
+      {"hilly_climb", "road_grade", "1 (net grade)", "net climb plus unrecorded hills (1 % amplitude, 0.8-3 km wavelengths)", {0.002, 0.005, 0.01}},
+  };
+  return kTruths;
+}
+
+const ConcealedTruthInfo& concealed_truth(const std::string& truth) {
+  for (const auto& t : concealed_truths())
+    if (t.truth == truth) return t;
+  throw InputError("concealed truth '" + truth + "'", "is not one of the generator's truths");
+}
+
+Recording generate_case(const Vehicle& vehicle, const SyntheticCase& o) {
+  std::mt19937 rng(o.seed);
+  std::mt19937 truth_rng(o.seed * 7919u + 13u);  // the truths' own randomness, apart from the artefacts' stream
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  DriveCycle c;
+  if (o.cycle == "steady") {
+    c = steady_cruise(truth_rng);
+  } else {
+    const DriveCycle one = load_cycle(o.cycle);
+    c.name = o.cycle + " x" + std::to_string(o.repeats);
+    for (int k = 0; k < o.repeats; ++k) {
+      const double t0 = c.time_s.empty() ? 0.0 : c.time_s.back() + 1.0;
+      for (std::size_t i = 0; i < one.time_s.size(); ++i) {
+        c.time_s.push_back(t0 + one.time_s[i] - one.time_s.front());
+        c.speed_mps.push_back(one.speed_mps[i]);
+        c.grade.push_back(0.0);
+      }
+    }
+  }
+  Vehicle truth_vehicle = vehicle;
+  DriveCycle truth_cycle = c;
+  std::vector<std::shared_ptr<const Effect>> truths;
   const double level = 1.0 + o.rrc_level_jitter * unit(rng);
-  model.effects.push_back(std::make_shared<TwoNodeTyreTruth>(o.tyre_cold_excess, level, o.time_reversed, c.duration_s()));
+  truths.push_back(std::make_shared<RrcLevelTruth>(level));
+  const double rho_cda = vehicle.body.air_density_kg_per_m3 * vehicle.body.drag_coefficient * vehicle.body.frontal_area_m2;
+  const double weight_n = vehicle.body.test_mass_kg * kG;
+  for (const auto& e : o.effects) {
+    const std::string& t = concealed_truth(e.truth).truth;
+    if (t == "tyre_two_node") {
+      truths.push_back(std::make_shared<TwoNodeTyreTruth>(e.size, o.time_reversed, c.duration_s()));
+    } else if (t == "aux_compressor") {
+      const double period = 300.0 + 60.0 * unit(truth_rng);
+      truths.push_back(std::make_shared<CompressorTruth>(e.size, period, period * 0.5 * (1.0 + unit(truth_rng))));
+    } else if (t == "wind_gusty") {
+      truths.push_back(std::make_shared<GustyWindTruth>(e.size, rho_cda, c.duration_s(), truth_rng));
+    } else if (t == "payload_drop") {
+      truths.push_back(std::make_shared<PayloadTruth>(e.size, vehicle.body.test_mass_kg, middle_stop_s(c)));
+    } else if (t == "rotating_parts") {
+      double eta = 0.95;
+      if (const auto* ep = std::get_if<ElectricPowertrainParams>(&vehicle.powertrain)) eta = ep->reduction.efficiency;
+      truths.push_back(std::make_shared<RotatingPartsTruth>(e.size, eta));
+    } else if (t == "magic_formula_slip") {
+      const double driven = vehicle.body.driven_axle == DrivenAxle::front ? vehicle.body.front_axle_load_fraction
+                                                                           : 1.0 - vehicle.body.front_axle_load_fraction;
+      truths.push_back(std::make_shared<MagicFormulaSlipTruth>(e.size, driven * weight_n, weight_n));
+    } else if (t == "underinflated") {
+      if (!truth_vehicle.front_tyre) throw InputError("concealed truth 'underinflated'", "needs a vehicle with tyres");
+      truth_vehicle.front_tyre->state.pressure_pa += e.size * 1e5;
+      truth_vehicle.rear_tyre->state.pressure_pa += e.size * 1e5;
+    } else if (t == "regen_cap") {
+      auto* ep = std::get_if<ElectricPowertrainParams>(&truth_vehicle.powertrain);
+      if (!ep) throw InputError("concealed truth 'regen_cap'", "needs an electric vehicle");
+      ep->regen.max_power_w = std::min(ep->regen.max_power_w, e.size);
+    } else if (t == "hilly_climb") {
+      // Net grade plus three zero-mean hill components along the distance (random wavelengths and phases).
+      double amp[3], len[3], ph[3];
+      for (int k = 0; k < 3; ++k) {
+        amp[k] = 0.01 / 3.0;
+        len[k] = 1900.0 + 1100.0 * unit(truth_rng);
+        ph[k] = kTwoPi * 0.5 * (1.0 + unit(truth_rng));
+      }
+      double s = 0.0;
+      for (std::size_t i = 0; i < truth_cycle.time_s.size(); ++i) {
+        double g = e.size;
+        for (int k = 0; k < 3; ++k) g += amp[k] * std::sin(kTwoPi * s / len[k] + ph[k]);
+        truth_cycle.grade[i] = g;
+        if (i + 1 < truth_cycle.time_s.size())
+          s += 0.5 * (c.speed_mps[i] + c.speed_mps[i + 1]) * (c.time_s[i + 1] - c.time_s[i]);
+      }
+    }
+  }
+  VehicleModel model = VehicleModel::assemble(truth_vehicle);
+  for (auto& tr : truths) model.effects.push_back(tr);
   SimulationOptions so;
   so.record_trace = true;
-  const SimulationResult r = simulate_replay(model, c, so);
+  const SimulationResult r = simulate_replay(model, truth_cycle, so);
   const double scale = 1.0 + o.scale_jitter * unit(rng);
   std::normal_distribution<double> noise(0.0, o.noise_w);
   Recording rec;
@@ -75,8 +305,23 @@ Recording generate_recording(const Vehicle& vehicle, const SyntheticOptions& o) 
   }
   rec.time_s.assign(c.time_s.begin(), c.time_s.begin() + static_cast<long>(n));
   rec.speed_mps.assign(c.speed_mps.begin(), c.speed_mps.begin() + static_cast<long>(n));
-  rec.battery_power_w = p;
+  rec.battery_power_w = p;  // no grade column: the diagnosis sees a flat road
   return rec;
+}
+
+Recording generate_recording(const Vehicle& vehicle, const SyntheticOptions& opt) {
+  SyntheticCase c;
+  c.cycle = opt.cycle;
+  c.repeats = opt.repeats;
+  c.effects.push_back({"tyre_two_node", opt.tyre_cold_excess});
+  c.rrc_level_jitter = opt.rrc_level_jitter;
+  c.scale_jitter = opt.scale_jitter;
+  c.noise_w = opt.noise_w;
+  c.quantum_w = opt.quantum_w;
+  c.lag_s = opt.lag_s;
+  c.time_reversed = opt.time_reversed;
+  c.seed = opt.seed;
+  return generate_case(vehicle, c);
 }
 
 }  // namespace rollsim

@@ -1,0 +1,47 @@
+// Synthetic recordings with concealed effects for the discovery benchmark: each truth is richer than its catalogue module.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "rollsim/recording/recording.hpp"
+#include "rollsim/vehicle/vehicle.hpp"
+
+namespace rollsim {
+
+/// A concealed effect of the truth, by its truth identifier (see concealed_truths()) and its size in that truth's
+/// own unit. The truth's model is its own code (an Effect in generate.cpp, a changed vehicle parameter run through
+/// the tyre model or the powertrain, or a road profile), never the catalogue module that the diagnosis fits.
+struct ConcealedEffect {
+  std::string truth;
+  double size = 0.0;
+};
+
+/// What each truth is, which catalogue effect an honest diagnosis should name, and a sweep of sizes.
+struct ConcealedTruthInfo {
+  std::string truth;            ///< e.g. "aux_compressor"
+  std::string catalogue_id;     ///< the effect it should be named as, e.g. "aux_load"
+  std::string size_unit;
+  std::string description;      ///< the truth's model, in words
+  std::vector<double> sweep;    ///< sizes, smallest effect first
+};
+const std::vector<ConcealedTruthInfo>& concealed_truths();
+const ConcealedTruthInfo& concealed_truth(const std::string& truth);  ///< throws InputError when unknown
+
+/// One synthetic recording: a speed trace (a shipped cycle repeated, or "steady", an hour of 90 km/h cruising with
+/// slow +-1 km/h drift), the concealed effects, and the logger's artefacts (electric car, battery power channel).
+struct SyntheticCase {
+  std::string cycle = "wltc";
+  int repeats = 2;
+  std::vector<ConcealedEffect> effects;
+  double rrc_level_jitter = 0.03;  ///< truth's RRC level, uniform +- (calibration, not a discovery)
+  double scale_jitter = 0.02;      ///< measured channel scale, uniform +-
+  double noise_w = 400.0;          ///< white sensor noise, standard deviation
+  double quantum_w = 100.0;        ///< logger quantisation
+  double lag_s = 1.0;              ///< channel lag
+  bool time_reversed = false;      ///< tyre truths: the warm-up decay placed at the end of the trip (a null)
+  unsigned seed = 1;
+};
+Recording generate_case(const Vehicle& vehicle, const SyntheticCase& c);
+
+}  // namespace rollsim
