@@ -34,6 +34,7 @@ void run_diagnose(const DiagnoseCliOptions& o) {
   const std::string vehicle_path = resolve_data_file(o.vehicle, "vehicles", ".yaml", "--vehicle");
   Vehicle v = load_vehicle_file(vehicle_path);
   if (!o.tyre.empty()) fit_tyres(v, load_tyre_file(resolve_data_file(o.tyre, "tyres", ".yaml", "--tyre")));
+  if (!o.report.empty()) check_report_dir(o.report);  // fail before the diagnosis, not after it
   ColumnMapping mapping;
   if (!o.preset.empty()) mapping = preset_mapping(o.preset);
   ColumnMapping overrides;

@@ -60,9 +60,11 @@ ElevationGrade grade_from_elevation(const std::vector<double>& time_s, const std
     const std::ptrdiff_t a = std::max<std::ptrdiff_t>(0, c - half), b = std::min(nc - 1, c + half);
     smooth[static_cast<std::size_t>(c)] = (prefix[static_cast<std::size_t>(b + 1)] - prefix[static_cast<std::size_t>(a)]) / static_cast<double>(b - a + 1);
   }
+  // Derivative over +-half the filter length: a central difference over a short baseline would turn metre-level
+  // noise left in the averaged profile into grade noise of a few per cent.
   std::vector<double> g(cells, 0.0);
   for (std::ptrdiff_t c = 0; c < nc; ++c) {
-    const std::ptrdiff_t a = std::max<std::ptrdiff_t>(0, c - 1), b = std::min(nc - 1, c + 1);
+    const std::ptrdiff_t a = std::max<std::ptrdiff_t>(0, c - half), b = std::min(nc - 1, c + half);
     if (b > a)
       g[static_cast<std::size_t>(c)] = std::clamp((smooth[static_cast<std::size_t>(b)] - smooth[static_cast<std::size_t>(a)]) /
                                                       (static_cast<double>(b - a) * opt.grid_m),

@@ -62,16 +62,22 @@ struct Figure {
 
 }  // namespace
 
-std::vector<std::string> write_diagnosis_report(const std::string& dir, const Diagnosis& d, const std::string& title) {
+void check_report_dir(const std::string& dir) {
   const std::string where = "--report '" + dir + "'";
   std::error_code ec;
   fs::create_directories(dir, ec);
-  if (!fs::is_directory(dir) || access(dir.c_str(), W_OK) != 0)
+  if (!fs::is_directory(dir, ec) || access(dir.c_str(), W_OK) != 0)
     throw InputError(where, "cannot create or write to this folder" + (ec ? ": " + ec.message() : std::string()));
-  const std::string gnuplot = find_gnuplot();
-  if (gnuplot.empty())
+  if (find_gnuplot().empty())
     throw InputError(where, "gnuplot is not installed or not on PATH (Debian: apt-get install gnuplot-nox); "
                             "the text and --json output do not need it");
+}
+
+std::vector<std::string> write_diagnosis_report(const std::string& dir, const Diagnosis& d, const std::string& title) {
+  const std::string where = "--report '" + dir + "'";
+  check_report_dir(dir);
+  std::error_code ec;
+  const std::string gnuplot = find_gnuplot();
   if (d.series.empty()) throw InputError(where, "the diagnosis has no windows to draw");
 
   const fs::path work = fs::temp_directory_path() / ("rollsim_report_" + std::to_string(getpid()) + "_" +
@@ -100,7 +106,7 @@ std::vector<std::string> write_diagnosis_report(const std::string& dir, const Di
     }
   }
   const std::string dat = "'" + gp_escape((work / "windows.dat").string()) + "'";
-  const std::string after = d.findings.empty() ? "after (no findings: same as before)" : "after the findings' effects";
+  const std::string after = gp_escape(d.findings.empty() ? "after (no findings: same as before)" : "after the findings' effects");
   std::vector<Figure> figs{
       {"energy.svg", "Measured against simulated mean power per window (" + d.channel + " channel)",
        "set xlabel 'time, recordings one after another [min]'\nset ylabel 'mean power per window [W]'\nplot " + dat +

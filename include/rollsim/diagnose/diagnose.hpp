@@ -22,7 +22,7 @@ struct DiagnoseOptions {
   /// for two quantised readings) is at most this fraction of the mean window energy.
   double soc_quantisation_fraction = 0.02;
   /// Unexplained-residual basis: time constants of the early-trip decay shapes [s].
-  std::vector<double> unexplained_decay_s{300.0, 900.0, 1800.0};
+  std::vector<double> unexplained_decay_s{300.0, 600.0, 1200.0, 2400.0};
   unsigned threads = 0;  ///< simulator runs in parallel (0: hardware concurrency)
 };
 

@@ -14,6 +14,10 @@ namespace rollsim {
 /// effects, and report.html embedding the SVGs inline with the text and JSON summaries. Creates DIR if missing.
 /// Throws InputError (naming `--report` and DIR) when DIR cannot be created or written, or gnuplot is missing
 /// or fails. Returns the paths written.
+/// Creates DIR if missing and checks that it can be written and that gnuplot is there, so that a bad --report
+/// fails before a long diagnosis; throws InputError as write_diagnosis_report does.
+void check_report_dir(const std::string& dir);
+
 std::vector<std::string> write_diagnosis_report(const std::string& dir, const Diagnosis& d, const std::string& title);
 
 }  // namespace rollsim
