@@ -1,0 +1,57 @@
+// Benchmark of `rollsim diagnose` on a one-hour 10 Hz recording (the speed target: under 10 s).
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <random>
+#include <string>
+
+#include "rollsim/cycle/drive_cycle.hpp"
+#include "rollsim/diagnose/diagnose.hpp"
+#include "rollsim/sim/simulation.hpp"
+
+namespace {
+
+// WLTC (1800 s) twice, resampled at 10 Hz: 36 000 samples; measured battery power = the model's own replay
+// plus 400 W white noise and a 100 W logger quantum (a null recording: the diagnosis does its full work).
+rollsim::Recording one_hour_10hz(const rollsim::Vehicle& v) {
+  const rollsim::DriveCycle one = rollsim::load_cycle("wltc");
+  rollsim::DriveCycle c;
+  c.name = "wltc x2 at 10 Hz";
+  const double d = one.duration_s();
+  for (int k = 0; k < 2; ++k)
+    for (int i = 0; i < static_cast<int>(std::lround(d * 10.0)); ++i) {
+      const double t = 0.1 * i;
+      c.time_s.push_back(k * d + t);
+      c.speed_mps.push_back(one.speed_mps_at(one.time_s.front() + t));
+    }
+  c.grade.assign(c.time_s.size(), 0.0);
+  rollsim::SimulationOptions so;
+  so.record_trace = true;
+  const auto s = rollsim::simulate_replay(rollsim::VehicleModel::assemble(v), c, so);
+  rollsim::Recording r;
+  r.source = c.name;
+  r.time_s = c.time_s;
+  r.speed_mps = c.speed_mps;
+  std::mt19937 rng(1);
+  std::normal_distribution<double> noise(0.0, 400.0);
+  std::vector<double> p(c.time_s.size());
+  for (std::size_t i = 0; i < p.size(); ++i) p[i] = 100.0 * std::round((s.trace[i].battery_power_w + noise(rng)) / 100.0);
+  r.battery_power_w = p;
+  return r;
+}
+
+void BM_DiagnoseOneHour10Hz(benchmark::State& state) {
+  const auto v = rollsim::load_vehicle_file(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/ev.yaml");
+  const auto rec = one_hour_10hz(v);
+  rollsim::DiagnoseOptions opt;
+  opt.threads = static_cast<unsigned>(state.range(0));
+  for (auto _ : state) {
+    auto d = rollsim::diagnose(v, {rec}, opt);
+    benchmark::DoNotOptimize(d);
+  }
+  state.counters["samples"] = static_cast<double>(rec.time_s.size());
+}
+// Argument: simulator threads (1 = serial, 0 = all cores).
+BENCHMARK(BM_DiagnoseOneHour10Hz)->Arg(1)->Arg(0)->Unit(benchmark::kSecond)->Iterations(1)->Repetitions(5)->ReportAggregatesOnly(true);
+
+}  // namespace
