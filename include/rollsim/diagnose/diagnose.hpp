@@ -13,7 +13,8 @@ namespace rollsim {
 /// Fixed in advance (not tuned per recording), so that the null case's false-discovery rate is what it is.
 struct DiagnoseOptions {
   double window_s = 60.0;          ///< energy windows
-  int block_windows = 3;           ///< held-out folds alternate in blocks of this many windows
+  int block_windows = 3;           ///< one recording: held-out folds alternate in blocks of this many windows
+                                   ///< (several recordings: each recording is a fold)
   double bic_threshold = 10.0;     ///< "very strong" evidence on the Kass-Raftery scale
   double collinear_corr = 0.9;     ///< |corr| of calibration-cleaned signatures above which effects are confounded
   int max_effects = 2;
