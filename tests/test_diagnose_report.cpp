@@ -237,3 +237,49 @@ TEST(DiagnoseTwizy, RealRecordingGetsGradeFromElevationAndSocWindows) {
 
 }  // namespace
 }  // namespace rollsim
+
+#include <array>
+#include <cstdio>
+#include <memory>
+#include <sys/wait.h>
+
+namespace rollsim {
+namespace {
+
+struct CliOutput {
+  int exit_code;
+  std::string text;
+};
+
+CliOutput run_cli(const std::string& args) {
+  const std::string cmd = std::string(ROLLSIM_BINARY) + " " + args + " 2>&1";
+  std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
+  std::string text;
+  std::array<char, 4096> buf{};
+  while (std::size_t n = std::fread(buf.data(), 1, buf.size(), pipe.get())) text.append(buf.data(), n);
+  const int status = pclose(pipe.release());
+  return {WEXITSTATUS(status), text};
+}
+
+TEST(DiagnoseReportCli, CamryRecordingsGiveAReportAndAnUnwritableDirFailsFirst) {
+  const std::string dir = std::string(ROLLSIM_SHARED_DIR) + "/data/recordings/anl_d3_2018_toyota_camry/";
+  if (!fs::exists(dir)) GTEST_SKIP() << "shared recordings not present";
+  const std::string recs = "--recording '" + dir + "61811012_test_data.csv' --recording '" + dir + "61811013_test_data.csv'";
+  const std::string vehicle = "--vehicle " + src("vehicles/camry_2018.yaml") + " --preset anl_d3 ";
+  const std::string file = ::testing::TempDir() + "/diag_cli_plain_file";
+  std::ofstream(file) << "x";
+  const auto bad = run_cli("diagnose " + vehicle + recs + " --report '" + file + "/r'");
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_NE(bad.text.find("--report"), std::string::npos) << bad.text;
+  EXPECT_EQ(bad.text.find("verdict"), std::string::npos) << "must fail before diagnosing\n" << bad.text;
+  if (!have_gnuplot()) GTEST_SKIP() << "gnuplot not installed";
+  const std::string out = ::testing::TempDir() + "/diag_cli_report";
+  fs::remove_all(out);
+  const auto ok = run_cli("diagnose " + vehicle + recs + " --report '" + out + "' --json '" + out + ".json'");
+  ASSERT_EQ(ok.exit_code, 0) << ok.text;
+  EXPECT_TRUE(fs::exists(out + "/report.html"));
+  EXPECT_TRUE(fs::exists(out + ".json"));
+}
+
+}  // namespace
+}  // namespace rollsim

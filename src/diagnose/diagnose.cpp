@@ -788,6 +788,9 @@ std::string diagnosis_json(const Diagnosis& d) {
   os << "  \"calibration\": {\"channel_scale\": " << num(d.channel_scale) << ", \"rrc_level_change\": " << num(d.rrc_level_change)
      << ", \"drag_change\": " << num(d.drag_change) << "},\n";
   os << "  \"lag_samples\": " << d.lag_samples << ",\n";
+  os << "  \"window_s\": " << num(d.window_s) << ",\n  \"notes\": [";
+  for (std::size_t i = 0; i < d.notes.size(); ++i) os << (i ? ", " : "") << "\"" << json_escape(d.notes[i]) << "\"";
+  os << "],\n";
   os << "  \"raw_trip_energy_error_pct\": " << num(d.raw_trip_energy_error_pct) << ",\n";
   os << "  \"heldout_rmse_calibrated\": " << num(d.heldout_rmse_calibrated_j) << ",\n";
   os << "  \"heldout_energy_error_pct_calibrated\": " << num(d.heldout_energy_error_pct_calibrated) << ",\n";
