@@ -206,3 +206,41 @@ TEST(Simulation, PetrolCarKicksDownToFollowDemandingCycles) {
     EXPECT_LT(std::abs(f.fuel_volume_m3 / r.fuel_volume_m3 - 1.0), 0.005) << cycle;
   }
 }
+
+// A battery that cannot give what the trace asks (Voc^2 / 4R = 9 kW at 60 V and 0.1 ohm) limits the car, which
+// falls behind and says so, like at the motor's limit; the run finishes and the balance still closes.
+TEST(Simulation, WeakBatteryLimitsTheCarInsteadOfFailing) {
+  Vehicle v = load_vehicle_file(shipped("vehicles/ev.yaml"));
+  std::get<ElectricPowertrainParams>(v.powertrain).battery.open_circuit_voltage_v = 60.0;
+  const auto r = simulate_forward(VehicleModel::assemble(v), load_cycle("nedc"));
+  EXPECT_FALSE(r.shortfalls.empty());
+  EXPECT_LT(std::abs(r.energy.wheel_residual_j()) / r.energy.traction_j, 1e-3);
+}
+
+namespace {
+// An effect whose model breaks down after 100 s: stands for any model error inside the integration.
+struct FailingEffect final : Effect {
+  std::string id() const override { return "failing"; }
+  double extra_resistance_n(const EffectInputs& in, const double*) const override {
+    if (in.time_s > 100.0) throw ModelDomainError("test model out of its domain");
+    return 0.0;
+  }
+};
+}  // namespace
+
+// A model failure inside the integration stops the run with the time and the cause; no energy figure is
+// produced from the failed step.
+TEST(Simulation, SolverFailureReportsTimeAndCause) {
+  auto m = model_of("vehicles/ev.yaml");
+  m.effects.push_back(std::make_shared<FailingEffect>());
+  try {
+    simulate_forward(m, load_cycle("nedc"));
+    FAIL() << "a failing model gave a result";
+  } catch (const SolverError& e) {
+    // The time is where the last good step ended; the failing step started there.
+    EXPECT_GT(e.time_s, 90.0);
+    EXPECT_LE(e.time_s, 100.0);
+    EXPECT_NE(std::string(e.what()).find("test model out of its domain"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("after t = "), std::string::npos) << e.what();
+  }
+}

@@ -15,6 +15,12 @@ double ElectricPowertrain::motor_loss_w(double torque_nm, double speed_radps) co
          l.windage_w_s3_per_rad3 * speed_radps * speed_radps * speed_radps + l.constant_w;
 }
 
+double ElectricPowertrain::max_battery_power_w() const {
+  const double r = p_.battery.internal_resistance_ohm;
+  const double voc = p_.battery.open_circuit_voltage_v;
+  return r > 0.0 ? voc * voc / (4.0 * r) * (1.0 - 1e-9) : std::numeric_limits<double>::infinity();
+}
+
 double ElectricPowertrain::battery_current_a(double terminal_power_w) const {
   const double voc = p_.battery.open_circuit_voltage_v;
   const double r = p_.battery.internal_resistance_ohm;
@@ -92,6 +98,20 @@ PowerFlow ElectricPowertrain::deliver(double wheel_force_n, double speed_mps, in
   out.motor_loss_w = motor_loss_w(torque_nm, motor_speed_radps);
   out.aux_power_w = p_.aux_power_w;
   out.battery_terminal_power_w = shaft_power_w + out.motor_loss_w + out.aux_power_w;
+  // A battery gives at most Voc^2 / 4R (at half its open-circuit voltage): beyond it the car is power-limited,
+  // like at the motor's own limit, and falls behind the trace instead of asking the impossible.
+  const double max_terminal_w = max_battery_power_w();
+  if (wheel_force_n > 0.0 && out.battery_terminal_power_w > max_terminal_w) {
+    double lo = 0.0, hi = out.wheel_force_n;
+    for (int i = 0; i < 40; ++i) {
+      const double mid = 0.5 * (lo + hi);
+      const double p = mid * v / eta + motor_loss_w(mid * wheel_radius_m / (ratio * eta), motor_speed_radps) + out.aux_power_w;
+      (p > max_terminal_w ? hi : lo) = mid;
+    }
+    PowerFlow limited = deliver(lo, speed_mps, gear, wheel_radius_m);
+    limited.force_limited = true;
+    return limited;
+  }
   out.battery_current_a = battery_current_a(out.battery_terminal_power_w);
   out.battery_loss_w = out.battery_current_a * out.battery_current_a * p_.battery.internal_resistance_ohm;
   return out;

@@ -5,6 +5,7 @@
 #include <sundials/sundials_context.h>
 #include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
 
+#include <cstdio>
 #include <limits>
 #include <string>
 
@@ -21,6 +22,7 @@ struct CvodeIntegrator::Impl {
   SUNNonlinearSolver nls = nullptr;
   OdeSystem* system = nullptr;
   std::string last_error;
+  std::string model_error;  // what the model threw inside a callback
 
   ~Impl() {
     if (mem) CVodeFree(&mem);
@@ -31,15 +33,31 @@ struct CvodeIntegrator::Impl {
     if (ctx) SUNContext_Free(&ctx);
   }
 
+  // No exception may cross CVODES' C frames: a model that throws (a battery asked for more than it can give)
+  // ends the integration with an unrecoverable flag, and its message becomes the SolverError's cause.
+  template <typename F>
+  static int guarded(void* user, F&& f) {
+    auto* self = static_cast<Impl*>(user);
+    try {
+      return f(*self);
+    } catch (const std::exception& e) {
+      self->model_error = e.what();
+      return -1;
+    }
+  }
   static int rhs(realtype t, N_Vector y, N_Vector ydot, void* user) {
-    return static_cast<Impl*>(user)->system->rhs(t, N_VGetArrayPointer(y), N_VGetArrayPointer(ydot));
+    return guarded(user, [&](Impl& s) { return s.system->rhs(t, N_VGetArrayPointer(y), N_VGetArrayPointer(ydot)); });
   }
   static int quad_rhs(realtype t, N_Vector y, N_Vector qdot, void* user) {
-    return static_cast<Impl*>(user)->system->quadrature_rhs(t, N_VGetArrayPointer(y), N_VGetArrayPointer(qdot));
+    return guarded(user, [&](Impl& s) {
+      return s.system->quadrature_rhs(t, N_VGetArrayPointer(y), N_VGetArrayPointer(qdot));
+    });
   }
   static int roots(realtype t, N_Vector y, realtype* g, void* user) {
-    static_cast<Impl*>(user)->system->roots(t, N_VGetArrayPointer(y), g);
-    return 0;
+    return guarded(user, [&](Impl& s) {
+      s.system->roots(t, N_VGetArrayPointer(y), g);
+      return 0;
+    });
   }
   // CVODES reports through this instead of printing; the message becomes part of the SolverError.
   static void on_error(int, const char*, const char* function, char* msg, void* user) {
@@ -48,8 +66,11 @@ struct CvodeIntegrator::Impl {
 
   void check(int flag, const char* call, double t) const {
     if (flag < 0) {
-      throw SolverError(t, std::string(call) + " failed at t = " + std::to_string(t) + " s: " +
-                               CVodeGetReturnFlagName(flag) + (last_error.empty() ? "" : " (" + last_error + ")"));
+      char when[32];
+      std::snprintf(when, sizeof when, "%.3f", t);
+      const std::string cause = !model_error.empty() ? model_error : last_error;
+      throw SolverError(t, std::string(call) + " failed at t = " + when + " s: " + CVodeGetReturnFlagName(flag) +
+                               (cause.empty() ? "" : " (" + cause + ")"));
     }
   }
 };
@@ -109,7 +130,19 @@ bool CvodeIntegrator::step(double t_stop) {
   }
   realtype t_reached = t_;
   const int flag = CVode(s.mem, t_stop, s.y, &t_reached, CV_ONE_STEP);
+  // CVODES' fixed-point solver can take a failed callback for a failed iteration and return without a step;
+  // a model error is final whatever CVODES made of it.
+  if (!s.model_error.empty()) {
+    char when[32];
+    std::snprintf(when, sizeof when, "%.3f", t_reached);
+    throw SolverError(t_reached, std::string("the model failed in the step after t = ") + when + " s: " + s.model_error);
+  }
   s.check(flag, "CVode", t_reached);
+  if (!(t_reached > t_)) {
+    if (++stalls_ > 100) throw SolverError(t_, "CVODES made no progress past t = " + std::to_string(t_) + " s");
+  } else {
+    stalls_ = 0;
+  }
   t_ = t_reached;
   const double* data = N_VGetArrayPointer(s.y);
   y_.assign(data, data + y_.size());

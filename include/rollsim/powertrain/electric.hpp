@@ -68,6 +68,8 @@ class ElectricPowertrain final : public Powertrain {
   /// Battery current [A] (+ discharging) for a terminal power [W]; throws ModelDomainError when the battery
   /// cannot deliver it (P > Voc^2 / 4R).
   double battery_current_a(double terminal_power_w) const;
+  /// The most the battery can deliver at its terminals [W]: Voc^2 / 4R, at half the open-circuit voltage.
+  double max_battery_power_w() const;
 
  private:
   double motor_loss_w(double torque_nm, double speed_radps) const;

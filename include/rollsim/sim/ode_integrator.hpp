@@ -85,6 +85,7 @@ class CvodeIntegrator {
   bool q_current_ = true;          // q_ holds the quadratures at t_
   std::vector<int> root_flags_;
   long restarts_ = 0;
+  int stalls_ = 0;  // successive calls that returned without advancing
   double stop_time_ = -1e300;
   OdeStats before_restarts_;  // CVodeReInit zeroes the counters; earlier runs are kept here
 };
