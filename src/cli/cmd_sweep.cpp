@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "rollsim/report/gnuplot.hpp"
 #include "rollsim/common/units.hpp"
 #include "rollsim/report/table.hpp"
 #include "rollsim/selection/common.hpp"
@@ -30,15 +31,6 @@ struct SweepOptionsText {
   bool base100 = false, json = false;
 };
 
-std::string find_gnuplot() {
-  const char* path = std::getenv("PATH");
-  std::stringstream ss(path ? path : "");
-  for (std::string dir; std::getline(ss, dir, ':');) {
-    const std::string p = (dir.empty() ? "." : dir) + "/gnuplot";
-    if (access(p.c_str(), X_OK) == 0) return p;
-  }
-  return "";
-}
 
 std::string axis_label(selection::SweepParam p) {
   switch (p) {
@@ -52,23 +44,12 @@ std::string axis_label(selection::SweepParam p) {
   return "";
 }
 
-std::string shell_quote(const std::string& s) {
-  std::string o = "'";
-  for (char c : s) o += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return o + "'";
-}
 
 std::string display_unit(selection::SweepParam p) {
   const std::string u = selection::sweep_param_unit(p);
   return u == "kmh" ? "km/h" : u == "pct" ? "%" : u;
 }
 
-// gnuplot single-quoted strings: a quote is doubled.
-std::string gp_escape(const std::string& s) {
-  std::string o;
-  for (char c : s) o += c == '\'' ? std::string("''") : std::string(1, c);
-  return o;
-}
 
 // Draws RRC against the first swept parameter (one line per value of the second) with gnuplot.
 void plot(const selection::SweepResult& r, const std::string& tyre_name, const std::string& file, bool base100) {
@@ -76,7 +57,7 @@ void plot(const selection::SweepResult& r, const std::string& tyre_name, const s
   if (r.points.empty()) throw InputError("--plot " + file, "no valid point to draw");
   const std::string ext = fs::path(file).extension().string();
   if (ext != ".svg" && ext != ".png") throw InputError("--plot " + file, "must end in .svg or .png");
-  const std::string gnuplot = find_gnuplot();
+  const std::string gnuplot = report::find_gnuplot();
   if (gnuplot.empty()) {
     throw InputError("--plot " + file, "gnuplot is not installed or not on PATH (Debian: apt-get install gnuplot-nox); "
                                        "the CSV output does not need it");
@@ -114,7 +95,7 @@ void plot(const selection::SweepResult& r, const std::string& tyre_name, const s
   std::ofstream gp(work / "plot.gp");
   gp << (ext == ".svg" ? "set terminal svg size 800,500 dynamic font 'Sans,12'\n"
                        : "set terminal pngcairo size 800,500 font 'Sans,11'\n")
-     << "set output '" << gp_escape(tmp_out.string()) << "'\n"
+     << "set output '" << report::gnuplot_escape(tmp_out.string()) << "'\n"
      << "set title \"" << title << " (rollsim tyre model)\"\n"
      << "set xlabel \"" << axis_label(a0.param) << "\"\n"
      << "set ylabel \"" << (base100 ? "RRC, base 100 at " + format_value(r.points.front().values[0]) + " " +
@@ -127,22 +108,16 @@ void plot(const selection::SweepResult& r, const std::string& tyre_name, const s
     std::string label = r.axes.size() > 1 ? selection::sweep_param_key(r.axes[1].param) + " " + format_value(key) + " " +
                                                 display_unit(r.axes[1].param)
                                           : tyre_name;
-    gp << (i ? ", " : "") << "'" << gp_escape((work / "data.dat").string()) << "' index " << i << " with linespoints lw 2 pt 7 ps 0.6 title \""
+    gp << (i ? ", " : "") << "'" << report::gnuplot_escape((work / "data.dat").string()) << "' index " << i << " with linespoints lw 2 pt 7 ps 0.6 title \""
        << label << "\"";
     ++i;
   }
   gp << "\n";
   gp.close();
-  const std::string cmd = shell_quote(gnuplot) + " " + shell_quote((work / "plot.gp").string()) + " 2>" +
-                          shell_quote((work / "gnuplot.err").string());
-  const int status = std::system(cmd.c_str());
-  if (status != 0) {
-    std::ifstream err(work / "gnuplot.err");
-    std::stringstream ss;
-    ss << err.rdbuf();
+  if (const std::string err = report::run_gnuplot_script(gnuplot, (work / "plot.gp").string()); !err.empty()) {
     fs::remove(tmp_out, ec);
     fs::remove_all(work, ec);
-    throw InputError("--plot " + file, "gnuplot failed: " + ss.str());
+    throw InputError("--plot " + file, "gnuplot failed: " + err);
   }
   fs::rename(tmp_out, target, ec);
   fs::remove_all(work);

@@ -1,7 +1,6 @@
 // Diagnosis report: per-window data to gnuplot (SVG), and one HTML page with the SVGs inline.
 #include "rollsim/diagnose/report.hpp"
 
-#include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -10,33 +9,15 @@
 
 #include "rollsim/common/atomic_file.hpp"
 #include "rollsim/common/error.hpp"
+#include "rollsim/report/gnuplot.hpp"
 
 namespace rollsim {
 namespace {
 
 namespace fs = std::filesystem;
 
-std::string find_gnuplot() {
-  const char* path = std::getenv("PATH");
-  std::stringstream ss(path ? path : "");
-  for (std::string dir; std::getline(ss, dir, ':');) {
-    const std::string p = (dir.empty() ? "." : dir) + "/gnuplot";
-    if (access(p.c_str(), X_OK) == 0) return p;
-  }
-  return "";
-}
 
-std::string shell_quote(const std::string& s) {
-  std::string o = "'";
-  for (char c : s) o += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return o + "'";
-}
 
-std::string gp_escape(const std::string& s) {
-  std::string o;
-  for (char c : s) o += c == '\'' ? std::string("''") : std::string(1, c);
-  return o;
-}
 
 std::string html_escape(const std::string& s) {
   std::string o;
@@ -68,7 +49,7 @@ void check_report_dir(const std::string& dir) {
   fs::create_directories(dir, ec);
   if (!fs::is_directory(dir, ec) || access(dir.c_str(), W_OK) != 0)
     throw InputError(where, "cannot create or write to this folder" + (ec ? ": " + ec.message() : std::string()));
-  if (find_gnuplot().empty())
+  if (report::find_gnuplot().empty())
     throw InputError(where, "gnuplot is not installed or not on PATH (Debian: apt-get install gnuplot-nox); "
                             "the text and --json output do not need it");
 }
@@ -77,7 +58,7 @@ std::vector<std::string> write_diagnosis_report(const std::string& dir, const Di
   const std::string where = "--report '" + dir + "'";
   check_report_dir(dir);
   std::error_code ec;
-  const std::string gnuplot = find_gnuplot();
+  const std::string gnuplot = report::find_gnuplot();
   if (d.series.empty()) throw InputError(where, "the diagnosis has no windows to draw");
 
   const fs::path work = fs::temp_directory_path() / ("rollsim_report_" + std::to_string(getpid()) + "_" +
@@ -105,8 +86,8 @@ std::vector<std::string> write_diagnosis_report(const std::string& dir, const Di
            << (w.measured_j - w.calibrated_j) / dur << " " << (w.measured_j - w.fitted_j) / dur << "\n";
     }
   }
-  const std::string dat = "'" + gp_escape((work / "windows.dat").string()) + "'";
-  const std::string after = gp_escape(d.findings.empty() ? "after (no findings: same as before)" : "after the findings' effects");
+  const std::string dat = "'" + report::gnuplot_escape((work / "windows.dat").string()) + "'";
+  const std::string after = report::gnuplot_escape(d.findings.empty() ? "after (no findings: same as before)" : "after the findings' effects");
   std::vector<Figure> figs{
       {"energy.svg", "Measured against simulated mean power per window (" + d.channel + " channel)",
        "set xlabel 'time, recordings one after another [min]'\nset ylabel 'mean power per window [W]'\nplot " + dat +
@@ -130,13 +111,10 @@ std::vector<std::string> write_diagnosis_report(const std::string& dir, const Di
     const fs::path out = work / f.file;
     {
       std::ofstream gp(work / "plot.gp");
-      gp << "set terminal svg size 800,450 dynamic font 'Sans,11'\nset output '" << gp_escape(out.string()) << "'\n"
-         << "set title '" << gp_escape(f.caption) << "'\nset grid\nset key outside bottom center horizontal\n" << f.script;
+      gp << "set terminal svg size 800,450 dynamic font 'Sans,11'\nset output '" << report::gnuplot_escape(out.string()) << "'\n"
+         << "set title '" << report::gnuplot_escape(f.caption) << "'\nset grid\nset key outside bottom center horizontal\n" << f.script;
     }
-    const std::string cmd = shell_quote(gnuplot) + " " + shell_quote((work / "plot.gp").string()) + " 2>" +
-                            shell_quote((work / "gnuplot.err").string());
-    if (std::system(cmd.c_str()) != 0) {
-      const std::string err = read_all(work / "gnuplot.err");
+    if (const std::string err = report::run_gnuplot_script(gnuplot, (work / "plot.gp").string()); !err.empty()) {
       fs::remove_all(work, ec);
       throw InputError(where, "gnuplot failed on " + f.file + ": " + err);
     }

@@ -1,0 +1,54 @@
+#include "rollsim/report/gnuplot.hpp"
+
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace rollsim::report {
+namespace {
+
+// POSIX single quotes: the only character to escape is the quote itself.
+std::string shell_quote(const std::string& s) {
+  std::string o = "'";
+  for (char c : s) o += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return o + "'";
+}
+
+}  // namespace
+
+std::string find_gnuplot() {
+  const char* path = std::getenv("PATH");
+  std::stringstream ss(path ? path : "");
+  for (std::string dir; std::getline(ss, dir, ':');) {
+    const std::string p = (dir.empty() ? "." : dir) + "/gnuplot";
+    if (access(p.c_str(), X_OK) == 0) return p;
+  }
+  return "";
+}
+
+std::string gnuplot_escape(const std::string& text) {
+  std::string o;
+  for (char c : text) o += c == '\'' ? std::string("''") : std::string(1, c);
+  return o;
+}
+
+std::string run_gnuplot_script(const std::string& gnuplot, const std::string& script_path) {
+  const std::string err_path = script_path + ".err";
+  const std::string cmd = shell_quote(gnuplot) + " " + shell_quote(script_path) + " 2>" + shell_quote(err_path);
+  const int status = std::system(cmd.c_str());
+  std::string err;
+  if (status != 0) {
+    std::ifstream in(err_path);
+    std::stringstream text;
+    text << in.rdbuf();
+    err = text.str().empty() ? "exit status " + std::to_string(status) : text.str();
+  }
+  std::error_code ec;
+  std::filesystem::remove(err_path, ec);
+  return err;
+}
+
+}  // namespace rollsim::report
