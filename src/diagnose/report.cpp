@@ -1,6 +1,8 @@
 // Diagnosis report: per-window data to gnuplot (SVG), and one HTML page with the SVGs inline.
 #include "rollsim/diagnose/report.hpp"
 
+#include <unistd.h>
+
 
 #include <cstdlib>
 #include <filesystem>
