@@ -1,5 +1,7 @@
 // compare, sweep, sensitivity and regress end to end: runs the built binary on shipped and broken inputs.
 #include <gtest/gtest.h>
+
+#include "cli_runner.hpp"
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -16,39 +18,11 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct CmdResult {
-  int exit_code = -1;
-  std::string out;
-  std::string err;
-};
+using rollsim::test::CmdResult;
+using rollsim::test::slurp;
+using rollsim::test::temp_dir;
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-fs::path temp_dir() {
-  const auto dir = fs::temp_directory_path() / ("rollsim_test_cli_sel_" + std::to_string(getpid()));
-  fs::create_directories(dir);
-  return dir;
-}
-
-// Runs `[env] rollsim <args>` through the shell from the source folder (args are shell words).
-CmdResult run(const std::string& args, const std::string& env = "") {
-  const auto dir = temp_dir();
-  const auto out = dir / "stdout.txt";
-  const auto err = dir / "stderr.txt";
-  const std::string cmd = "cd '" + std::string(ROLLSIM_SOURCE_DIR) + "' && " + env + " '" + ROLLSIM_BINARY + "' " +
-                          args + " >'" + out.string() + "' 2>'" + err.string() + "'";
-  const int status = std::system(cmd.c_str());
-  CmdResult r;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = slurp(out);
-  r.err = slurp(err);
-  return r;
-}
+CmdResult run(const std::string& args, const std::string& env = "") { return rollsim::test::run_rollsim(args, env); }
 
 bool has(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 

@@ -1,26 +1,21 @@
+// `rollsim simulate` end to end: JSON keys, comparison tables, trace output and bad input, through the binary.
 #include <gtest/gtest.h>
 
-#include <array>
-#include <cstdio>
+#include "cli_runner.hpp"
+
 #include <filesystem>
-#include <memory>
 #include <string>
 
 namespace {
 
 struct Output {
   int exit_code;
-  std::string text;
+  std::string text;  ///< stdout and stderr together
 };
 
 Output run(const std::string& args) {
-  const std::string cmd = std::string(ROLLSIM_BINARY) + " " + args + " 2>&1";
-  std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
-  std::string text;
-  std::array<char, 4096> buf{};
-  while (std::size_t n = std::fread(buf.data(), 1, buf.size(), pipe.get())) text.append(buf.data(), n);
-  const int status = pclose(pipe.release());
-  return {WEXITSTATUS(status), text};
+  const auto r = rollsim::test::run_rollsim(args);
+  return {r.exit_code, r.out + r.err};
 }
 
 }  // namespace
@@ -43,7 +38,7 @@ TEST(CliSimulate, SeveralTyresGiveOneTableWithDifferences) {
 }
 
 TEST(CliSimulate, TraceIsWrittenWholeOrNotAtAll) {
-  const auto dir = std::filesystem::temp_directory_path() / ("rollsim_cli_sim_" + std::to_string(::getpid()));
+  const auto dir = rollsim::test::temp_dir() / "simulate";
   std::filesystem::create_directories(dir);
   const auto trace = (dir / "trace.csv").string();
   auto out = run("simulate --vehicle ev --cycle udds --trace " + trace);

@@ -1,5 +1,7 @@
 // `rollsim tyre` end to end: runs the built binary and checks its table, JSON lines, warnings and errors.
 #include <gtest/gtest.h>
+
+#include "cli_runner.hpp"
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -16,40 +18,11 @@
 
 namespace {
 
-struct CmdResult {
-  int exit_code = -1;
-  std::string out;
-  std::string err;
-};
+using rollsim::test::CmdResult;
+using rollsim::test::slurp;
+using rollsim::test::temp_dir;
 
-std::string slurp(const std::filesystem::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-std::filesystem::path temp_dir() {
-  // Unique per process: several test processes (ctest -j, other build folders) may run at once.
-  const auto dir = std::filesystem::temp_directory_path() / ("rollsim_test_cli_tyre_" + std::to_string(getpid()));
-  std::filesystem::create_directories(dir);
-  return dir;
-}
-
-// Runs `rollsim tyre <args>` through the shell (args are shell words, quote as needed).
-CmdResult tyre(const std::string& args) {
-  const auto dir = temp_dir();
-  const auto out = dir / "stdout.txt";
-  const auto err = dir / "stderr.txt";
-  const std::string cmd = std::string("'") + ROLLSIM_BINARY + "' tyre " + args + " >'" + out.string() + "' 2>'" +
-                          err.string() + "'";
-  const int status = std::system(cmd.c_str());
-  CmdResult r;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = slurp(out);
-  r.err = slurp(err);
-  return r;
-}
+CmdResult tyre(const std::string& args) { return rollsim::test::run_rollsim("tyre " + args); }
 
 std::vector<std::string> lines(const std::string& text) {
   std::vector<std::string> out;

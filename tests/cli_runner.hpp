@@ -1,0 +1,59 @@
+// Test support for end-to-end CLI tests: runs the built rollsim binary and captures its streams and status.
+#pragma once
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace rollsim::test {
+
+struct CmdResult {
+  int exit_code = -1;
+  std::string out;
+  std::string err;
+};
+
+inline std::string slurp(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+/// A scratch folder for this test process (ctest -j runs several at once), removed when the process ends.
+inline std::filesystem::path temp_dir() {
+  struct Scratch {
+    std::filesystem::path path =
+        std::filesystem::temp_directory_path() / ("rollsim_cli_test_" + std::to_string(::getpid()));
+    Scratch() { std::filesystem::create_directories(path); }
+    ~Scratch() {
+      std::error_code ec;
+      std::filesystem::remove_all(path, ec);
+    }
+  };
+  static const Scratch scratch;
+  std::filesystem::create_directories(scratch.path);
+  return scratch.path;
+}
+
+/// Runs `[env] rollsim <args>` through the shell from the source folder (args are shell words, quote as needed).
+inline CmdResult run_rollsim(const std::string& args, const std::string& env = "") {
+  const auto dir = temp_dir();
+  const auto out = dir / "stdout.txt";
+  const auto err = dir / "stderr.txt";
+  const std::string cmd = "cd '" + std::string(ROLLSIM_SOURCE_DIR) + "' && " + env + " '" + ROLLSIM_BINARY + "' " +
+                          args + " >'" + out.string() + "' 2>'" + err.string() + "'";
+  const int status = std::system(cmd.c_str());
+  CmdResult r;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = slurp(out);
+  r.err = slurp(err);
+  return r;
+}
+
+}  // namespace rollsim::test
