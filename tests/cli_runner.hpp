@@ -9,6 +9,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace rollsim::test {
 
@@ -54,6 +55,15 @@ inline CmdResult run_rollsim(const std::string& args, const std::string& env = "
   r.out = slurp(out);
   r.err = slurp(err);
   return r;
+}
+
+/// The non-empty lines of `text`.
+inline std::vector<std::string> lines(const std::string& text) {
+  std::vector<std::string> out;
+  std::istringstream in(text);
+  for (std::string l; std::getline(in, l);)
+    if (!l.empty()) out.push_back(l);
+  return out;
 }
 
 }  // namespace rollsim::test

@@ -26,13 +26,7 @@ CmdResult run(const std::string& args, const std::string& env = "") { return rol
 
 bool has(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 
-std::vector<std::string> lines(const std::string& text) {
-  std::vector<std::string> out;
-  std::istringstream in(text);
-  for (std::string l; std::getline(in, l);)
-    if (!l.empty()) out.push_back(l);
-  return out;
-}
+using rollsim::test::lines;
 
 }  // namespace
 

@@ -24,13 +24,7 @@ using rollsim::test::temp_dir;
 
 CmdResult tyre(const std::string& args) { return rollsim::test::run_rollsim("tyre " + args); }
 
-std::vector<std::string> lines(const std::string& text) {
-  std::vector<std::string> out;
-  std::istringstream in(text);
-  for (std::string l; std::getline(in, l);)
-    if (!l.empty()) out.push_back(l);
-  return out;
-}
+using rollsim::test::lines;
 
 bool has(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 

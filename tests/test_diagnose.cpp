@@ -81,11 +81,7 @@ namespace {
 
 // Ratio of measured to simulated energy over [t0, t1) of a recording.
 double measured_over_simulated(const Vehicle& v, const Recording& r, double t0, double t1) {
-  DriveCycle c;
-  c.name = "rec";
-  c.time_s = r.time_s;
-  c.speed_mps = r.speed_mps;
-  c.grade.assign(r.time_s.size(), 0.0);
+  const DriveCycle c = cycle_of_recording(r);
   SimulationOptions so;
   so.record_trace = true;
   const SimulationResult s = simulate_replay(VehicleModel::assemble(v), c, so);

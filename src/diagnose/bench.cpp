@@ -31,11 +31,7 @@ std::pair<double, double> wilson_interval(int k, int n) {
 std::vector<std::string> sparse_regression_discovery(const Vehicle& vehicle, const Recording& rec) {
   // Nominal model on the recorded speed: the regression explains the measured window energy by the simulated one
   // plus library terms, as a SINDy user without the physics catalogue would.
-  DriveCycle c;
-  c.name = "rec";
-  c.time_s = rec.time_s;
-  c.speed_mps = rec.speed_mps;
-  c.grade.assign(rec.time_s.size(), 0.0);
+  const DriveCycle c = cycle_of_recording(rec);
   SimulationOptions so;
   so.record_trace = true;
   const SimulationResult sim = simulate_replay(VehicleModel::assemble(vehicle), c, so);

@@ -78,22 +78,6 @@ EffectContext context_of(const Vehicle& v) {
   return c;
 }
 
-DriveCycle cycle_of(const Recording& r) {
-  DriveCycle c;
-  c.name = r.source;
-  c.source = r.source;
-  // Time from the start of the recording: effects that decay from the start of a trip read it.
-  c.time_s = r.time_s;
-  for (double& t : c.time_s) t -= r.time_s.front();
-  c.speed_mps = r.speed_mps;
-  if (r.grade) c.grade = *r.grade;
-  else if (r.elevation_m) c.grade = grade_from_elevation(r.time_s, r.speed_mps, *r.elevation_m).grade;
-  else c.grade.assign(r.time_s.size(), 0.0);
-  // Quantised to 0.05 % (under 0.3 N per 100 kg of grade force error): the simulator prepares the tyre model once
-  // per distinct grade, which otherwise is once per sample and 90 % of a hilly recording's diagnosis.
-  for (double& g : c.grade) g = 0.0005 * std::round(g / 0.0005);
-  return c;
-}
 
 // Measured power per sample [W] in the energy domain of the simulation (battery terminals or fuel chemical).
 // SOC is handled per window (a difference), so it returns an empty vector and sets `soc` instead.
@@ -332,6 +316,23 @@ struct BasisShape {
 
 }  // namespace
 
+DriveCycle cycle_of_recording(const Recording& r) {
+  DriveCycle c;
+  c.name = r.source;
+  c.source = r.source;
+  // Time from the start of the recording: effects that decay from the start of a trip read it.
+  c.time_s = r.time_s;
+  for (double& t : c.time_s) t -= r.time_s.front();
+  c.speed_mps = r.speed_mps;
+  if (r.grade) c.grade = *r.grade;
+  else if (r.elevation_m) c.grade = grade_from_elevation(r.time_s, r.speed_mps, *r.elevation_m).grade;
+  else c.grade.assign(r.time_s.size(), 0.0);
+  // Quantised to 0.05 % (under 0.3 N per 100 kg of grade force error): the simulator prepares the tyre model once
+  // per distinct grade, which otherwise is once per sample and 90 % of a hilly recording's diagnosis.
+  for (double& g : c.grade) g = 0.0005 * std::round(g / 0.0005);
+  return c;
+}
+
 Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordings, const DiagnoseOptions& opt) {
   if (recordings.empty()) throw InputError("--recording", "at least one recording is needed");
   Diagnosis out;
@@ -340,7 +341,7 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
   double soc_capacity_j = 0.0;
   if (const auto* ep = std::get_if<ElectricPowertrainParams>(&vehicle.powertrain)) soc_capacity_j = ep->battery.usable_capacity_j;
   for (const Recording& r : recordings) {
-    cycles.push_back(cycle_of(r));
+    cycles.push_back(cycle_of_recording(r));
     if (!r.grade && r.elevation_m) {
       const ElevationGrade eg = grade_from_elevation(r.time_s, r.speed_mps, *r.elevation_m);
       out.notes.push_back(r.source + ": grade from recorded elevation (" + std::to_string(eg.rejected_steps) +

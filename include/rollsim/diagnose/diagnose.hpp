@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "rollsim/cycle/drive_cycle.hpp"
 #include "rollsim/effects/catalogue.hpp"
 #include "rollsim/recording/recording.hpp"
 #include "rollsim/vehicle/vehicle.hpp"
@@ -80,6 +81,10 @@ struct Diagnosis {
   std::vector<std::string> notes;   ///< preparation done on the data (grade from elevation, SOC quantum)
   std::vector<DiagnosisWindow> series;
 };
+
+/// The trace a recording is replayed on: its speed, time from the recording's start (effects that decay from
+/// the start of a trip read it), and its grade, or one derived robustly from its elevation, quantised to 0.05 %.
+DriveCycle cycle_of_recording(const Recording& r);
 
 /// Replays each recording's speed (and grade) through the vehicle, compares energies per window, calibrates,
 /// and tests each catalogue effect (see docs/diagnose.md for the method).
