@@ -10,6 +10,7 @@
 #include <mutex>
 #include <sstream>
 #include <thread>
+#include <tuple>
 
 #include "rollsim/common/error.hpp"
 #include "rollsim/cycle/drive_cycle.hpp"
@@ -333,6 +334,30 @@ DriveCycle cycle_of_recording(const Recording& r) {
   return c;
 }
 
+std::string separating_test(const std::string& a, const std::string& b) {
+  // Each pair's confusion (docs/diagnose.md) and the experiment that breaks it: a variable that moves one
+  // signature and not the other.
+  static const std::vector<std::tuple<std::string, std::string, std::string>> kTests{
+      {"mass", "rotational_inertia", "drive a route with grade, or weigh the car: mass also loads the grade and the tyres, inertia only acceleration"},
+      {"mass", "rr_speed", "weigh the car, or compare an uphill and a downhill run at the same speed"},
+      {"mass", "road_grade", "drive the route in both directions: a grade changes sign, a mass error does not"},
+      {"aux_load", "rr_speed", "log a long standstill with the car switched on: an auxiliary load draws power at zero speed, rolling resistance does not"},
+      {"aux_load", "tyre_warmup", "log a standstill early and late in the trip: an auxiliary load draws at standstill, a tyre warms only while rolling"},
+      {"wind", "rr_speed", "drive the same road in both directions: a headwind reverses, rolling resistance does not"},
+      {"wind", "mass", "drive the same road in both directions, or at two steady speeds: wind grows with speed squared, mass with acceleration"},
+      {"tyre_warmup", "engine_warmup", "idle the cold car for ten minutes before driving: an engine warms idling, a tyre only rolling"},
+      {"tyre_warmup", "ambient_rrc", "repeat the trip with a warm start: a warm-up decays within the trip, an ambient effect stays"},
+      {"battery_resistance", "tyre_slip", "compare hard accelerations at low and high speed: battery loss follows current squared, slip loss also grows with speed"},
+      {"regen_limit", "rotational_inertia", "brake at different strengths from the same speed: a regen limit shows only above its power, inertia in every braking"},
+      {"road_grade", "rr_speed", "drive the route in both directions, or record elevation: grade reverses with direction"},
+  };
+  for (const auto& [x, y, text] : kTests) {
+    if ((a == x && b == y) || (a == y && b == x)) return text;
+  }
+  return "vary the conditions that move one signature and not the other (speed, acceleration, grade, time since start, "
+         "direction of travel) in a second recording";
+}
+
 Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordings, const DiagnoseOptions& opt) {
   if (recordings.empty()) throw InputError("--recording", "at least one recording is needed");
   Diagnosis out;
@@ -588,7 +613,10 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
       const double corr = sb.dot(so) / std::max(1e-300, sb.norm() * so.norm());
       if (std::abs(corr) > opt.collinear_corr &&
           std::find(fnd.confounded_with.begin(), fnd.confounded_with.end(), o.id) == fnd.confounded_with.end())
+      {
         fnd.confounded_with.push_back(o.id);
+        fnd.separating_tests.push_back(o.id + ": " + separating_test(c.id, o.id));
+      }
     }
     fnd.heldout_rmse_before_j = rmse(pred_before, d.measured_j);
     fnd.heldout_rmse_after_j = rmse(best.pred, d.measured_j);
@@ -600,6 +628,28 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
     pred_before = best.pred;
     chosen_ids.push_back(c.id);
     out.findings.push_back(std::move(fnd));
+  }
+
+  // Detection limits: for each catalogue effect not found, the amplitude whose signature, cleaned of calibration
+  // and of the effects found, would have cut the residual enough to pass the same BIC threshold:
+  // n_eff ln(1 + c^2 |s|^2 / RSS) - ln n_eff = threshold.
+  {
+    const double factor = std::exp((opt.bic_threshold + std::log(n_eff)) / n_eff) - 1.0;
+    std::map<std::string, DetectionLimit> best;
+    for (const auto& c : cands) {
+      if (std::find(chosen_ids.begin(), chosen_ids.end(), c.id) != chosen_ids.end()) continue;
+      const double norm = cleaned(x, c.signature).norm();
+      if (!(norm > 0.0)) continue;
+      const double amp = std::sqrt(rss * factor) / norm / std::max(1e-12, std::abs(coef_final[0]));
+      auto [it, inserted] = best.try_emplace(c.id, DetectionLimit{c.id, c.amplitude_name, c.amplitude_unit, amp, true});
+      if (!inserted && amp < it->second.smallest_detectable) it->second.smallest_detectable = amp;
+    }
+    for (auto& [id, lim] : best) {
+      for (const auto& c : cands) {
+        if (c.id == id) lim.within_bounds = lim.smallest_detectable <= std::max(std::abs(c.amp_min), std::abs(c.amp_max));
+      }
+      out.detection_limits.push_back(lim);
+    }
   }
 
   // Unexplained: what the catalogue left, if still significant by the same BIC threshold and held-out test,
@@ -808,6 +858,9 @@ std::string diagnosis_json(const Diagnosis& d) {
     }
     os << "}, \"confounded_with\": [";
     for (std::size_t k = 0; k < f.confounded_with.size(); ++k) os << (k ? ", " : "") << "\"" << f.confounded_with[k] << "\"";
+    os << "], \"separating_tests\": [";
+    for (std::size_t k = 0; k < f.separating_tests.size(); ++k)
+      os << (k ? ", " : "") << "\"" << json_escape(f.separating_tests[k]) << "\"";
     os << "], \"delta_bic\": " << num(f.delta_bic) << ", \"heldout_rmse_before\": " << num(f.heldout_rmse_before_j)
        << ", \"heldout_rmse_after\": " << num(f.heldout_rmse_after_j)
        << ", \"heldout_energy_error_pct_before\": " << num(f.heldout_energy_error_pct_before)
@@ -819,7 +872,14 @@ std::string diagnosis_json(const Diagnosis& d) {
     os << (i ? "," : "") << "\n    {\"regime\": \"" << l.regime << "\", \"samples\": " << l.samples << ", \"mean_residual_w\": "
        << num(l.mean_w) << ", \"ci_low_w\": " << num(l.ci_low_w) << ", \"ci_high_w\": " << num(l.ci_high_w) << "}";
   }
-  os << (d.located.empty() ? "" : "\n  ") << "]\n}\n";
+  os << (d.located.empty() ? "" : "\n  ") << "],\n  \"detection_limits\": [";
+  for (std::size_t i = 0; i < d.detection_limits.size(); ++i) {
+    const auto& l = d.detection_limits[i];
+    os << (i ? "," : "") << "\n    {\"effect\": \"" << l.effect << "\", \"parameter\": \"" << l.parameter
+       << "\", \"smallest_detectable\": " << num(l.smallest_detectable) << ", \"unit\": \"" << l.unit
+       << "\", \"within_bounds\": " << (l.within_bounds ? "true" : "false") << "}";
+  }
+  os << (d.detection_limits.empty() ? "" : "\n  ") << "]\n}\n";
   return os.str();
 }
 
@@ -845,10 +905,19 @@ std::string diagnosis_text(const Diagnosis& d) {
     }
     os << "\n";
     if (!f.description.empty()) os << "    " << f.description << "\n";
+    for (const auto& t : f.separating_tests) os << "    to separate from " << t << "\n";
     for (const auto& p : f.parameters)
       os << "    " << p.name << " = " << p.value << " [" << p.ci_low << ", " << p.ci_high << "] " << p.unit << "\n";
     os << "    held-out RMSE " << f.heldout_rmse_before_j / 1e3 << " -> " << f.heldout_rmse_after_j / 1e3
        << " kJ/window, trip energy error " << f.heldout_energy_error_pct_before << " -> " << f.heldout_energy_error_pct_after << " %\n";
+  }
+  if (!d.detection_limits.empty()) {
+    os << "not found; smallest size of each effect's catalogue shape this data would have shown (a lower bound:\n"
+       << "real effects differ from the shape; the discovery benchmark measures 1-3 times these):\n";
+    for (const auto& l : d.detection_limits) {
+      os << "  " << l.effect << ": " << l.parameter << " " << l.smallest_detectable << " " << l.unit
+         << (l.within_bounds ? "" : " (beyond its physical bounds: not detectable here)") << "\n";
+    }
   }
   os << "located (measured - calibrated model, mean power, 95 %):\n";
   os.precision(0);

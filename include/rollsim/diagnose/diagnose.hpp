@@ -36,6 +36,8 @@ struct ParameterEstimate {
 struct Finding {
   std::string effect;  ///< catalogue identifier, or "unexplained" (described by its signature)
   std::string description;  ///< in words, with the fitted numbers (unexplained findings)
+  /// For each effect it is confounded with, the measurement that would tell the two apart.
+  std::vector<std::string> separating_tests;
   std::vector<ParameterEstimate> parameters;
   std::vector<std::string> confounded_with;
   double delta_bic = 0.0;
@@ -62,6 +64,15 @@ struct DiagnosisWindow {
   double fitted_j = 0.0;      ///< calibrated model with the findings' effects (in-sample)
 };
 
+/// For a catalogue effect that was not found: the smallest size of its catalogue shape that would have passed the
+/// same test on this data. A lower bound: a real effect's shape differs, and the benchmark measures 1-3 times it.
+struct DetectionLimit {
+  std::string effect;
+  std::string parameter, unit;
+  double smallest_detectable = 0.0;  ///< amplitude at which Delta BIC would reach the threshold
+  bool within_bounds = true;         ///< false: even the largest allowed size would not have been detected
+};
+
 struct Diagnosis {
   std::string verdict;   ///< missing_physics, nothing_missing, confounded
   std::string channel;   ///< which measured channel was compared
@@ -77,10 +88,14 @@ struct Diagnosis {
   double heldout_energy_error_pct_calibrated = 0.0;
   std::vector<Finding> findings;
   std::vector<RegimeResidual> located;
+  std::vector<DetectionLimit> detection_limits;  ///< catalogue effects not found, with what would have been
   double window_s = 0.0;            ///< window length used (SOC: lengthened by the quantum)
   std::vector<std::string> notes;   ///< preparation done on the data (grade from elevation, SOC quantum)
   std::vector<DiagnosisWindow> series;
 };
+
+/// The measurement that tells effect `a` from effect `b` where one trip cannot (docs/diagnose.md's confusions).
+std::string separating_test(const std::string& a, const std::string& b);
 
 /// The trace a recording is replayed on: its speed, time from the recording's start (effects that decay from
 /// the start of a trip read it), and its grade, or one derived robustly from its elevation, quantised to 0.05 %.
