@@ -23,20 +23,18 @@ struct DiagnoseCliOptions {
   double window_s = 0.0;  // 0: the library default
 };
 
-void write_file(const std::string& path, const std::string& text, const std::string& option) {
-  std::ofstream out(path);
-  if (!out) throw InputError(option + " '" + path + "'", "cannot write");
-  out << text;
-  if (!out) throw InputError(option + " '" + path + "'", "write failed");
-}
-
 void run_diagnose(const DiagnoseCliOptions& o) {
   const std::string vehicle_path = resolve_data_file(o.vehicle, "vehicles", ".yaml", "--vehicle");
   Vehicle v = load_vehicle_file(vehicle_path);
   if (!o.tyre.empty()) fit_tyres(v, load_tyre_file(resolve_data_file(o.tyre, "tyres", ".yaml", "--tyre")));
   if (!o.report.empty()) check_report_dir(o.report);  // fail before the diagnosis, not after it
+  // Column mapping: a preset, then the vehicle file's own logger mapping, then the command line's options.
   ColumnMapping mapping;
   if (!o.preset.empty()) mapping = preset_mapping(o.preset);
+  {
+    YamlMap vehicle_file = YamlMap::load_file(vehicle_path);
+    mapping = merge_mapping(mapping, column_mapping_from_yaml(vehicle_file));
+  }
   ColumnMapping overrides;
   for (const auto& c : o.columns) parse_column_option(c, overrides);
   for (const auto& s : o.scales) parse_scale_option(s, overrides);
@@ -55,7 +53,7 @@ void run_diagnose(const DiagnoseCliOptions& o) {
     std::cout << "report written to " << o.report << " (" << files.size() << " files, report.html)\n";
   }
   if (!o.write_vehicle.empty()) {
-    write_file(o.write_vehicle, fitted_vehicle_yaml(vehicle_path, d), "--write-vehicle");
+    write_file_atomically(o.write_vehicle, "--write-vehicle", [&](std::ostream& os) { os << fitted_vehicle_yaml(vehicle_path, d); });
     std::cout << "fitted vehicle written to " << o.write_vehicle << "\n";
   }
 }

@@ -210,6 +210,9 @@ Vehicle load_vehicle_file(const std::string& path) {
                                        : v.body.air_density_kg_per_m3 * v.body.drag_coefficient * v.body.frontal_area_m2;
     v.effects = load_effects(*eff, ctx);
   }
+  // A vehicle may name its logger's columns; the recording module reads these blocks (rollsim diagnose).
+  root.accept("recording_columns");
+  root.accept("recording_scale");
   root.finish();
 
   // Every tyre must carry its static load: the model has no solution past the rim.
