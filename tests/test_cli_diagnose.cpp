@@ -1,7 +1,7 @@
 // `rollsim diagnose` end to end: the vehicle file's logger mapping, and bad mappings named with file and key.
 #include <gtest/gtest.h>
 
-#include "cli_runner.hpp"
+#include "test_support.hpp"
 
 #include <filesystem>
 #include <fstream>

@@ -1,7 +1,7 @@
 // compare, sweep, sensitivity and regress end to end: runs the built binary on shipped and broken inputs.
 #include <gtest/gtest.h>
 
-#include "cli_runner.hpp"
+#include "test_support.hpp"
 #include <sys/wait.h>
 #include <unistd.h>
 

@@ -1,7 +1,7 @@
 // `rollsim simulate` end to end: JSON keys, comparison tables, trace output and bad input, through the binary.
 #include <gtest/gtest.h>
 
-#include "cli_runner.hpp"
+#include "test_support.hpp"
 
 #include <filesystem>
 #include <string>

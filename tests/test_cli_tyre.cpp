@@ -1,7 +1,7 @@
 // `rollsim tyre` end to end: runs the built binary and checks its table, JSON lines, warnings and errors.
 #include <gtest/gtest.h>
 
-#include "cli_runner.hpp"
+#include "test_support.hpp"
 #include <sys/wait.h>
 #include <unistd.h>
 

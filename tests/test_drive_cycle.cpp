@@ -1,6 +1,8 @@
 // Drive cycles: published figures of every shipped cycle, the rebuilt NEDC, lookups and bad input.
 #include <gtest/gtest.h>
 
+#include "test_support.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -19,20 +21,8 @@ using rollsim::load_cycle;
 namespace {
 
 // A fresh folder per test for small bad-input files.
-class DriveCycleFiles : public ::testing::Test {
+class DriveCycleFiles : public rollsim::test::FileFixture {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("rollsim_cycle_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "_" +
-            std::to_string(::getpid()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string write(const std::string& name, const std::string& text) {
-    const fs::path p = dir_ / name;
-    std::ofstream(p) << text;
-    return p.string();
-  }
   // Loads `text` as a cycle and returns the error message, failing the test if none is thrown.
   std::string error_of(const std::string& text) {
     const std::string path = write("bad.csv", text);
@@ -44,7 +34,6 @@ class DriveCycleFiles : public ::testing::Test {
     ADD_FAILURE() << "no InputError for:\n" << text;
     return "";
   }
-  fs::path dir_;
 };
 
 double km(double m) { return m / 1000.0; }

@@ -1,6 +1,8 @@
 // Recordings: the shipped real recordings read through the presets against their published facts, and
 // every kind of broken input.
 #include <gtest/gtest.h>
+
+#include "test_support.hpp"
 #include <unistd.h>
 
 #include <cmath>
@@ -34,20 +36,8 @@ double integral(const std::vector<double>& t, const std::vector<double>& y) {
                                              : ::testing::AssertionFailure() << "'" << part << "' not in: " << msg;
 }
 
-class RecordingFiles : public ::testing::Test {
+class RecordingFiles : public rollsim::test::FileFixture {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("rollsim_rec_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "_" +
-            std::to_string(::getpid()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string write(const std::string& name, const std::string& text) {
-    const fs::path p = dir_ / name;
-    std::ofstream(p) << text;
-    return p.string();
-  }
   // A valid 1 Hz recording of `seconds` + 1 rows: time_s, speed_kmh, soc_pct; `edit(t)` may replace a row.
   static std::string trip(int seconds, const std::function<std::string(int)>& edit = nullptr) {
     std::string s = "time_s,speed_kmh,soc_pct\n";
@@ -67,7 +57,6 @@ class RecordingFiles : public ::testing::Test {
     ADD_FAILURE() << "no InputError";
     return "";
   }
-  fs::path dir_;
 };
 
 }  // namespace

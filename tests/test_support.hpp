@@ -1,6 +1,7 @@
-// Test support for end-to-end CLI tests: runs the built rollsim binary and captures its streams and status.
+// Test support: a per-test folder for input files, and running the built rollsim binary with its streams captured.
 #pragma once
 
+#include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -56,6 +57,25 @@ inline CmdResult run_rollsim(const std::string& args, const std::string& env = "
   r.err = slurp(err);
   return r;
 }
+
+/// A fixture with a fresh folder per test for small input files (bad-input cases), removed after the test.
+class FileFixture : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() /
+           ("rollsim_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "_" +
+            std::to_string(::getpid()));
+    std::filesystem::create_directories(dir_);
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  /// Writes `text` to `name` in the test's folder and returns its path.
+  std::string write(const std::string& name, const std::string& text) {
+    const std::filesystem::path p = dir_ / name;
+    std::ofstream(p) << text;
+    return p.string();
+  }
+  std::filesystem::path dir_;
+};
 
 /// The non-empty lines of `text`.
 inline std::vector<std::string> lines(const std::string& text) {
