@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include "test_support.hpp"
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -27,16 +29,8 @@ DriveCycle constant_speed_cycle(double speed_mps, double duration_s) {
   return c;
 }
 
-// A per-process scratch folder, removed when the test program ends.
-struct ScratchDir {
-  std::filesystem::path path = std::filesystem::temp_directory_path() / ("rollsim_sim_test_" + std::to_string(::getpid()));
-  ScratchDir() { std::filesystem::create_directories(path); }
-  ~ScratchDir() { std::filesystem::remove_all(path); }
-};
-
 std::string temp_file(const std::string& name, const std::string& text) {
-  static const ScratchDir dir;
-  const auto p = dir.path / name;
+  const auto p = rollsim::test::temp_dir() / name;
   std::ofstream(p) << text;
   return p.string();
 }

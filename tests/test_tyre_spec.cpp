@@ -1,6 +1,8 @@
 // Size designations, the load-index table, tyre files, and the thesis' published trends on shipped tyres.
 #include <gtest/gtest.h>
 
+#include "test_support.hpp"
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -22,10 +24,7 @@ std::string tyre_path(const std::string& name) { return std::string(ROLLSIM_SOUR
 
 // Writes `text` to a fresh file in the temp folder and returns its path.
 std::string temp_yaml(const std::string& stem, const std::string& text) {
-  // Unique per process: several test processes (ctest -j, other build folders) may run at once.
-  const auto dir = std::filesystem::temp_directory_path() / ("rollsim_test_tyre_spec_" + std::to_string(getpid()));
-  std::filesystem::create_directories(dir);
-  const auto path = dir / (stem + ".yaml");
+  const auto path = rollsim::test::temp_dir() / (stem + ".yaml");
   std::ofstream(path) << text;
   return path.string();
 }
