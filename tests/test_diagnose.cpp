@@ -147,3 +147,30 @@ TEST(DiagnoseLimits, ConfoundedPairsNameTheirSeparatingTest) {
   EXPECT_NE(rollsim::separating_test("aux_load", "rr_speed").find("standstill"), std::string::npos);
   EXPECT_FALSE(rollsim::separating_test("wind", "tyre_slip").empty());
 }
+
+// Where elevation is known, the mismatch is located uphill and downhill too. A recording made on a flat road but
+// logged with a hill's elevation: the model then expects climbing power the measurement never had, so the residual
+// (measured - model) is negative uphill and positive downhill.
+TEST(DiagnoseLimits, LocatesUphillAndDownhillWhereElevationIsKnown) {
+  const rollsim::Vehicle v = rollsim::load_vehicle_file(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/ev.yaml");
+  rollsim::SyntheticOptions o;
+  o.seed = 3;
+  rollsim::Recording r = rollsim::generate_recording(v, o);
+  std::vector<double> elevation_m(r.time_s.size(), 0.0);
+  double x_m = 0.0;
+  for (std::size_t i = 1; i < r.time_s.size(); ++i) {
+    x_m += 0.5 * (r.speed_mps[i] + r.speed_mps[i - 1]) * (r.time_s[i] - r.time_s[i - 1]);
+    elevation_m[i] = 40.0 * std::sin(2.0 * M_PI * x_m / 4000.0);  // +-40 m over 4 km: grades up to 6 %
+  }
+  r.elevation_m = elevation_m;
+  const auto d = rollsim::diagnose(v, {r});
+  double uphill = 0.0, downhill = 0.0;
+  bool seen_up = false, seen_down = false;
+  for (const auto& l : d.located) {
+    if (l.regime.rfind("uphill", 0) == 0) { uphill = l.mean_w; seen_up = true; }
+    if (l.regime.rfind("downhill", 0) == 0) { downhill = l.mean_w; seen_down = true; }
+  }
+  ASSERT_TRUE(seen_up && seen_down);
+  EXPECT_LT(uphill, 0.0);
+  EXPECT_GT(downhill, 0.0);
+}

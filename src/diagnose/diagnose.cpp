@@ -783,7 +783,8 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
   if (d.channel != "soc") {
     std::map<std::string, std::pair<std::vector<double>, int>> by;  // values, order
     const std::vector<std::string> order{"standing", "accelerating", "cruising", "braking", "speed 0-50 km/h",
-                                         "speed 50-90 km/h", "speed >90 km/h", "first 10 min", "10-30 min", "after 30 min"};
+                                         "speed 50-90 km/h", "speed >90 km/h", "first 10 min", "10-30 min", "after 30 min",
+                                         "uphill (> 1 %)", "level", "downhill (< -1 %)"};
     std::map<std::string, std::vector<double>> vals;
     std::vector<double> all;
     for (std::size_t ri = 0; ri < recordings.size(); ++ri) {
@@ -799,6 +800,11 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
         vals[v < 0.3 ? "standing" : a > 0.3 ? "accelerating" : a < -0.3 ? "braking" : "cruising"].push_back(res);
         if (v >= 0.3) vals[v < 50 / 3.6 ? "speed 0-50 km/h" : v < 90 / 3.6 ? "speed 50-90 km/h" : "speed >90 km/h"].push_back(res);
         vals[t < 600 ? "first 10 min" : t < 1800 ? "10-30 min" : "after 30 min"].push_back(res);
+        // Grade regimes only where the recording gave grade or elevation (the replay trace then carries it).
+        if (r.grade || r.elevation_m) {
+          const double g = cycles[ri].grade[i];
+          if (v >= 0.3) vals[g > 0.01 ? "uphill (> 1 %)" : g < -0.01 ? "downhill (< -1 %)" : "level"].push_back(res);
+        }
       }
     }
     Eigen::VectorXd allv = Eigen::Map<Eigen::VectorXd>(all.data(), static_cast<Eigen::Index>(all.size()));
