@@ -4,16 +4,21 @@
 #include <iostream>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "commands.hpp"
 #include "rollsim/common/yaml_reader.hpp"
 #include "rollsim/diagnose/bench.hpp"
+#include "rollsim/diagnose/diagnose.hpp"
+#include "rollsim/recording/recording.hpp"
 
 namespace rollsim::cli {
 namespace {
 
 struct CliOptions {
   std::string vehicle = "ev";
+  std::vector<std::string> real_traces;
+  std::string real_trace_preset = "rsk_twizy";
   BenchOptions bench;
 };
 
@@ -27,9 +32,15 @@ void register_diagnose_bench_command(CLI::App& app) {
   sub->add_option("--null-seeds", o->bench.null_seeds, "Seeds of the null and time-reversed null (default 200)")->check(CLI::Range(1, 5000));
   sub->add_option("--threads", o->bench.threads, "Worker threads (default: every core)");
   sub->add_flag("--quick", o->bench.quick, "CI subset: warm-up at 30 %, two pairs, the nulls");
+  sub->add_option("--real-trace", o->real_traces, "A real recording whose speed trace also carries the null and a "
+                  "concealed tyre warm-up (repeatable)")->type_name("CSV");
+  sub->add_option("--real-trace-preset", o->real_trace_preset, "Column preset of the --real-trace files (default rsk_twizy)")
+      ->type_name("NAME");
   sub->callback([o] {
     const Vehicle v = load_vehicle_file(resolve_data_file(o->vehicle, "vehicles", ".yaml", "--vehicle"));
     BenchOptions b = o->bench;
+    const ColumnMapping mapping = preset_mapping(o->real_trace_preset);
+    for (const auto& path : o->real_traces) b.real_traces.push_back(cycle_of_recording(load_recording(path, mapping)));
     b.progress = isatty(STDERR_FILENO) != 0;
     std::cout << bench_text(run_discovery_bench(v, b));
   });

@@ -5,6 +5,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <filesystem>
 #include <array>
 #include <atomic>
 #include <chrono>
@@ -161,6 +162,24 @@ std::vector<Case> build_cases(const BenchOptions& o) {
     add("two", "wind 3 m/s + payload 150 kg", b, {"wind", "mass"}, o.seeds, 93000);
   }
   add("null", "null (calibration and noise only)", SyntheticCase{}, {}, o.null_seeds, 50000);
+  // The same on real speed traces (urban trips with their own stop-and-go), one block per trace.
+  unsigned real_block = 70000;
+  for (const auto& trace : o.real_traces) {
+    const std::string name = std::filesystem::path(trace.name).stem().string();
+    SyntheticCase nul;
+    nul.trace = trace;
+    add("null", "null on real trace " + name, nul, {}, std::max(1, o.null_seeds / 4), real_block);
+    if (!o.quick) {
+      for (double size : {0.2, 0.3}) {
+        SyntheticCase w;
+        w.trace = trace;
+        w.effects = {{"tyre_two_node", size}};
+        add("single", "tyre_two_node " + num(size) + " on real trace " + name, w, {"tyre_warmup"}, o.seeds,
+            real_block + 1000 * static_cast<unsigned>(size * 10));
+      }
+    }
+    real_block += 5000;
+  }
   SyntheticCase r;
   r.effects = {{"tyre_two_node", 0.3}};
   r.time_reversed = true;

@@ -221,7 +221,10 @@ Recording generate_case(const Vehicle& vehicle, const SyntheticCase& o) {
   std::mt19937 truth_rng(o.seed * 7919u + 13u);  // the truths' own randomness, apart from the artefacts' stream
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   DriveCycle c;
-  if (o.cycle == "steady") {
+  if (o.trace) {
+    c = *o.trace;
+    c.grade.assign(c.time_s.size(), 0.0);
+  } else if (o.cycle == "steady") {
     c = steady_cruise(truth_rng);
   } else {
     const DriveCycle one = load_cycle(o.cycle);

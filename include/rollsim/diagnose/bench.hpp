@@ -15,6 +15,8 @@ struct BenchOptions {
   bool quick = false;      ///< the CI subset: warm-up at 30 %, the null, the time-reversed null, one pair
   unsigned threads = 0;    ///< 0: every core
   bool progress = false;   ///< one line on stderr per finished recording count (terminals only)
+  /// Real speed traces (replay cycles of shipped recordings) on which the null and tyre warm-up are also concealed.
+  std::vector<DriveCycle> real_traces;
 };
 
 /// How one method fared on one case, over its seeds.

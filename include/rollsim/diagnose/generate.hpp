@@ -1,9 +1,11 @@
 // Synthetic recordings with concealed effects for the discovery benchmark: each truth is richer than its catalogue module.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "rollsim/cycle/drive_cycle.hpp"
 #include "rollsim/recording/recording.hpp"
 #include "rollsim/vehicle/vehicle.hpp"
 
@@ -32,6 +34,9 @@ const ConcealedTruthInfo& concealed_truth(const std::string& truth);  ///< throw
 /// slow +-1 km/h drift), the concealed effects, and the logger's artefacts (electric car, battery power channel).
 struct SyntheticCase {
   std::string cycle = "wltc";
+  /// A real speed trace to use instead of `cycle` (e.g. a shipped recording's, via cycle_of_recording); its grade
+  /// is dropped, so the truth drives a flat road at the recorded speeds. `repeats` is ignored.
+  std::optional<DriveCycle> trace;
   int repeats = 2;
   std::vector<ConcealedEffect> effects;
   double rrc_level_jitter = 0.03;  ///< truth's RRC level, uniform +- (calibration, not a discovery)
