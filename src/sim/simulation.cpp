@@ -197,6 +197,25 @@ void accumulate(const Instant& s, double speed_mps, double* d) {
   d[kUnmet] = 0.0;
 }
 
+// The accumulators that can be non-zero for this car and trace; the others are zero by construction, and every
+// quadrature costs vector arithmetic in each CVODES step.
+std::vector<int> active_accumulators_for(const VehicleModel& m, const DriveCycle& c, bool unmet_demand) {
+  const bool electric = m.powertrain->is_electric();
+  const bool graded = std::any_of(c.grade.begin(), c.grade.end(), [](double g) { return g != 0.0; });
+  const bool effects = !m.effects.empty();
+  std::vector<int> active;
+  for (int k = 0; k < kAccumulators; ++k) {
+    const bool needed = k == kGrade                              ? graded
+                        : (k == kOther || k == kWheelLoss)       ? effects
+                        : k == kUnmet                            ? unmet_demand
+                        : (k == kRegen || k == kMotor || k == kBatteryLoss || k == kTerminal) ? electric
+                        : (k == kFuelEnergy || k == kEngineLoss || k == kClutch || k == kFuelVolume) ? !electric || effects
+                        : true;
+    if (needed) active.push_back(k);
+  }
+  return active;
+}
+
 EnergyBreakdown breakdown_from(const double* acc) {
   EnergyBreakdown e;
   e.traction_j = acc[kTraction];
@@ -281,18 +300,7 @@ class ForwardSystem final : public OdeSystem {
       : m_(m), c_(c), o_(o), eval_(m), loads_(m, c) {
     standstill_.resize(c.time_s.size(), false);
     for (std::size_t i = 0; i + 1 < c.time_s.size(); ++i) standstill_[i] = c.speed_mps[i] == 0.0 && c.speed_mps[i + 1] == 0.0;
-    const bool electric = m.powertrain->is_electric();
-    const bool graded = std::any_of(c.grade.begin(), c.grade.end(), [](double g) { return g != 0.0; });
-    const bool effects = !m.effects.empty();
-    for (int k = 0; k < kAccumulators; ++k) {
-      const bool needed = k == kGrade        ? graded
-                          : (k == kOther || k == kWheelLoss) ? effects
-                          : k == kUnmet      ? false  // the forward car falls behind instead
-                          : (k == kRegen || k == kMotor || k == kBatteryLoss || k == kTerminal) ? electric
-                          : (k == kFuelEnergy || k == kEngineLoss || k == kClutch || k == kFuelVolume) ? !electric || effects
-                          : true;
-      if (needed) active_.push_back(k);
-    }
+    active_ = active_accumulators_for(m, c, false);  // the forward car falls behind instead of leaving demand unmet
   }
   bool standstill_segment(double t) const { return standstill_[c_.segment_index(t, hint_)]; }
   int size() const override { return kBaseStates + eval_.effect_states; }
