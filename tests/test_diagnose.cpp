@@ -174,3 +174,21 @@ TEST(DiagnoseLimits, LocatesUphillAndDownhillWhereElevationIsKnown) {
   EXPECT_LT(uphill, 0.0);
   EXPECT_GT(downhill, 0.0);
 }
+
+// A concealed warm-up leaves a slowly decaying, hence autocorrelated, residual; once the effect is found and fitted,
+// the held-out residual is whiter.
+TEST(DiagnoseLimits, FoundWarmupWhitensTheHeldOutResidual) {
+  const rollsim::Vehicle v = rollsim::load_vehicle_file(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/ev.yaml");
+  int checked = 0;
+  for (unsigned seed : {1u, 2u, 3u}) {
+    rollsim::SyntheticOptions o;
+    o.tyre_cold_excess = 0.3;
+    o.seed = seed;
+    const auto d = rollsim::diagnose(v, {rollsim::generate_recording(v, o)});
+    if (d.findings.empty() || d.findings.front().effect != "tyre_warmup") continue;
+    const auto& f = d.findings.front();
+    EXPECT_LT(f.heldout_lag1_autocorrelation_after, f.heldout_lag1_autocorrelation_before) << "seed " << seed;
+    ++checked;
+  }
+  EXPECT_GE(checked, 2);
+}

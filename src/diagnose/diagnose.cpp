@@ -621,7 +621,9 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
     fnd.heldout_rmse_before_j = rmse(pred_before, d.measured_j);
     fnd.heldout_rmse_after_j = rmse(best.pred, d.measured_j);
     fnd.heldout_energy_error_pct_before = energy_error_pct(pred_before, d.measured_j);
+    fnd.heldout_lag1_autocorrelation_before = lag1_autocorrelation(Eigen::VectorXd(d.measured_j - pred_before));
     fnd.heldout_energy_error_pct_after = energy_error_pct(best.pred, d.measured_j);
+    fnd.heldout_lag1_autocorrelation_after = lag1_autocorrelation(Eigen::VectorXd(d.measured_j - best.pred));
     x = hcat(x, c.signature);
     rss = best.fit.rss;
     coef_final = best.fit.coef;
@@ -743,7 +745,9 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
       fnd.heldout_rmse_before_j = rmse(pred_before, d.measured_j);
       fnd.heldout_rmse_after_j = rmse(best_pred, d.measured_j);
       fnd.heldout_energy_error_pct_before = energy_error_pct(pred_before, d.measured_j);
+      fnd.heldout_lag1_autocorrelation_before = lag1_autocorrelation(Eigen::VectorXd(d.measured_j - pred_before));
       fnd.heldout_energy_error_pct_after = energy_error_pct(best_pred, d.measured_j);
+      fnd.heldout_lag1_autocorrelation_after = lag1_autocorrelation(Eigen::VectorXd(d.measured_j - best_pred));
       x = hcat(x, b.signature);
       coef_final = best_fit.coef;
       out.findings.push_back(std::move(fnd));
@@ -870,7 +874,9 @@ std::string diagnosis_json(const Diagnosis& d) {
     os << "], \"delta_bic\": " << num(f.delta_bic) << ", \"heldout_rmse_before\": " << num(f.heldout_rmse_before_j)
        << ", \"heldout_rmse_after\": " << num(f.heldout_rmse_after_j)
        << ", \"heldout_energy_error_pct_before\": " << num(f.heldout_energy_error_pct_before)
-       << ", \"heldout_energy_error_pct_after\": " << num(f.heldout_energy_error_pct_after) << "}";
+       << ", \"heldout_energy_error_pct_after\": " << num(f.heldout_energy_error_pct_after)
+       << ", \"heldout_lag1_autocorrelation_before\": " << num(f.heldout_lag1_autocorrelation_before)
+       << ", \"heldout_lag1_autocorrelation_after\": " << num(f.heldout_lag1_autocorrelation_after) << "}";
   }
   os << (d.findings.empty() ? "" : "\n  ") << "],\n  \"located\": [";
   for (std::size_t i = 0; i < d.located.size(); ++i) {
@@ -915,7 +921,9 @@ std::string diagnosis_text(const Diagnosis& d) {
     for (const auto& p : f.parameters)
       os << "    " << p.name << " = " << p.value << " [" << p.ci_low << ", " << p.ci_high << "] " << p.unit << "\n";
     os << "    held-out RMSE " << f.heldout_rmse_before_j / 1e3 << " -> " << f.heldout_rmse_after_j / 1e3
-       << " kJ/window, trip energy error " << f.heldout_energy_error_pct_before << " -> " << f.heldout_energy_error_pct_after << " %\n";
+       << " kJ/window, trip energy error " << f.heldout_energy_error_pct_before << " -> " << f.heldout_energy_error_pct_after
+       << " %, residual lag-1 autocorrelation " << f.heldout_lag1_autocorrelation_before << " -> "
+       << f.heldout_lag1_autocorrelation_after << " (0: white)\n";
   }
   if (!d.detection_limits.empty()) {
     os << "not found; smallest size of each effect's catalogue shape this data would have shown (a lower bound:\n"

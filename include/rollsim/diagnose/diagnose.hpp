@@ -43,6 +43,8 @@ struct Finding {
   double delta_bic = 0.0;
   double heldout_rmse_before_j = 0.0, heldout_rmse_after_j = 0.0;  ///< per window
   double heldout_energy_error_pct_before = 0.0, heldout_energy_error_pct_after = 0.0;
+  /// Whiteness of the held-out window residual: its lag-1 autocorrelation (0 for white noise), before and after.
+  double heldout_lag1_autocorrelation_before = 0.0, heldout_lag1_autocorrelation_after = 0.0;
   EffectParameters fitted;  ///< for --write-vehicle
 };
 
