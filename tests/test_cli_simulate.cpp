@@ -4,6 +4,7 @@
 #include "test_support.hpp"
 
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 namespace {
@@ -60,3 +61,15 @@ TEST(CliSimulate, BadInputGivesOneClearErrorAndNonZeroExit) {
     EXPECT_NE(out.text.find("no_such"), std::string::npos) << args << ": " << out.text;
   }
 }
+
+// A tyre loaded above its rating runs, with a warning naming it (load index 75: 387 kg, 3795 N < 4000 N).
+TEST(CliSimulate, OverloadedTyreRunsWithAWarning) {
+  const auto tyre = rollsim::test::temp_dir() / "li75.yaml";
+  std::ofstream(tyre) << "size: \"195/65 R15 75T\"\npressure_bar: 2.5\n";
+  const auto r = rollsim::test::run_rollsim("simulate --vehicle ev --tyre '" + tyre.string() + "'");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("warning:"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("rated maximum"), std::string::npos) << r.err;
+  EXPECT_NE(r.out.find("kWh/10 km"), std::string::npos);
+}
+

@@ -52,16 +52,11 @@ void run_simulate(const SimulateOptions& o) {
       if (tyre) {
         fit_tyres(v, *tyre);
         label = tyre->name;
-        // A tyre must carry the car's wheel load: the model has no solution past the rim.
-        const auto loads = wheel_loads(v.body, 0.0);
-        try {
-          check_operating_point(tyre->state, std::max(loads.front_n, loads.rear_n), 0.0);
-        } catch (const ModelDomainError& e) {
-          throw InputError("--tyre '" + tyre->source + "'", e.what());
-        }
-        if (tyre->max_load_n > 0.0 && std::max(loads.front_n, loads.rear_n) > tyre->max_load_n)
-          std::cerr << "warning: --tyre '" << tyre->source << "': wheel load " << report::fixed(std::max(loads.front_n, loads.rear_n), 0)
-                    << " N exceeds the tyre's rated maximum " << report::fixed(tyre->max_load_n, 0) << " N\n";
+      }
+      // Once per tyre set (the first cycle): an overloaded tyre is allowed but said.
+      if (&cycle == &cycles.front()) {
+        for (const auto& w : check_tyre_loads(v, tyre ? "--tyre '" + tyre->source + "'" : base.source))
+          std::cerr << "warning: " << w << "\n";
       }
       const VehicleModel model = VehicleModel::assemble(v);
       SimulationResult r;

@@ -215,19 +215,27 @@ Vehicle load_vehicle_file(const std::string& path) {
   root.accept("recording_scale");
   root.finish();
 
-  // Every tyre must carry its static load: the model has no solution past the rim.
-  if (v.front_tyre) {
-    const auto loads = wheel_loads(v.body, 0.0);
-    for (const auto& [tyre, load_n, axle] : {std::tuple{*v.front_tyre, loads.front_n, "front"},
-                                              std::tuple{*v.rear_tyre, loads.rear_n, "rear"}}) {
-      try {
-        check_operating_point(tyre.state, load_n, 0.0);
-      } catch (const ModelDomainError& e) {
-        throw InputError(path + ": " + axle + " tyre '" + tyre.name + "'", e.what());
-      }
+  check_tyre_loads(v, path);
+  return v;
+}
+
+std::vector<std::string> check_tyre_loads(const Vehicle& vehicle, const std::string& where) {
+  std::vector<std::string> warnings;
+  if (!vehicle.front_tyre) return warnings;
+  const auto loads = wheel_loads(vehicle.body, 0.0);
+  for (const auto& [tyre, load_n, axle] : {std::tuple{*vehicle.front_tyre, loads.front_n, "front"},
+                                            std::tuple{*vehicle.rear_tyre, loads.rear_n, "rear"}}) {
+    try {
+      check_operating_point(tyre.state, load_n, 0.0);
+    } catch (const ModelDomainError& e) {
+      throw InputError(where + ": " + axle + " tyre '" + tyre.name + "'", e.what());
+    }
+    if (tyre.max_load_n > 0.0 && load_n > tyre.max_load_n) {
+      warnings.push_back(where + ": " + axle + " tyre '" + tyre.name + "': wheel load " + format_value(std::round(load_n)) +
+                         " N exceeds its rated maximum " + format_value(std::round(tyre.max_load_n)) + " N");
     }
   }
-  return v;
+  return warnings;
 }
 
 void fit_tyres(Vehicle& vehicle, const TyreSpec& tyre) {
