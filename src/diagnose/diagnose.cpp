@@ -826,6 +826,52 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
       const double half = 1.96 * std::sqrt(var * factor / static_cast<double>(v.size()));
       out.located.push_back({name, static_cast<int>(v.size()), mean, mean - half, mean + half});
     }
+  } else {
+    // SOC gives energy per window, not power per sample: locate by window, each window in the regimes of its own
+    // means (speed, grade, time since start). Mean residual power of the windows, with the same AR(1) inflation.
+    const Eigen::VectorXd res_j = d.measured_j - xc * cal.coef;
+    std::map<std::string, std::vector<double>> vals;
+    const std::vector<std::string> order{"standing (window)", "speed 0-50 km/h (window)", "speed 50-90 km/h (window)",
+                                         "speed >90 km/h (window)", "first 10 min (window)", "10-30 min (window)",
+                                         "after 30 min (window)", "uphill > 1 % (window)", "level (window)",
+                                         "downhill < -1 % (window)"};
+    for (std::size_t w = 0; w < d.windows.size(); ++w) {
+      const auto& win = d.windows[w];
+      const DriveCycle& c = cycles[win.rec];
+      const double duration_s = c.time_s[win.end] - c.time_s[win.begin];
+      if (!(duration_s > 0.0)) continue;
+      double distance_m = 0.0, rise = 0.0;
+      for (std::size_t i = win.begin; i < win.end; ++i) {
+        const double ds = 0.5 * (c.speed_mps[i] + c.speed_mps[i + 1]) * (c.time_s[i + 1] - c.time_s[i]);
+        distance_m += ds;
+        rise += c.grade[i] * ds;
+      }
+      const double v = distance_m / duration_s;
+      const double p_w = res_j[static_cast<Eigen::Index>(w)] / duration_s;
+      const double mid_s = 0.5 * (c.time_s[win.begin] + c.time_s[win.end]) - c.time_s.front();
+      vals[v < 0.5 ? "standing (window)" : v < 50 / 3.6 ? "speed 0-50 km/h (window)"
+                                         : v < 90 / 3.6 ? "speed 50-90 km/h (window)" : "speed >90 km/h (window)"].push_back(p_w);
+      vals[mid_s < 600 ? "first 10 min (window)" : mid_s < 1800 ? "10-30 min (window)" : "after 30 min (window)"].push_back(p_w);
+      const Recording& r = recordings[win.rec];
+      if ((r.grade || r.elevation_m) && distance_m > 0.0) {
+        const double g = rise / distance_m;
+        vals[g > 0.01 ? "uphill > 1 % (window)" : g < -0.01 ? "downhill < -1 % (window)" : "level (window)"].push_back(p_w);
+      }
+    }
+    const double rs = std::clamp(lag1_autocorrelation(res_j), 0.0, 0.99);
+    const double factor = (1.0 + rs) / (1.0 - rs);
+    for (const auto& name : order) {
+      const auto it = vals.find(name);
+      if (it == vals.end() || it->second.size() < 2) continue;
+      const auto& v = it->second;
+      double mean = 0.0, var = 0.0;
+      for (double e : v) mean += e;
+      mean /= static_cast<double>(v.size());
+      for (double e : v) var += (e - mean) * (e - mean);
+      var /= static_cast<double>(v.size() - 1);
+      const double half = 1.96 * std::sqrt(var * factor / static_cast<double>(v.size()));
+      out.located.push_back({name, static_cast<int>(v.size()), mean, mean - half, mean + half});
+    }
   }
   return out;
 }
