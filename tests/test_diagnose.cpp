@@ -239,3 +239,43 @@ TEST(DiagnoseLimits, LocatesSocRecordingsByWindow) {
   EXPECT_GT(first_low, 0.0);
   EXPECT_GT(first, late + 500.0);
 }
+
+#include "rollsim/diagnose/generate.hpp"
+
+// The fuel and SOC channels of the generator: the artefacts are in the channel's own units (a non-negative flow
+// on its meter's quantum; SOC on the BMS's 0.1 % steps), and the concealed truths add energy where they should.
+TEST(Generate, FuelAndSocChannelsCarryTheirTruths) {
+  const rollsim::Vehicle ice = rollsim::load_vehicle_file(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/ice.yaml");
+  const rollsim::Vehicle ev = rollsim::load_vehicle_file(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/ev.yaml");
+  auto total = [](const std::vector<double>& x, std::size_t from, std::size_t to) {
+    double s = 0.0;
+    for (std::size_t i = from; i < to; ++i) s += x[i];
+    return s;
+  };
+  rollsim::SyntheticCase f;
+  f.channel = rollsim::SyntheticChannel::fuel_rate;
+  const rollsim::Recording nul = rollsim::generate_case(ice, f);
+  f.effects = {{"engine_oil_coolant", 0.4}};
+  const rollsim::Recording cold = rollsim::generate_case(ice, f);  // same seed: same artefacts' stream
+  ASSERT_TRUE(nul.fuel_rate_m3ps && cold.fuel_rate_m3ps);
+  EXPECT_FALSE(cold.battery_power_w || cold.soc_fraction);
+  const auto& fn = *nul.fuel_rate_m3ps;
+  EXPECT_GE(*std::min_element(fn.begin(), fn.end()), 0.0);
+  const double q = f.fuel_quantum_m3ps;
+  for (double x : fn) EXPECT_NEAR(x / q, std::round(x / q), 1e-6);
+  // Cold start: clearly more fuel in the first 5 minutes; warm after an hour: within the noise.
+  EXPECT_GT(total(*cold.fuel_rate_m3ps, 0, 300), 1.15 * total(fn, 0, 300));
+  const std::size_t n = fn.size();
+  EXPECT_NEAR(total(*cold.fuel_rate_m3ps, n - 600, n), total(fn, n - 600, n), 0.01 * total(fn, n - 600, n));
+
+  rollsim::SyntheticCase s;
+  s.channel = rollsim::SyntheticChannel::soc;
+  const rollsim::Recording base = rollsim::generate_case(ev, s);
+  s.effects = {{"battery_r_of_soc", 0.2}};
+  const rollsim::Recording worn = rollsim::generate_case(ev, s);
+  ASSERT_TRUE(base.soc_fraction && worn.soc_fraction);
+  const auto& sb = *base.soc_fraction;
+  for (double x : sb) EXPECT_NEAR(x / 0.001, std::round(x / 0.001), 1e-6);
+  EXPECT_LT(sb.back(), sb.front() - 0.1);
+  EXPECT_LT(worn.soc_fraction->back(), sb.back());  // the extra resistance's loss drains the cells faster
+}

@@ -13,9 +13,11 @@
 #include <cstdio>
 #include <iomanip>
 #include <mutex>
+#include <optional>
 #include <sstream>
 #include <thread>
 
+#include "rollsim/common/yaml_reader.hpp"
 #include "rollsim/cycle/drive_cycle.hpp"
 #include "rollsim/diagnose/diagnose.hpp"
 #include "rollsim/sim/simulation.hpp"
@@ -29,15 +31,24 @@ std::pair<double, double> wilson_interval(int k, int n) {
   return {std::max(0.0, c - h), std::min(1.0, c + h)};
 }
 
-std::vector<std::string> sparse_regression_discovery(const Vehicle& vehicle, const Recording& rec) {
+std::vector<std::string> sparse_regression_discovery(const Vehicle& vehicle, const Recording& rec, double window_s) {
   // Nominal model on the recorded speed: the regression explains the measured window energy by the simulated one
   // plus library terms, as a SINDy user without the physics catalogue would.
   const DriveCycle c = cycle_of_recording(rec);
   SimulationOptions so;
   so.record_trace = true;
   const SimulationResult sim = simulate_replay(VehicleModel::assemble(vehicle), c, so);
-  const std::vector<double>& meas = *rec.battery_power_w;
-  constexpr double kWindowS = 60.0;  // the diagnosis' windows
+  // The channel in the simulation's energy domain: battery power, fuel chemical power, or SOC x capacity.
+  double fuel_j_per_m3 = 0.0, capacity_j = 0.0;
+  if (const auto* cp = std::get_if<CombustionPowertrainParams>(&vehicle.powertrain))
+    fuel_j_per_m3 = cp->fuel.density_kg_per_m3 * cp->fuel.lower_heating_value_j_per_kg;
+  if (const auto* ep = std::get_if<ElectricPowertrainParams>(&vehicle.powertrain)) capacity_j = ep->battery.usable_capacity_j;
+  const bool soc = !rec.battery_power_w && !rec.fuel_rate_m3ps && rec.soc_fraction;
+  std::vector<double> meas(rec.time_s.size(), 0.0);
+  if (rec.battery_power_w) meas = *rec.battery_power_w;
+  else if (rec.fuel_rate_m3ps)
+    for (std::size_t i = 0; i < meas.size(); ++i) meas[i] = (*rec.fuel_rate_m3ps)[i] * fuel_j_per_m3;
+  const double kWindowS = window_s;  // the diagnosis' windows
   constexpr int kTerms = 7;          // sim, 1, v, v^2, v^3, a, a v
   std::vector<std::array<double, kTerms>> rows;
   std::vector<double> y;
@@ -46,9 +57,11 @@ std::vector<std::string> sparse_regression_discovery(const Vehicle& vehicle, con
   for (std::size_t i = 0; i + 1 < rec.time_s.size() && i < sim.trace.size(); ++i) {
     const double dt = rec.time_s[i + 1] - rec.time_s[i], v = rec.speed_mps[i];
     const double a = (rec.speed_mps[i + 1] - v) / dt;
-    const std::array<double, kTerms> phi{sim.trace[i].battery_power_w, 1.0, v, v * v, v * v * v, a, a * v};
+    const double sim_w = fuel_j_per_m3 > 0.0 ? sim.trace[i].fuel_rate_m3_per_s * fuel_j_per_m3 : sim.trace[i].battery_power_w;
+    const std::array<double, kTerms> phi{sim_w, 1.0, v, v * v, v * v * v, a, a * v};
     for (int k = 0; k < kTerms; ++k) acc[k] += phi[k] * dt;
-    yw += meas[i] * dt;
+    // SOC is a state: a window's energy is its drop times the capacity, not an integral of samples.
+    yw += soc ? ((*rec.soc_fraction)[i] - (*rec.soc_fraction)[i + 1]) * capacity_j : meas[i] * dt;
     if (rec.time_s[i + 1] - w0 >= kWindowS) {
       rows.push_back(acc);
       y.push_back(yw);
@@ -111,6 +124,7 @@ struct Case {
   std::vector<std::string> expected;
   int seeds = 0;
   unsigned seed0 = 0;
+  bool combustion = false;  ///< run on the combustion car (fuel channel) instead of the bench's electric one
 };
 
 struct Outcome {
@@ -139,7 +153,10 @@ std::vector<Case> build_cases(const BenchOptions& o) {
       if (o.quick && !(t.truth == "tyre_two_node" && size == 0.3)) continue;
       SyntheticCase s;
       s.effects = {{t.truth, size}};
-      add("single", t.truth + " " + num(size) + " " + t.size_unit, s, {t.catalogue_id}, o.seeds, block);
+      s.channel = t.channel;
+      const char* where = t.channel == SyntheticChannel::fuel_rate ? " (ice, fuel)" : t.channel == SyntheticChannel::soc ? " (SOC)" : "";
+      add("single", t.truth + " " + num(size) + " " + t.size_unit + where, s, {t.catalogue_id}, o.seeds, block);
+      cases.back().combustion = t.channel == SyntheticChannel::fuel_rate;
       block += 1000;
     }
   }
@@ -162,6 +179,18 @@ std::vector<Case> build_cases(const BenchOptions& o) {
     add("two", "wind 3 m/s + payload 150 kg", b, {"wind", "mass"}, o.seeds, 93000);
   }
   add("null", "null (calibration and noise only)", SyntheticCase{}, {}, o.null_seeds, 50000);
+  if (!o.quick) {
+    // The fuel and SOC channels' own nulls (their artefacts differ: a flow meter's quantum and zero under fuel cut;
+    // a 0.1 % SOC quantum with lengthened windows), at least 50 seeds each.
+    const int channel_null_seeds = std::max(50, o.null_seeds / 4);
+    SyntheticCase f;
+    f.channel = SyntheticChannel::fuel_rate;
+    add("null", "null, fuel channel (ice.yaml)", f, {}, channel_null_seeds, 52000);
+    cases.back().combustion = true;
+    SyntheticCase q;
+    q.channel = SyntheticChannel::soc;
+    add("null", "null, SOC channel (ev.yaml)", q, {}, channel_null_seeds, 54000);
+  }
   // The same on real speed traces (urban trips with their own stop-and-go), one block per trace.
   unsigned real_block = 70000;
   for (const auto& trace : o.real_traces) {
@@ -229,6 +258,9 @@ void score_one(const Case& c, const Outcome& r, BenchRow& row) {
 BenchResult run_discovery_bench(const Vehicle& vehicle, const BenchOptions& opt) {
   const auto t0 = std::chrono::steady_clock::now();
   const std::vector<Case> cases = build_cases(opt);
+  std::optional<Vehicle> combustion;
+  if (std::any_of(cases.begin(), cases.end(), [](const Case& c) { return c.combustion; }))
+    combustion = load_vehicle_file(resolve_data_file(opt.combustion_vehicle, "vehicles", ".yaml", "combustion vehicle"));
   struct Task {
     std::size_t c;
     int s;
@@ -245,8 +277,9 @@ BenchResult run_discovery_bench(const Vehicle& vehicle, const BenchOptions& opt)
       const Case& c = cases[tasks[k].c];
       SyntheticCase s = c.synth;
       s.seed = c.seed0 + static_cast<unsigned>(tasks[k].s);
-      const Recording rec = generate_case(vehicle, s);
-      const Diagnosis d = diagnose(vehicle, {rec});
+      const Vehicle& car = c.combustion ? *combustion : vehicle;
+      const Recording rec = generate_case(car, s);
+      const Diagnosis d = diagnose(car, {rec});
       Outcome& o = out[k];
       for (std::size_t f = 0; f < d.findings.size(); ++f) {
         o.all.push_back(d.findings[f].effect);
@@ -256,7 +289,7 @@ BenchResult run_discovery_bench(const Vehicle& vehicle, const BenchOptions& opt)
           o.first_value = d.findings[f].parameters.empty() ? 0.0 : d.findings[f].parameters.front().value;
         }
       }
-      o.sparse = sparse_regression_discovery(vehicle, rec);
+      o.sparse = sparse_regression_discovery(car, rec, d.window_s);
       const std::size_t n = done.fetch_add(1) + 1;
       if (opt.progress) {
         std::lock_guard<std::mutex> lock(io);

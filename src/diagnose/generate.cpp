@@ -167,6 +167,58 @@ class MagicFormulaSlipTruth final : public Effect {
   double cx_per_tyre_n_, fz_driven_, fz_all_;
 };
 
+// Truth cold engine, applied to the simulated fuel power after the run (its own code path, no Effect): two
+// thermal nodes above ambient, coolant (engine block and water, 75 kJ/K) and oil (15 kJ/K). The fuel power's
+// losses (fuel power minus positive traction power) heat the coolant (30 %) and the oil (8 %), the rest leaves with
+// the exhaust; oil and coolant exchange 60 W/K; the coolant loses 15 W/K below the thermostat (80 K above
+// ambient) and 600 W/K above it (radiator); the oil sump 5 W/K. Friction follows oil viscosity,
+// ~ exp(b (T_ref - T_oil)) with b = 0.035 /K, so the fuel power is multiplied by
+// 1 + k (exp(b (T_ref - T_oil)) - 1) / (exp(b T_ref) - 1) below T_ref = 80 K: exactly 1 + k cold, 1 warm.
+// The extra fuel's losses heat the engine too (the step uses the multiplied fuel power).
+std::vector<double> oil_coolant_fuel_power_w(const SimulationResult& r, double fuel_j_per_m3, double cold_excess) {
+  constexpr double kCoolantJPerK = 75000.0, kOilJPerK = 15000.0, kToCoolant = 0.30, kToOil = 0.08;
+  constexpr double kOilCoolantWPerK = 60.0, kCoolantWPerK = 15.0, kRadiatorWPerK = 600.0, kThermostatK = 80.0;
+  constexpr double kSumpWPerK = 5.0, kViscosityPerK = 0.035, kRefK = 80.0;
+  const double norm = std::exp(kViscosityPerK * kRefK) - 1.0;
+  double oil_k = 0.0, coolant_k = 0.0;
+  std::vector<double> p(r.trace.size());
+  for (std::size_t i = 0; i < r.trace.size(); ++i) {
+    const double rise = oil_k < kRefK ? (std::exp(kViscosityPerK * (kRefK - oil_k)) - 1.0) / norm : 0.0;
+    p[i] = r.trace[i].fuel_rate_m3_per_s * fuel_j_per_m3 * (1.0 + cold_excess * rise);
+    if (i + 1 == r.trace.size()) break;
+    const double dt = r.trace[i + 1].time_s - r.trace[i].time_s;
+    const double loss_w = std::max(0.0, p[i] - std::max(0.0, r.trace[i].traction_power_w));
+    const double exchange_w = kOilCoolantWPerK * (coolant_k - oil_k);
+    const double cooling_w = coolant_k < kThermostatK ? kCoolantWPerK * coolant_k
+                                                      : kCoolantWPerK * coolant_k + kRadiatorWPerK * (coolant_k - kThermostatK);
+    coolant_k += dt * (kToCoolant * loss_w - exchange_w - cooling_w) / kCoolantJPerK;
+    oil_k += dt * (kToOil * loss_w + exchange_w - kSumpWPerK * oil_k) / kOilJPerK;
+  }
+  return p;
+}
+
+// Truth battery, integrated from the simulated terminal power after the run (its own code path): open-circuit
+// voltage falling with SOC (OCV = V_nom (0.92 + 0.16 SOC), a flat NMC-like curve), the vehicle file's resistance
+// plus an extra R(SOC) = dR (1 + 2 (1 - SOC)^2) (resistance rises as the cells empty), the current from
+// P = OCV I - R I^2, the loss I^2 R drawn from the cells with the terminal power. Returns SOC per sample.
+std::vector<double> soc_with_resistance(const SimulationResult& r, const BatteryParams& b, double initial_soc, double extra_ohm) {
+  std::vector<double> soc(r.trace.size());
+  double x = initial_soc;
+  for (std::size_t i = 0; i < r.trace.size(); ++i) {
+    soc[i] = x;
+    if (i + 1 == r.trace.size()) break;
+    const double dt = r.trace[i + 1].time_s - r.trace[i].time_s;
+    const double p = r.trace[i].battery_power_w;
+    const double ocv = b.open_circuit_voltage_v * (0.92 + 0.16 * std::clamp(x, 0.0, 1.0));
+    const double ohm = b.internal_resistance_ohm + extra_ohm * (1.0 + 2.0 * std::pow(1.0 - std::clamp(x, 0.0, 1.0), 2));
+    // Discharge root of R I^2 - OCV I + P = 0 (the smaller current); beyond the maximum power, the peak current.
+    const double disc = std::max(0.0, ocv * ocv - 4.0 * ohm * p);
+    const double i_a = ohm > 0.0 ? (ocv - std::sqrt(disc)) / (2.0 * ohm) : p / ocv;
+    x -= dt * (p + i_a * i_a * ohm) / b.usable_capacity_j;
+  }
+  return soc;
+}
+
 DriveCycle steady_cruise(std::mt19937& rng) {
   // An hour at 90 km/h with a slow +-1 km/h drift, 60 s ramps at both ends: speed hardly varies.
   DriveCycle c;
@@ -206,6 +258,12 @@ const std::vector<ConcealedTruthInfo>& concealed_truths() {
       {"underinflated", "rr_speed", "bar (pressure change)", "tyre pressure lowered in the tyre model (level and speed curve change)", {-0.3, -0.6, -0.9}},
       {"regen_cap", "regen_limit", "W (regen power limit)", "the powertrain's own regen limit lowered from 20 kW", {12000, 8000, 4000}},
       {"hilly_climb", "road_grade", "1 (net grade)", "net climb plus unrecorded hills (1 % amplitude, 0.8-3 km wavelengths)", {0.002, 0.005, 0.01}},
+      {"engine_oil_coolant", "engine_warmup", "1 (cold fuel excess)",
+       "oil + coolant nodes heated by the fuel losses, thermostat, friction ~ exp(b (T_ref - T_oil)) (fuel channel)",
+       {0.1, 0.2, 0.4}, SyntheticChannel::fuel_rate},
+      {"battery_r_of_soc", "battery_resistance", "ohm (extra at full charge)",
+       "extra cell resistance rising as SOC falls, OCV(SOC), loss I^2 R (SOC channel, 0.1 % quantum)",
+       {0.05, 0.1, 0.2}, SyntheticChannel::soc},
   };
   return kTruths;
 }
@@ -245,9 +303,16 @@ Recording generate_case(const Vehicle& vehicle, const SyntheticCase& o) {
   truths.push_back(std::make_shared<RrcLevelTruth>(level));
   const double rho_cda = vehicle.body.air_density_kg_per_m3 * vehicle.body.drag_coefficient * vehicle.body.frontal_area_m2;
   const double weight_n = vehicle.body.test_mass_kg * kG;
+  double engine_cold_excess = 0.0, battery_extra_ohm = 0.0;  // post-run truths, applied to the channel below
   for (const auto& e : o.effects) {
     const std::string& t = concealed_truth(e.truth).truth;
-    if (t == "tyre_two_node") {
+    if (t == "engine_oil_coolant") {
+      if (o.channel != SyntheticChannel::fuel_rate) throw InputError("concealed truth 'engine_oil_coolant'", "needs the fuel channel");
+      engine_cold_excess = e.size;
+    } else if (t == "battery_r_of_soc") {
+      if (o.channel != SyntheticChannel::soc) throw InputError("concealed truth 'battery_r_of_soc'", "needs the SOC channel");
+      battery_extra_ohm = e.size;
+    } else if (t == "tyre_two_node") {
       truths.push_back(std::make_shared<TwoNodeTyreTruth>(e.size, o.time_reversed, c.duration_s()));
     } else if (t == "aux_compressor") {
       const double period = 300.0 + 60.0 * unit(truth_rng);
@@ -296,19 +361,52 @@ Recording generate_case(const Vehicle& vehicle, const SyntheticCase& o) {
   so.record_trace = true;
   const SimulationResult r = simulate_replay(model, truth_cycle, so);
   const double scale = 1.0 + o.scale_jitter * unit(rng);
-  std::normal_distribution<double> noise(0.0, o.noise_w);
   Recording rec;
   rec.source = "synthetic " + c.name + " seed " + std::to_string(o.seed);
   const std::size_t n = r.trace.size();  // one point per segment start; the last sample is dropped
   const auto lag = static_cast<std::size_t>(std::lround(std::max(0.0, o.lag_s)));
+  rec.time_s.assign(c.time_s.begin(), c.time_s.begin() + static_cast<long>(n));
+  rec.speed_mps.assign(c.speed_mps.begin(), c.speed_mps.begin() + static_cast<long>(n));
+  // no grade column in any channel: the diagnosis sees a flat road
+  if (o.channel == SyntheticChannel::soc) {
+    const auto* ep = std::get_if<ElectricPowertrainParams>(&truth_vehicle.powertrain);
+    if (!ep) throw InputError("synthetic SOC channel", "needs an electric vehicle");
+    // The scale error is the BMS's capacity estimate (the SOC drop is scaled); SOC is a state, so no lag.
+    const std::vector<double> soc = soc_with_resistance(r, ep->battery, ep->battery.initial_soc, battery_extra_ohm);
+    std::vector<double> q(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const double x = soc.front() - scale * (soc.front() - soc[i]);
+      q[i] = o.soc_quantum > 0.0 ? o.soc_quantum * std::round(x / o.soc_quantum) : x;
+    }
+    rec.soc_fraction = q;
+    return rec;
+  }
+  std::vector<double> truth_w(n);
+  if (o.channel == SyntheticChannel::fuel_rate) {
+    const auto* cp = std::get_if<CombustionPowertrainParams>(&truth_vehicle.powertrain);
+    if (!cp) throw InputError("synthetic fuel channel", "needs a combustion vehicle");
+    const double j_per_m3 = cp->fuel.density_kg_per_m3 * cp->fuel.lower_heating_value_j_per_kg;
+    truth_w = oil_coolant_fuel_power_w(r, j_per_m3, engine_cold_excess);
+    std::normal_distribution<double> noise(0.0, o.fuel_noise_w);
+    std::vector<double> f(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      // Under fuel cut the injectors are shut and the ECU reports exactly zero; otherwise the reading is noisy but
+      // never negative.
+      const double w = truth_w[i >= lag ? i - lag : 0];
+      const double e = noise(rng);
+      const double m3ps = w > 0.0 ? std::max(0.0, (w * scale + e) / j_per_m3) : 0.0;
+      f[i] = o.fuel_quantum_m3ps > 0.0 ? o.fuel_quantum_m3ps * std::round(m3ps / o.fuel_quantum_m3ps) : m3ps;
+    }
+    rec.fuel_rate_m3ps = f;
+    return rec;
+  }
+  std::normal_distribution<double> noise(0.0, o.noise_w);
   std::vector<double> p(n);
   for (std::size_t i = 0; i < n; ++i) {
     const double truth = r.trace[i >= lag ? i - lag : 0].battery_power_w * scale + noise(rng);
     p[i] = o.quantum_w > 0.0 ? o.quantum_w * std::round(truth / o.quantum_w) : truth;
   }
-  rec.time_s.assign(c.time_s.begin(), c.time_s.begin() + static_cast<long>(n));
-  rec.speed_mps.assign(c.speed_mps.begin(), c.speed_mps.begin() + static_cast<long>(n));
-  rec.battery_power_w = p;  // no grade column: the diagnosis sees a flat road
+  rec.battery_power_w = p;
   return rec;
 }
 

@@ -17,6 +17,9 @@ struct BenchOptions {
   bool progress = false;   ///< one line on stderr per finished recording count (terminals only)
   /// Real speed traces (replay cycles of shipped recordings) on which the null and tyre warm-up are also concealed.
   std::vector<DriveCycle> real_traces;
+  /// The combustion car of the fuel-channel cases (engine warm-up, fuel null), a shipped name or a path; not
+  /// loaded in the quick subset, which has no fuel case.
+  std::string combustion_vehicle = "ice";
 };
 
 /// How one method fared on one case, over its seeds.
@@ -42,7 +45,8 @@ struct BenchResult {
   unsigned threads = 1;
 };
 
-/// Runs the cases on `vehicle` (electric, battery power channel). Seeds are fixed, so runs are reproducible.
+/// Runs the cases on `vehicle` (electric: battery power and SOC channels) and, for the fuel-channel cases, on
+/// opt.combustion_vehicle. Seeds are fixed, so runs are reproducible.
 BenchResult run_discovery_bench(const Vehicle& vehicle, const BenchOptions& opt);
 
 /// The scorecard as plain text (false-discovery rates with Wilson 95 % intervals).
@@ -53,7 +57,9 @@ std::pair<double, double> wilson_interval(int k, int n);
 
 /// The sparse-regression baseline on one recording: sequential thresholded least squares on window integrals of
 /// {1, v, v^2, v^3, a, a v} beside the simulated energy; returns the catalogue ids its selected non-calibration
-/// terms map to, largest contribution first ("mass|rotational_inertia" for the inertial term a v).
-std::vector<std::string> sparse_regression_discovery(const Vehicle& vehicle, const Recording& rec);
+/// terms map to, largest contribution first ("mass|rotational_inertia" for the inertial term a v). The measured
+/// channel is the recording's battery power, fuel rate (as fuel power) or SOC (window differences x capacity);
+/// `window_s` is the window length (the diagnosis lengthens it for a quantised SOC).
+std::vector<std::string> sparse_regression_discovery(const Vehicle& vehicle, const Recording& rec, double window_s = 60.0);
 
 }  // namespace rollsim

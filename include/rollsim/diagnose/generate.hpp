@@ -19,6 +19,13 @@ struct ConcealedEffect {
   double size = 0.0;
 };
 
+/// The energy channel a synthetic recording carries (the logger's artefacts are in that channel's own units).
+enum class SyntheticChannel {
+  battery_power,  ///< Recording::battery_power_w (electric car)
+  fuel_rate,      ///< Recording::fuel_rate_m3ps (combustion car)
+  soc,            ///< Recording::soc_fraction, quantised like a BMS display (electric car)
+};
+
 /// What each truth is, which catalogue effect an honest diagnosis should name, and a sweep of sizes.
 struct ConcealedTruthInfo {
   std::string truth;            ///< e.g. "aux_compressor"
@@ -26,12 +33,15 @@ struct ConcealedTruthInfo {
   std::string size_unit;
   std::string description;      ///< the truth's model, in words
   std::vector<double> sweep;    ///< sizes, smallest effect first
+  /// The channel the truth is written to; a fuel-channel truth needs a combustion car (vehicles/ice.yaml).
+  SyntheticChannel channel = SyntheticChannel::battery_power;
 };
 const std::vector<ConcealedTruthInfo>& concealed_truths();
 const ConcealedTruthInfo& concealed_truth(const std::string& truth);  ///< throws InputError when unknown
 
 /// One synthetic recording: a speed trace (a shipped cycle repeated, or "steady", an hour of 90 km/h cruising with
-/// slow +-1 km/h drift), the concealed effects, and the logger's artefacts (electric car, battery power channel).
+/// slow +-1 km/h drift), the concealed effects, and the logger's artefacts in the chosen channel (battery power or
+/// SOC of an electric car, fuel rate of a combustion car).
 struct SyntheticCase {
   std::string cycle = "wltc";
   /// A real speed trace to use instead of `cycle` (e.g. a shipped recording's, via cycle_of_recording); its grade
@@ -44,6 +54,12 @@ struct SyntheticCase {
   double noise_w = 400.0;          ///< white sensor noise, standard deviation
   double quantum_w = 100.0;        ///< logger quantisation
   double lag_s = 1.0;              ///< channel lag
+  SyntheticChannel channel = SyntheticChannel::battery_power;
+  /// Fuel channel: white noise of the fuel power [W] (three times noise_w: at the engine's ~30 % efficiency the
+  /// same road-load error is three times the chemical power) and the flow meter's quantum (0.05 l/h).
+  double fuel_noise_w = 1200.0;
+  double fuel_quantum_m3ps = 0.05e-3 / 3600.0;
+  double soc_quantum = 0.001;  ///< SOC channel: the BMS's resolution (0.1 %); the channel is noise-free otherwise
   bool time_reversed = false;      ///< tyre truths: the warm-up decay placed at the end of the trip (a null)
   unsigned seed = 1;
 };
