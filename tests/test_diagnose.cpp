@@ -279,3 +279,23 @@ TEST(Generate, FuelAndSocChannelsCarryTheirTruths) {
   EXPECT_LT(sb.back(), sb.front() - 0.1);
   EXPECT_LT(worn.soc_fraction->back(), sb.back());  // the extra resistance's loss drains the cells faster
 }
+
+// A state of charge counts what leaves the cells, so the model side must include the cells' internal loss: then an
+// extra internal resistance has a signature and a detection limit on SOC recordings (it had none when the diagnosis
+// compared SOC with terminal energy only).
+TEST(DiagnoseLimits, BatteryResistanceIsVisibleOnStateOfCharge) {
+  const rollsim::Vehicle v = rollsim::load_vehicle_file(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/ev.yaml");
+  rollsim::SyntheticCase c;
+  c.channel = rollsim::SyntheticChannel::soc;
+  c.seed = 3;
+  const auto d = rollsim::diagnose(v, {rollsim::generate_case(v, c)});
+  ASSERT_EQ(d.channel, "soc");
+  bool seen = false;
+  for (const auto& l : d.detection_limits) {
+    if (l.effect != "battery_resistance") continue;
+    seen = true;
+    EXPECT_TRUE(std::isfinite(l.smallest_detectable));
+    EXPECT_TRUE(l.within_bounds);
+  }
+  EXPECT_TRUE(seen);
+}

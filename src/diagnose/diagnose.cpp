@@ -106,8 +106,11 @@ std::vector<double> measured_power_w(const Vehicle& v, const Recording& r, std::
   return {};
 }
 
-double sim_power_w(const TracePoint& t, bool electric, double fuel_j_per_m3) {
-  return electric ? t.battery_power_w : t.fuel_rate_m3_per_s * fuel_j_per_m3;
+// The simulated counterpart of the measured channel: fuel power, battery terminal power, or, for a state of charge
+// (which counts what leaves the cells), terminal power plus the cells' internal loss.
+double sim_power_w(const TracePoint& t, bool electric, double fuel_j_per_m3, bool cells) {
+  if (!electric) return t.fuel_rate_m3_per_s * fuel_j_per_m3;
+  return cells ? t.battery_power_w + t.battery_loss_w : t.battery_power_w;
 }
 
 struct Window {
@@ -131,7 +134,7 @@ struct Data {
 
 // Simulated channel power per sample for one model variant (the base model plus `extra` effects).
 std::vector<std::vector<double>> simulate_power(const Vehicle& vehicle, const std::vector<DriveCycle>& cycles,
-                                                const std::vector<std::shared_ptr<const Effect>>& extra) {
+                                                const std::vector<std::shared_ptr<const Effect>>& extra, bool cells) {
   VehicleModel model = VehicleModel::assemble(vehicle);
   for (const auto& e : extra) model.effects.push_back(e);
   const bool electric = vehicle.is_electric();
@@ -144,7 +147,7 @@ std::vector<std::vector<double>> simulate_power(const Vehicle& vehicle, const st
   for (const auto& c : cycles) {
     const SimulationResult r = simulate_replay(model, c, so);
     std::vector<double> p(r.trace.size());
-    for (std::size_t i = 0; i < p.size(); ++i) p[i] = sim_power_w(r.trace[i], electric, fuel_j_per_m3);
+    for (std::size_t i = 0; i < p.size(); ++i) p[i] = sim_power_w(r.trace[i], electric, fuel_j_per_m3, cells);
     out.push_back(std::move(p));
   }
   return out;
@@ -173,7 +176,7 @@ std::vector<Variant> run_variants(const Vehicle& vehicle, const std::vector<Driv
   auto work = [&] {
     for (std::size_t k = next++; k < extras.size(); k = next++) {
       try {
-        out[k].power_w = simulate_power(vehicle, cycles, extras[k]);
+        out[k].power_w = simulate_power(vehicle, cycles, extras[k], d.channel == "soc");
         out[k].window_j = window_energies(out[k].power_w, d);
       } catch (...) {
         const std::lock_guard<std::mutex> lock(failure_mutex);
@@ -436,7 +439,7 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
 
   const EffectContext ctx = context_of(vehicle);
   Variant base;
-  base.power_w = simulate_power(vehicle, cycles, {});
+  base.power_w = simulate_power(vehicle, cycles, {}, d.channel == "soc");
   // Channel lag (calibration): the shift of the simulated power, 0-10 samples, that best matches the measured.
   if (d.channel != "soc") {
     double best = 1e300;

@@ -285,6 +285,7 @@ TracePoint trace_point(const VehicleModel& m, double t, double target_mps, doubl
   p.traction_power_w = s.flow.traction_power_w;
   p.battery_power_w = s.flow.battery_terminal_power_w;
   p.battery_current_a = s.flow.battery_current_a;
+  p.battery_loss_w = s.flow.battery_loss_w;
   p.fuel_rate_m3_per_s = s.flow.fuel_rate_m3_per_s;
   const double normal_n = m.mass_kg * units::kStandardGravity_mps2 / std::sqrt(1.0 + grade * grade);
   p.rrc = s.rolling_n / normal_n;

@@ -83,6 +83,7 @@ struct TracePoint {
   double time_s, target_speed_mps, speed_mps, accel_mps2, grade;
   double rolling_force_n, aero_force_n, grade_force_n, wheel_force_n;
   double traction_power_w, battery_power_w, battery_current_a, fuel_rate_m3_per_s;
+  double battery_loss_w;  ///< inside the cells (I^2 R and effects'); a state of charge sees terminal + this
   double rrc;  ///< rolling force / total normal load
   double soc;  ///< state of charge, fraction (electric)
   int gear;
