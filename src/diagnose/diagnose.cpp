@@ -320,6 +320,30 @@ struct BasisShape {
 
 }  // namespace
 
+namespace {
+
+// Mean residual of each regime (in `order`, those with two values or more) with a 95 % normal interval whose
+// variance is inflated for AR(1) correlation of the values (lag-1 autocorrelation `rho`, clamped to [0, 0.99]).
+void append_regime_means(const std::vector<std::string>& order, const std::map<std::string, std::vector<double>>& vals,
+                         double rho, std::vector<RegimeResidual>& out) {
+  const double rs = std::clamp(rho, 0.0, 0.99);
+  const double factor = (1.0 + rs) / (1.0 - rs);
+  for (const auto& name : order) {
+    const auto it = vals.find(name);
+    if (it == vals.end() || it->second.size() < 2) continue;
+    const auto& v = it->second;
+    double mean = 0.0, var = 0.0;
+    for (double e : v) mean += e;
+    mean /= static_cast<double>(v.size());
+    for (double e : v) var += (e - mean) * (e - mean);
+    var /= static_cast<double>(v.size() - 1);
+    const double half = 1.96 * std::sqrt(var * factor / static_cast<double>(v.size()));
+    out.push_back({name, static_cast<int>(v.size()), mean, mean - half, mean + half});
+  }
+}
+
+}  // namespace
+
 DriveCycle cycle_of_recording(const Recording& r) {
   DriveCycle c;
   c.name = r.source;
@@ -788,7 +812,6 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
 
   // Locate: per-sample residual of the calibrated model, by regime, with a normal interval on an effective n.
   if (d.channel != "soc") {
-    std::map<std::string, std::pair<std::vector<double>, int>> by;  // values, order
     const std::vector<std::string> order{"standing", "accelerating", "cruising", "braking", "speed 0-50 km/h",
                                          "speed 50-90 km/h", "speed >90 km/h", "first 10 min", "10-30 min", "after 30 min",
                                          "uphill (> 1 %)", "level", "downhill (< -1 %)"};
@@ -815,20 +838,7 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
       }
     }
     Eigen::VectorXd allv = Eigen::Map<Eigen::VectorXd>(all.data(), static_cast<Eigen::Index>(all.size()));
-    const double rs = std::clamp(lag1_autocorrelation(allv), 0.0, 0.99);
-    const double factor = (1.0 + rs) / (1.0 - rs);  // variance inflation of a mean of AR(1) samples
-    for (const auto& name : order) {
-      const auto it = vals.find(name);
-      if (it == vals.end() || it->second.size() < 2) continue;
-      const auto& v = it->second;
-      double mean = 0.0, var = 0.0;
-      for (double e : v) mean += e;
-      mean /= static_cast<double>(v.size());
-      for (double e : v) var += (e - mean) * (e - mean);
-      var /= static_cast<double>(v.size() - 1);
-      const double half = 1.96 * std::sqrt(var * factor / static_cast<double>(v.size()));
-      out.located.push_back({name, static_cast<int>(v.size()), mean, mean - half, mean + half});
-    }
+    append_regime_means(order, vals, lag1_autocorrelation(allv), out.located);
   } else {
     // SOC gives energy per window, not power per sample: locate by window, each window in the regimes of its own
     // means (speed, grade, time since start). Mean residual power of the windows, with the same AR(1) inflation.
@@ -861,20 +871,7 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
         vals[g > 0.01 ? "uphill > 1 % (window)" : g < -0.01 ? "downhill < -1 % (window)" : "level (window)"].push_back(p_w);
       }
     }
-    const double rs = std::clamp(lag1_autocorrelation(res_j), 0.0, 0.99);
-    const double factor = (1.0 + rs) / (1.0 - rs);
-    for (const auto& name : order) {
-      const auto it = vals.find(name);
-      if (it == vals.end() || it->second.size() < 2) continue;
-      const auto& v = it->second;
-      double mean = 0.0, var = 0.0;
-      for (double e : v) mean += e;
-      mean /= static_cast<double>(v.size());
-      for (double e : v) var += (e - mean) * (e - mean);
-      var /= static_cast<double>(v.size() - 1);
-      const double half = 1.96 * std::sqrt(var * factor / static_cast<double>(v.size()));
-      out.located.push_back({name, static_cast<int>(v.size()), mean, mean - half, mean + half});
-    }
+    append_regime_means(order, vals, lag1_autocorrelation(res_j), out.located);
   }
   return out;
 }
