@@ -15,10 +15,11 @@ TEST(Bench, QuickSubsetMeetsTheIssuesBars) {
   o.seeds = 20;
   o.null_seeds = 60;
   const BenchResult r = run_discovery_bench(v, o);
-  bool saw_null = false, saw_reversed = false, saw_warmup = false;
+  bool saw_null = false, saw_reversed = false, saw_warmup = false, saw_ambient = false, saw_trip_null = false;
   for (const auto& row : r.rows) {
     if (row.group == "null") {
       saw_null = true;
+      saw_trip_null = saw_trip_null || row.label.find("4 trips") != std::string::npos;
       EXPECT_LE(row.rollsim.mistaken, 0.05 * row.rollsim.n()) << bench_text(r);
     } else if (row.group == "reversed") {
       saw_reversed = true;
@@ -26,9 +27,18 @@ TEST(Bench, QuickSubsetMeetsTheIssuesBars) {
     } else if (row.group == "single" && row.expected == std::vector<std::string>{"tyre_warmup"}) {
       saw_warmup = true;
       EXPECT_GE(row.rollsim.named + row.rollsim.confounded, 0.8 * row.rollsim.n()) << bench_text(r);
+    } else if (row.group == "trips") {
+      // Ambient RRC at 0.008 /K (the UN R117 correction's size) over four trips: named or confounded in >= 80 %.
+      saw_ambient = true;
+      EXPECT_EQ(row.expected, std::vector<std::string>{"ambient_rrc"});
+      EXPECT_GE(row.rollsim.named + row.rollsim.confounded, 0.8 * row.rollsim.n()) << bench_text(r);
     }
   }
-  EXPECT_TRUE(saw_null && saw_reversed && saw_warmup);
+  EXPECT_TRUE(saw_null && saw_reversed && saw_warmup && saw_ambient && saw_trip_null);
+  // The sparse baseline was scored at every threshold of its sweep, and its best is one of them.
+  ASSERT_EQ(r.sparse_summary.size(), sparse_thresholds().size());
+  EXPECT_GE(r.sparse_best, 0);
+  EXPECT_LT(r.sparse_best, static_cast<int>(sparse_thresholds().size()));
 }
 
 TEST(Bench, WilsonIntervalBracketsTheRate) {

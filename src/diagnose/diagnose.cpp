@@ -283,6 +283,7 @@ struct Candidate {
   std::string amplitude_name, amplitude_unit;
   double amp_min = 0.0, amp_max = 0.0;
   Eigen::VectorXd signature;  // window energy per unit amplitude
+  bool across_trips = false;  // ambient_rrc: a per-recording level, derived from the RRC-level variant (no own run)
 };
 
 std::string num(double v) {
@@ -491,8 +492,48 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
   extras.push_back({std::make_shared<RrcLevel>(0.1)});
   extras.push_back({std::make_shared<DragScale>(0.1, ctx.rho_cda_kg_per_m)});
   std::vector<Candidate> cands;
+  // Ambient temperature on RRC moves the RRC level from trip to trip, never within one: within one trip it is the
+  // RRC level (a calibration quantity). It is a candidate only across recordings whose recorded ambients differ.
+  std::vector<double> ambient_k;  // per recording: mean recorded ambient
+  bool ambient_testable = false;
+  if (recordings.size() < 2) {
+    out.notes.push_back("ambient_rrc not tested: one recording (within one trip it is the RRC level, a calibration quantity)");
+  } else if (!std::all_of(recordings.begin(), recordings.end(), [](const Recording& r) { return r.ambient_temp_k.has_value(); })) {
+    out.notes.push_back("ambient_rrc not tested: not every recording has an ambient_temp_c column");
+  } else {
+    for (const auto& r : recordings) {
+      double sum = 0.0;
+      for (double t : *r.ambient_temp_k) sum += t;
+      ambient_k.push_back(sum / static_cast<double>(std::max<std::size_t>(1, r.ambient_temp_k->size())));
+    }
+    const auto [lo, hi] = std::minmax_element(ambient_k.begin(), ambient_k.end());
+    ambient_testable = *hi - *lo >= opt.ambient_min_spread_k;
+    out.notes.push_back(ambient_testable
+                            ? "ambient_rrc tested across " + std::to_string(recordings.size()) + " recordings at " +
+                                  fixed(*lo - 273.15, 1) + " to " + fixed(*hi - 273.15, 1) + " degC (one shared RRC level)"
+                            : "ambient_rrc not tested: recorded ambients span " + fixed(*hi - *lo, 1) + " K, under " +
+                                  fixed(opt.ambient_min_spread_k, 1) + " K (the recordings are at the same ambient)");
+  }
+  // Reference: the recordings' mean ambient, so that the ambient signature is nearly orthogonal to the shared RRC
+  // level (whose prior would otherwise push a level offset into the unpenalised ambient coefficient).
+  double ambient_ref_k = 0.0;
+  for (double t : ambient_k) ambient_ref_k += t / static_cast<double>(ambient_k.size());
   for (const auto& info : effect_catalogue()) {
-    if (info.id == "ambient_rrc") continue;  // within one trip it is the RRC level (a calibration quantity)
+    if (info.id == "ambient_rrc") {
+      if (!ambient_testable) continue;
+      const EffectParameterInfo& amp = info.parameters.front();  // rrc_change_per_k
+      Candidate c;
+      c.id = c.label = info.id;
+      c.shape = {{"reference_temp_c", ambient_ref_k - 273.15}, {"ambient_temp_c", ambient_ref_k - 273.15}};
+      c.nominal = amp.nominal;
+      c.amplitude_name = amp.name;
+      c.amplitude_unit = amp.unit;
+      c.amp_min = amp.min;
+      c.amp_max = amp.max;
+      c.across_trips = true;
+      cands.push_back(std::move(c));
+      continue;
+    }
     std::vector<EffectParameters> shapes{{}};
     if (info.id == "tyre_warmup") shapes = {{{"heat_capacity_j_per_k", 20000.0}}, {{"heat_capacity_j_per_k", 50000.0}}, {{"heat_capacity_j_per_k", 120000.0}}};
     const EffectParameterInfo* amp = nullptr;
@@ -533,6 +574,16 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
     std::size_t k = 2;
     std::vector<Candidate> kept;
     for (auto& c : cands) {
+      if (c.across_trips) {
+        // RRC factor 1 + c (T_ref - T_r) on recording r: per unit c, (T_ref - T_r) times the RRC-level signature
+        // (the variant is +10 % RRC; rolling energy is linear in the RRC factor to first order).
+        c.signature.resize(n);
+        for (Eigen::Index w = 0; w < n; ++w)
+          c.signature[w] = (ambient_ref_k - ambient_k[d.windows[static_cast<std::size_t>(w)].rec]) *
+                           (vars[0].window_j[w] - base.window_j[w]) / 0.1;
+        kept.push_back(std::move(c));
+        continue;
+      }
       c.signature = (vars[k++].window_j - base.window_j) / c.nominal;
       if (c.signature.norm() > 0.0) kept.push_back(std::move(c));
     }
@@ -592,12 +643,53 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
     return Eigen::VectorXd(s - basis_m * c);
   };
   const double inflate = std::sqrt(static_cast<double>(n) / n_eff);  // autocorrelated windows carry less information
+  // ambient_rrc's evidence lives in a few per-trip RRC levels, not in the windows: a trip's RRC level also moves with
+  // tyre pressure and road surface, so windows alone would take any such trip-to-trip scatter for an ambient law.
+  // The trips' own RRC levels (model `xm` with the shared RRC column split per recording) are regressed on ambient
+  // by generalised least squares with their covariance plus that scatter (opt.trip_rrc_scatter, fixed in advance);
+  // returns the coefficient c [1/K], its standard error and the trips' Delta BIC (chi^2 - ln trips).
+  struct TripLevel {
+    double c = 0.0, se = 0.0, dbic = -1e300;
+  };
+  auto trip_level_ambient = [&](const Eigen::MatrixXd& xm) {
+    TripLevel t;
+    const auto nr = static_cast<Eigen::Index>(recordings.size());
+    Eigen::MatrixXd xt = Eigen::MatrixXd::Zero(n, xm.cols() - 1 + nr);
+    xt.col(0) = xm.col(0);
+    for (Eigen::Index w = 0; w < n; ++w) xt(w, 1 + static_cast<Eigen::Index>(d.windows[static_cast<std::size_t>(w)].rec)) = xm(w, 1);
+    xt.rightCols(xm.cols() - 2) = xm.rightCols(xm.cols() - 2);
+    Prior pt;
+    for (Eigen::Index r = 0; r < nr; ++r) pt.rows.push_back({1 + r, prior.rows[0].second});
+    pt.rows.push_back({1 + nr, prior.rows[1].second});
+    const Fit f = least_squares(xt, d.measured_j, pt);
+    const double s = f.coef[0];
+    if (!(std::abs(s) > 0.0)) return t;
+    const double tau_coef = opt.trip_rrc_scatter * std::abs(s) / 0.1;  // coefficients are per 10 % RRC
+    Eigen::MatrixXd v = f.cov.block(1, 1, nr, nr) * (inflate * inflate);
+    v.diagonal().array() += tau_coef * tau_coef;
+    Eigen::MatrixXd design(nr, 2);
+    Eigen::VectorXd a(nr);
+    for (Eigen::Index r = 0; r < nr; ++r) {
+      design(r, 0) = 1.0;
+      design(r, 1) = ambient_ref_k - ambient_k[static_cast<std::size_t>(r)];
+      a[r] = f.coef[1 + r];
+    }
+    const Eigen::MatrixXd vinv = v.inverse();
+    const Eigen::MatrixXd info = design.transpose() * vinv * design;
+    const Eigen::MatrixXd cov = info.inverse();
+    const Eigen::VectorXd beta = cov * design.transpose() * vinv * a;
+    t.c = 0.1 * beta[1] / s;
+    t.se = 0.1 * std::sqrt(std::max(0.0, cov(1, 1))) / std::abs(s);
+    t.dbic = beta[1] * beta[1] / std::max(1e-300, cov(1, 1)) - std::log(static_cast<double>(nr));
+    return t;
+  };
   for (int round = 0; round < opt.max_effects; ++round) {
     struct Scored {
       std::size_t idx;
       double dbic;
       Fit fit;
       Eigen::VectorXd pred;
+      double se_amplitude = 0.0;  // ambient_rrc: the trip-level standard error of c (else 0: the fit's own)
     };
     std::vector<Scored> passing;
     for (std::size_t k = 0; k < cands.size(); ++k) {
@@ -608,9 +700,16 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
       const double dbic = n_eff * std::log(rss / f.rss) - std::log(n_eff);
       const double amp = f.coef[f.coef.size() - 1] / f.coef[0];  // in the simulated channel's scale
       if (dbic < opt.bic_threshold || amp < cands[k].amp_min || amp > cands[k].amp_max) continue;
+      double se_amplitude = 0.0;
+      if (cands[k].across_trips) {
+        // It must also pass the same threshold on the trips' RRC levels, against trip-to-trip scatter.
+        const TripLevel t = trip_level_ambient(x);
+        if (t.dbic < opt.bic_threshold) continue;
+        se_amplitude = t.se;
+      }
       Eigen::VectorXd pred = heldout_prediction(xk, d.measured_j, fold_of, prior);
       if (rmse(pred, d.measured_j) >= rmse(pred_before, d.measured_j)) continue;
-      passing.push_back({k, dbic, f, pred});
+      passing.push_back({k, dbic, f, pred, se_amplitude});
     }
     if (passing.empty()) break;
     std::sort(passing.begin(), passing.end(), [](const Scored& a, const Scored& b) { return a.dbic > b.dbic; });
@@ -624,10 +723,18 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
     // The signature is per unit amplitude of the measured channel's scale 1; divide by the channel scale.
     const double s = best.fit.coef[0];
     const double value = best.fit.coef[j] / s;
-    fnd.parameters.push_back({c.amplitude_name, c.amplitude_unit, value, (best.fit.coef[j] - 1.96 * se) / s,
-                              (best.fit.coef[j] + 1.96 * se) / s});
+    // ambient_rrc: the wider of the windows' and the trips' intervals (a few trips carry its information).
+    const double se_value = std::max(std::abs(se / s), best.se_amplitude);
+    fnd.parameters.push_back({c.amplitude_name, c.amplitude_unit, value, value - 1.96 * se_value, value + 1.96 * se_value});
     fnd.fitted = c.shape;
     fnd.fitted[c.amplitude_name] = value;
+    if (c.across_trips) {
+      const auto [lo, hi] = std::minmax_element(ambient_k.begin(), ambient_k.end());
+      fnd.description = "RRC level follows ambient temperature across the recordings (" + fixed(*lo - 273.15, 1) + " to " +
+                        fixed(*hi - 273.15, 1) + " degC): " + fixed(100.0 * value, 2) + " % per K colder, referred to " +
+                        fixed(ambient_ref_k - 273.15, 1) + " degC; the written vehicle is neutral at that reference, set "
+                        "ambient_temp_c per trip";
+    }
     for (const auto& [k, v] : c.shape) {
       for (const auto& pi : effect_info(c.id).parameters)
         if (pi.name == k) fnd.parameters.push_back({k, pi.unit, v, v, v});

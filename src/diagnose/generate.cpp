@@ -58,6 +58,36 @@ class TwoNodeTyreTruth final : public Effect {
   double duration_s_;
 };
 
+// Truth ambient temperature on RRC, per tyre compound: ln RRC falls with the tyre's temperature along a WLF-like
+// curve, ln f = -c C2 dT / (C2 + dT) (slope -c at the reference, steeper when cold: not the catalogue's linear
+// 1 + c (T_ref - T_amb)), with dT the tyre's temperature above its reference (20 degC ambient, 20 K running rise).
+// Preconditioned (cold_start false): the tyre runs at ambient + 20 K from the start, as after a warm-up drive. Cold
+// start: the tyre starts at ambient and warms by a one-node heat balance (30 kJ/K, 90 % of the rolling loss in,
+// convection 40 (1 + v/8)^0.8 W/K out), so a cold ambient also brings a larger warm-up: the two are confounded.
+class AmbientCompoundTruth final : public Effect {
+ public:
+  AmbientCompoundTruth(double c_per_k, double c2_k, double ambient_c, bool cold_start)
+      : c_(c_per_k), c2_(c2_k), ambient_c_(ambient_c), cold_start_(cold_start) {}
+  std::string id() const override { return "truth_ambient_compound"; }
+  int num_states() const override { return cold_start_ ? 1 : 0; }
+  void state_derivatives(const EffectInputs& in, const double* x, double* xdot) const override {
+    if (!cold_start_) return;  // preconditioned: no state (the simulator still calls every effect)
+    const double v = std::max(in.speed_mps, 0.0);
+    const double p = in.base_rolling_force_n * rolling_resistance_factor(in, x) * v;
+    xdot[0] = (0.9 * p - 40.0 * std::pow(1.0 + v / 8.0, 0.8) * x[0]) / 30000.0;
+  }
+  double rolling_resistance_factor(const EffectInputs&, const double* x) const override {
+    constexpr double kRefAmbientC = 20.0, kRunningRiseK = 20.0;
+    const double rise = cold_start_ ? x[0] : kRunningRiseK;
+    const double dt = std::max(ambient_c_ + rise - kRefAmbientC - kRunningRiseK, -0.9 * c2_);
+    return std::exp(-c_ * c2_ * dt / (c2_ + dt));
+  }
+
+ private:
+  double c_, c2_, ambient_c_;
+  bool cold_start_;
+};
+
 // Truth auxiliary load: an A/C compressor cycling on and off (period 240-360 s, 40 % duty, random phase) plus a
 // blower at a quarter of the mean, not the catalogue's constant load. `mean_w` is the time-averaged power.
 class CompressorTruth final : public Effect {
@@ -264,6 +294,12 @@ const std::vector<ConcealedTruthInfo>& concealed_truths() {
       {"battery_r_of_soc", "battery_resistance", "ohm (extra at full charge)",
        "extra cell resistance rising as SOC falls, OCV(SOC), loss I^2 R (SOC channel, 0.1 % quantum)",
        {0.05, 0.1, 0.2}, SyntheticChannel::soc},
+      {"ambient_compound", "ambient_rrc", "1/K (RRC change per K at 20 degC)",
+       "tyre compound law ln RRC = -c C2 dT / (C2 + dT), C2 120-180 K, c +-10 % per car, preconditioned tyres, "
+       "trips at -5..30 degC", {0.001, 0.002, 0.004, 0.008, 0.012}, SyntheticChannel::battery_power, true},
+      {"ambient_cold_start", "ambient_rrc", "1/K (RRC change per K at 20 degC)",
+       "the same compound law on a tyre that starts each trip at ambient and warms (one-node heat balance)",
+       {0.008}, SyntheticChannel::battery_power, true},
   };
   return kTruths;
 }
@@ -299,7 +335,8 @@ Recording generate_case(const Vehicle& vehicle, const SyntheticCase& o) {
   Vehicle truth_vehicle = vehicle;
   DriveCycle truth_cycle = c;
   std::vector<std::shared_ptr<const Effect>> truths;
-  const double level = 1.0 + o.rrc_level_jitter * unit(rng);
+  const double level_draw = 1.0 + o.rrc_level_jitter * unit(rng);  // drawn always: the artefacts' stream stays put
+  const double level = o.rrc_level.value_or(level_draw);
   truths.push_back(std::make_shared<RrcLevelTruth>(level));
   const double rho_cda = vehicle.body.air_density_kg_per_m3 * vehicle.body.drag_coefficient * vehicle.body.frontal_area_m2;
   const double weight_n = vehicle.body.test_mass_kg * kG;
@@ -312,6 +349,11 @@ Recording generate_case(const Vehicle& vehicle, const SyntheticCase& o) {
     } else if (t == "battery_r_of_soc") {
       if (o.channel != SyntheticChannel::soc) throw InputError("concealed truth 'battery_r_of_soc'", "needs the SOC channel");
       battery_extra_ohm = e.size;
+    } else if (t == "ambient_compound" || t == "ambient_cold_start") {
+      if (!o.ambient_temp_c) throw InputError("concealed truth '" + t + "'", "needs the trip's ambient temperature");
+      const double c_per_k = e.size * (1.0 + 0.1 * unit(truth_rng));
+      const double c2_k = 150.0 + 30.0 * unit(truth_rng);
+      truths.push_back(std::make_shared<AmbientCompoundTruth>(c_per_k, c2_k, *o.ambient_temp_c, t == "ambient_cold_start"));
     } else if (t == "tyre_two_node") {
       truths.push_back(std::make_shared<TwoNodeTyreTruth>(e.size, o.time_reversed, c.duration_s()));
     } else if (t == "aux_compressor") {
@@ -360,13 +402,22 @@ Recording generate_case(const Vehicle& vehicle, const SyntheticCase& o) {
   SimulationOptions so;
   so.record_trace = true;
   const SimulationResult r = simulate_replay(model, truth_cycle, so);
-  const double scale = 1.0 + o.scale_jitter * unit(rng);
+  const double scale_draw = 1.0 + o.scale_jitter * unit(rng);
+  const double scale = o.channel_scale.value_or(scale_draw);
   Recording rec;
   rec.source = "synthetic " + c.name + " seed " + std::to_string(o.seed);
   const std::size_t n = r.trace.size();  // one point per segment start; the last sample is dropped
   const auto lag = static_cast<std::size_t>(std::lround(std::max(0.0, o.lag_s)));
   rec.time_s.assign(c.time_s.begin(), c.time_s.begin() + static_cast<long>(n));
   rec.speed_mps.assign(c.speed_mps.begin(), c.speed_mps.begin() + static_cast<long>(n));
+  if (o.ambient_temp_c) {
+    // The car's ambient sensor: noise and a 0.5 K quantum, on its own stream (the channel's artefacts stay put).
+    std::mt19937 sensor_rng(o.seed * 104729u + 7u);
+    std::normal_distribution<double> sensor(0.0, 0.3);
+    std::vector<double> t(n);
+    for (auto& x : t) x = 0.5 * std::round((*o.ambient_temp_c + 273.15 + sensor(sensor_rng)) / 0.5);
+    rec.ambient_temp_k = t;
+  }
   // no grade column in any channel: the diagnosis sees a flat road
   if (o.channel == SyntheticChannel::soc) {
     const auto* ep = std::get_if<ElectricPowertrainParams>(&truth_vehicle.powertrain);
@@ -408,6 +459,33 @@ Recording generate_case(const Vehicle& vehicle, const SyntheticCase& o) {
   }
   rec.battery_power_w = p;
   return rec;
+}
+
+std::vector<Recording> generate_trips(const Vehicle& vehicle, const MultiTripCase& m) {
+  if (m.cycles.empty()) throw InputError("multi-trip case", "needs at least one trip");
+  if (!(m.ambient_max_c >= m.ambient_min_c)) throw InputError("multi-trip case", "ambient_max_c is below ambient_min_c");
+  std::mt19937 rng(m.seed * 6151u + 3u);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0), u01(0.0, 1.0);
+  const double level = 1.0 + m.artefacts.rrc_level_jitter * unit(rng);
+  const double scale = 1.0 + m.artefacts.scale_jitter * unit(rng);
+  const std::size_t k = m.cycles.size();
+  std::vector<std::size_t> slice(k);
+  for (std::size_t i = 0; i < k; ++i) slice[i] = i;
+  std::shuffle(slice.begin(), slice.end(), rng);
+  std::vector<Recording> out;
+  for (std::size_t i = 0; i < k; ++i) {
+    SyntheticCase s = m.artefacts;
+    s.cycle = m.cycles[i];
+    s.repeats = 1;
+    s.trace.reset();
+    s.effects = m.effects;
+    s.ambient_temp_c = m.ambient_min_c + (m.ambient_max_c - m.ambient_min_c) * (static_cast<double>(slice[i]) + u01(rng)) / static_cast<double>(k);
+    s.rrc_level = level * (1.0 + m.trip_rrc_scatter * unit(rng));
+    s.channel_scale = scale;
+    s.seed = m.seed * 16u + static_cast<unsigned>(i);
+    out.push_back(generate_case(vehicle, s));
+  }
+  return out;
 }
 
 Recording generate_recording(const Vehicle& vehicle, const SyntheticOptions& opt) {

@@ -32,15 +32,30 @@ struct Score {
 };
 
 struct BenchRow {
-  std::string group;       ///< "single", "pair", "two", "null", "reversed"
+  std::string group;       ///< "single", "pair", "two", "trips" (several recordings), "null", "reversed"
   std::string label;       ///< e.g. "aux_compressor 300 W (mean)"
   std::vector<std::string> expected;  ///< catalogue ids an honest answer names (empty for nulls)
-  Score rollsim, calibration, sparse;
+  Score rollsim, calibration;
+  Score sparse;                            ///< the sparse baseline at the scorecard's best threshold (BenchResult)
+  std::vector<Score> sparse_by_threshold;  ///< per sparse_thresholds() entry
+  Score sparse_bic;                        ///< at the threshold BIC picks per recording
   int rollsim_unexplained = 0;  ///< seeds whose first finding was an unexplained signature
+};
+
+/// The sparse baseline at one threshold, pooled over the scorecard: null rows, and effect rows (single, pair, two).
+struct SparseThresholdSummary {
+  double threshold = 0.0;  ///< 0: BIC's per-recording choice
+  int null_false = 0, null_n = 0;
+  int named = 0, confounded = 0, mistaken = 0, effect_n = 0;
 };
 
 struct BenchResult {
   std::vector<BenchRow> rows;
+  /// Index into sparse_thresholds() of the sparse baseline's best threshold: the most effects named (alone or
+  /// confounded) with a pooled null false-discovery rate <= 5 %, or else the lowest null rate.
+  int sparse_best = 0;
+  std::vector<SparseThresholdSummary> sparse_summary;  ///< per sparse_thresholds() entry
+  SparseThresholdSummary sparse_bic_summary;
   double seconds = 0.0;
   unsigned threads = 1;
 };
@@ -57,9 +72,22 @@ std::pair<double, double> wilson_interval(int k, int n);
 
 /// The sparse-regression baseline on one recording: sequential thresholded least squares on window integrals of
 /// {1, v, v^2, v^3, a, a v} beside the simulated energy; returns the catalogue ids its selected non-calibration
-/// terms map to, largest contribution first ("mass|rotational_inertia" for the inertial term a v). The measured
-/// channel is the recording's battery power, fuel rate (as fuel power) or SOC (window differences x capacity);
-/// `window_s` is the window length (the diagnosis lengthens it for a quantised SOC).
-std::vector<std::string> sparse_regression_discovery(const Vehicle& vehicle, const Recording& rec, double window_s = 60.0);
+/// terms map to, largest contribution first ("mass|rotational_inertia" for the inertial term a v). A term is dropped
+/// when its contribution is below `threshold` times the measured energy's norm. The measured channel is the
+/// recording's battery power, fuel rate (as fuel power) or SOC (window differences x capacity); `window_s` is the
+/// window length (the diagnosis lengthens it for a quantised SOC).
+std::vector<std::string> sparse_regression_discovery(const Vehicle& vehicle, const Recording& rec, double window_s = 60.0,
+                                                     double threshold = 0.01);
+
+/// The thresholds the scorecard sweeps the sparse baseline over (0.003, 0.01, 0.03, 0.1).
+const std::vector<double>& sparse_thresholds();
+
+/// The sparse baseline at every threshold of sparse_thresholds(), and at the threshold BIC picks on this recording.
+struct SparseSweep {
+  std::vector<std::vector<std::string>> by_threshold;  ///< per sparse_thresholds() entry
+  std::vector<std::string> bic;                        ///< at the BIC-chosen threshold
+  double bic_threshold = 0.0;
+};
+SparseSweep sparse_regression_sweep(const Vehicle& vehicle, const Recording& rec, double window_s = 60.0);
 
 }  // namespace rollsim

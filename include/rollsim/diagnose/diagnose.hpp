@@ -25,6 +25,11 @@ struct DiagnoseOptions {
   double soc_quantisation_fraction = 0.02;
   /// Unexplained-residual basis: time constants of the early-trip decay shapes [s].
   std::vector<double> unexplained_decay_s{300.0, 600.0, 1200.0, 2400.0};
+  /// ambient_rrc is tested only across recordings whose mean recorded ambients span at least this much [K].
+  double ambient_min_spread_k = 5.0;
+  /// Trip-to-trip scatter (sd) of the RRC level at one ambient (tyre pressure +-0.1 bar, road surface): ambient_rrc
+  /// must explain the trips' RRC levels beyond it.
+  double trip_rrc_scatter = 0.01;
   unsigned threads = 0;  ///< simulator runs in parallel (0: hardware concurrency)
 };
 

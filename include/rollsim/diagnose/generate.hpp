@@ -35,6 +35,9 @@ struct ConcealedTruthInfo {
   std::vector<double> sweep;    ///< sizes, smallest effect first
   /// The channel the truth is written to; a fuel-channel truth needs a combustion car (vehicles/ice.yaml).
   SyntheticChannel channel = SyntheticChannel::battery_power;
+  /// Across-trip truths (ambient temperature): concealed in several trips at different ambients (generate_trips),
+  /// never in one recording.
+  bool multi_trip = false;
 };
 const std::vector<ConcealedTruthInfo>& concealed_truths();
 const ConcealedTruthInfo& concealed_truth(const std::string& truth);  ///< throws InputError when unknown
@@ -61,8 +64,27 @@ struct SyntheticCase {
   double fuel_quantum_m3ps = 0.05e-3 / 3600.0;
   double soc_quantum = 0.001;  ///< SOC channel: the BMS's resolution (0.1 %); the channel is noise-free otherwise
   bool time_reversed = false;      ///< tyre truths: the warm-up decay placed at the end of the trip (a null)
+  /// The trip's ambient temperature [degC]: the ambient truths read it, and the recording carries it as
+  /// ambient_temp_k (sensor noise 0.3 K, 0.5 K quantum). Unset: no ambient channel.
+  std::optional<double> ambient_temp_c;
+  std::optional<double> rrc_level;      ///< the truth's RRC level instead of a jitter draw (trips of one car share it)
+  std::optional<double> channel_scale;  ///< the channel scale instead of a jitter draw (one logger on every trip)
   unsigned seed = 1;
 };
 Recording generate_case(const Vehicle& vehicle, const SyntheticCase& c);
+
+/// Several trips of one car and logger at different ambient temperatures (the across-trip truths' proof): one RRC
+/// level and one channel scale (drawn once, as SyntheticCase's jitters), a trip-to-trip RRC scatter (tyre pressure,
+/// road surface), and ambients stratified over [ambient_min_c, ambient_max_c] (one trip per equal slice, in random
+/// order).
+struct MultiTripCase {
+  std::vector<std::string> cycles{"wltc", "ftp75", "artemis_road", "wltc"};  ///< one trip each
+  std::vector<ConcealedEffect> effects;
+  double ambient_min_c = -5.0, ambient_max_c = 30.0;
+  double trip_rrc_scatter = 0.015;  ///< each trip's RRC level, uniform +- this fraction about the car's
+  SyntheticCase artefacts;          ///< noise, quantum, lag, jitters and channel; its cycle and effects are ignored
+  unsigned seed = 1;
+};
+std::vector<Recording> generate_trips(const Vehicle& vehicle, const MultiTripCase& c);
 
 }  // namespace rollsim
