@@ -238,3 +238,48 @@ TEST(Simulation, SolverFailureReportsTimeAndCause) {
     EXPECT_NE(std::string(e.what()).find("after t = "), std::string::npos) << e.what();
   }
 }
+
+namespace {
+// A road that rises and falls along its length with no hidden state: what it costs depends on where the car is.
+struct CosineGrade final : Effect {
+  double force_n, wavelength_m;
+  CosineGrade(double f, double w) : force_n(f), wavelength_m(w) {}
+  std::string id() const override { return "cosine_grade"; }
+  double extra_resistance_n(const EffectInputs& in, const double*) const override {
+    return force_n * std::cos(2.0 * M_PI * in.distance_m / wavelength_m);
+  }
+};
+}  // namespace
+
+// Analytic limit: over whole wavelengths a cosine force does no net work. A replay that reused one cruise
+// segment's powers for the next (right only when nothing depends on time or distance) would book
+// force x distance instead.
+TEST(Simulation, ReplayEvaluatesEveryCruiseSegmentWhenEffectsDependOnDistance) {
+  auto m = model_of("vehicles/ev.yaml");
+  const double force_n = 300.0, speed_mps = 20.0, duration_s = 1000.0;
+  m.effects.push_back(std::make_shared<CosineGrade>(force_n, speed_mps * 50.0));  // 20 wavelengths, 5 segments each
+  const auto r = simulate_replay(m, constant_speed_cycle(speed_mps, duration_s));
+  EXPECT_NEAR(r.distance_m, speed_mps * duration_s, 1e-6);
+  EXPECT_LT(std::abs(r.energy.other_resistance_j), 1e-6 * force_n * r.distance_m);
+}
+
+// Invariant: recording the trace changes nothing in the energies. Without a trace (and without effects) the
+// replay integrates a repeated segment once and reuses it (NEDC repeats one urban cycle four times); with a
+// trace it evaluates every segment. The two must agree to rounding, gear schedule included.
+TEST(Simulation, ReplayReuseOfRepeatedSegmentsChangesNoEnergy) {
+  SimulationOptions traced;
+  traced.record_trace = true;
+  for (const char* vehicle : {"vehicles/ev.yaml", "vehicles/ice.yaml"}) {
+    const auto m = model_of(vehicle);
+    for (const char* cycle : {"nedc", "udds"}) {
+      const auto c = load_cycle(cycle);
+      const auto reused = simulate_replay(m, c), direct = simulate_replay(m, c, traced);
+      SCOPED_TRACE(std::string(vehicle) + " " + cycle);
+      EXPECT_NEAR(reused.energy.traction_j, direct.energy.traction_j, 1e-9 * direct.energy.traction_j);
+      EXPECT_NEAR(reused.energy.friction_brake_j, direct.energy.friction_brake_j, 1e-9 * direct.energy.traction_j);
+      EXPECT_NEAR(reused.energy.battery_terminal_j, direct.energy.battery_terminal_j, 1e-9 * direct.energy.traction_j);
+      EXPECT_NEAR(reused.energy.fuel_j, direct.energy.fuel_j, 1e-9 * std::max(direct.energy.fuel_j, 1.0));
+      EXPECT_EQ(reused.shortfalls.size(), direct.shortfalls.size());
+    }
+  }
+}

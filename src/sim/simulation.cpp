@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <map>
 
 #include "rollsim/common/units.hpp"
@@ -59,34 +60,38 @@ enum AccIdx : int {
 };
 
 double grade_force_n(double mass_kg, double grade) {
+  if (grade == 0.0) return 0.0;  // most traces are flat: no square root per evaluation
   return mass_kg * units::kStandardGravity_mps2 * grade / std::sqrt(1.0 + grade * grade);
 }
 
 // Road-load coefficients per trace segment: computed once per distinct grade (a tyre preparation each).
-struct SegmentRoadLoads {
-  std::vector<RoadLoadCoeffs> coeffs;
-  std::vector<int> of_segment;
+class SegmentRoadLoads {
+ public:
   SegmentRoadLoads(const VehicleModel& m, const DriveCycle& c) {
     // The flat road's coefficients were prepared once with the model; other grades once per distinct value.
-    coeffs.push_back(m.flat_road_load);
+    coeffs_.push_back(m.flat_road_load);
+    const auto first_graded = std::find_if(c.grade.begin(), c.grade.end(), [](double g) { return g != 0.0; });
+    if (first_graded == c.grade.end()) return;  // a flat trace needs no table
     std::vector<double> grades{0.0};
-    of_segment.resize(c.time_s.size(), 0);
-    for (std::size_t i = 0; i < c.grade.size(); ++i) {
+    for (auto i = static_cast<std::size_t>(first_graded - c.grade.begin()); i < c.grade.size(); ++i) {
       const double g = c.grade[i];
-      if (g == grades[of_segment[i > 0 ? i - 1 : 0]]) {
-        of_segment[i] = of_segment[i > 0 ? i - 1 : 0];
-        continue;
-      }
+      if (g == 0.0) continue;
+      if (of_segment_.empty()) of_segment_.assign(c.time_s.size(), 0);
       const auto it = std::find(grades.begin(), grades.end(), g);
-      if (it != grades.end()) {
-        of_segment[i] = static_cast<int>(it - grades.begin());
-      } else {
-        of_segment[i] = static_cast<int>(grades.size());
+      of_segment_[i] = static_cast<int>(it - grades.begin());
+      if (it == grades.end()) {
         grades.push_back(g);
-        coeffs.push_back(m.road_load->at_grade(g));
+        coeffs_.push_back(m.road_load->at_grade(g));
       }
     }
   }
+  const RoadLoadCoeffs& operator[](std::size_t segment) const {
+    return coeffs_[of_segment_.empty() ? 0 : static_cast<std::size_t>(of_segment_[segment])];
+  }
+
+ private:
+  std::vector<RoadLoadCoeffs> coeffs_;
+  std::vector<int> of_segment_;
 };
 
 // Everything at one instant, shared by the forward RHS, the replay and the trace so the three agree.
@@ -358,7 +363,7 @@ class ForwardSystem final : public OdeSystem {
     const double v_ref = c_.speed_mps[i] + a_ref * (t - c_.time_s[i]);
     EffectInputs in{t, v_ref, a_ref, c_.grade.empty() ? 0.0 : c_.grade[i], y[kDistance], 0.0, 0.0};
     Instant ff;
-    eval_.resistance(loads_.coeffs[loads_.of_segment[i]], in, y + kBaseStates, ff);
+    eval_.resistance(loads_[i], in, y + kBaseStates, ff);
     return m_.inertial_mass_kg() * (a_ref + o_.driver_kp_per_s * (v_ref - y[kSpeed]) + o_.driver_ki_per_s2 * y[kDriverIntegral]) +
            ff.resistance_n();
   }
@@ -383,7 +388,7 @@ class ForwardSystem final : public OdeSystem {
     const double a_ref = (c_.speed_mps[i + 1] - c_.speed_mps[i]) / dt;
     const double v_ref = c_.speed_mps[i] + a_ref * (t - c_.time_s[i]);
     const double grade = c_.grade.empty() ? 0.0 : c_.grade[i];
-    const RoadLoadCoeffs& rl = loads_.coeffs[loads_.of_segment[i]];
+    const RoadLoadCoeffs& rl = loads_[i];
     const double* x = y + kBaseStates;
     const double v = y[kSpeed];
     const double m_eff = m_.inertial_mass_kg();
@@ -592,6 +597,64 @@ SimulationResult simulate_forward(const VehicleModel& m, const DriveCycle& c, co
   return r;
 }
 
+namespace {
+
+// A replayed segment, as far as its energies go: end speeds, duration, grade, and the gear the schedule starts it in.
+struct SegmentKey {
+  double v0_mps, v1_mps, dt_s, grade;
+  int scheduled_gear;
+  bool operator==(const SegmentKey&) const = default;
+};
+
+struct SegmentEnergy {
+  std::array<double, kAccumulators> energy_j;
+  bool limited;
+  int scheduled_gear_after;
+};
+
+// The ramps already integrated in this replay, by their key: open addressing in one allocation, sized for every
+// segment of the trace, so a lookup is a hash and a compare or two and an insert never allocates.
+class SegmentMemo {
+ public:
+  explicit SegmentMemo(std::size_t max_entries) {
+    std::size_t slots = 16;
+    while (slots < 2 * max_entries) slots *= 2;
+    slots_.assign(slots, -1);
+    keys_.reserve(max_entries);
+    energies_.reserve(max_entries);
+  }
+  const SegmentEnergy* find(const SegmentKey& k) const {
+    for (std::size_t i = hash(k) & (slots_.size() - 1);; i = (i + 1) & (slots_.size() - 1)) {
+      if (slots_[i] < 0) return nullptr;
+      if (keys_[static_cast<std::size_t>(slots_[i])] == k) return &energies_[static_cast<std::size_t>(slots_[i])];
+    }
+  }
+  void insert(const SegmentKey& k, const SegmentEnergy& e) {
+    if (2 * (keys_.size() + 1) > slots_.size()) return;  // full (cannot happen: one entry per segment at most)
+    std::size_t i = hash(k) & (slots_.size() - 1);
+    while (slots_[i] >= 0) i = (i + 1) & (slots_.size() - 1);
+    slots_[i] = static_cast<int>(keys_.size());
+    keys_.push_back(k);
+    energies_.push_back(e);
+  }
+
+ private:
+  static std::size_t hash(const SegmentKey& k) {
+    std::uint64_t h = static_cast<std::uint64_t>(k.scheduled_gear) + 0xcbf29ce484222325ULL;
+    for (double x : {k.v0_mps, k.v1_mps, k.dt_s, k.grade}) {
+      std::uint64_t bits;
+      std::memcpy(&bits, &x, sizeof bits);
+      h = (h ^ bits) * 0x100000001b3ULL;
+    }
+    return static_cast<std::size_t>(h ^ (h >> 29));
+  }
+  std::vector<int> slots_;  // index into keys_/energies_, -1 when empty
+  std::vector<SegmentKey> keys_;
+  std::vector<SegmentEnergy> energies_;
+};
+
+}  // namespace
+
 SimulationResult simulate_replay(const VehicleModel& m, const DriveCycle& c, const SimulationOptions& opt) {
   Evaluator eval(m);
   SegmentRoadLoads loads(m, c);
@@ -613,8 +676,11 @@ SimulationResult simulate_replay(const VehicleModel& m, const DriveCycle& c, con
   double distance_m = 0.0;
   int scheduled_gear = m.powertrain->select_gear(c.speed_mps.front(), 1);
   int gear = scheduled_gear;
-  // Without hidden states, a cruise segment like the previous one has the same powers: reuse them.
-  const bool stateless = eval.effect_states == 0 && !opt.record_trace;
+  // Without effects (which may carry states or depend on time and distance), a segment's powers depend only on
+  // the segment and the gear it starts in: a cruise like the previous one, or a ramp seen before, is not
+  // evaluated again.
+  const bool stateless = m.effects.empty() && !opt.record_trace;
+  SegmentMemo seen(stateless ? c.time_s.size() : 0);
   bool cruise_valid = false, cruise_limited = false;
   double cruise_v = -1.0, cruise_grade = 0.0;
   SimulationResult r;
@@ -643,6 +709,7 @@ SimulationResult simulate_replay(const VehicleModel& m, const DriveCycle& c, con
   // A run of identical cruise seconds is booked once, when it ends: its powers do not change.
   double cruise_pending_s = 0.0;
   auto book_cruise = [&] {
+    if (cruise_pending_s == 0.0) return;
     for (int j = 0; j < kAccumulators; ++j) acc[j] += cruise_pending_s * cruise_rate[j];
     cruise_pending_s = 0.0;
   };
@@ -653,7 +720,7 @@ SimulationResult simulate_replay(const VehicleModel& m, const DriveCycle& c, con
     const double v0 = c.speed_mps[i];
     const double a = (c.speed_mps[i + 1] - v0) / dt;
     const double grade = c.grade.empty() ? 0.0 : c.grade[i];
-    const RoadLoadCoeffs& rl = loads.coeffs[loads.of_segment[i]];
+    const RoadLoadCoeffs& rl = loads[i];
     bool segment_limited = false;
     if (opt.record_trace) {
       const int g = gear;
@@ -677,15 +744,29 @@ SimulationResult simulate_replay(const VehicleModel& m, const DriveCycle& c, con
       segment_limited = cruise_limited;
     } else {
       book_cruise();
-      std::fill(xdot_sum.begin(), xdot_sum.end(), 0.0);
-      for (std::size_t k = 0; k < kNode.size(); ++k) {
-        const double v = v0 + a * kNode[k] * dt;
-        evaluate_at(t0 + kNode[k] * dt, v, a, grade, rl, distance_m + (v0 + v) / 2.0 * kNode[k] * dt);
-        segment_limited = segment_limited || s.flow.force_limited;
-        for (int j = 0; j < kAccumulators; ++j) acc[j] += kWeight[k] * dt * rate[j];
-        for (int j = 0; j < eval.effect_states; ++j) xdot_sum[j] += kWeight[k] * xdot[j];
-      }
       cruise_valid = false;
+      const SegmentKey key{v0, c.speed_mps[i + 1], dt, grade, scheduled_gear};
+      if (const SegmentEnergy* hit = stateless ? seen.find(key) : nullptr) {
+        for (int j = 0; j < kAccumulators; ++j) acc[j] += hit->energy_j[j];
+        segment_limited = hit->limited;
+        scheduled_gear = hit->scheduled_gear_after;
+      } else {
+        std::fill(xdot_sum.begin(), xdot_sum.end(), 0.0);
+        SegmentEnergy e{};
+        for (std::size_t k = 0; k < kNode.size(); ++k) {
+          const double v = v0 + a * kNode[k] * dt;
+          evaluate_at(t0 + kNode[k] * dt, v, a, grade, rl, distance_m + (v0 + v) / 2.0 * kNode[k] * dt);
+          segment_limited = segment_limited || s.flow.force_limited;
+          for (int j = 0; j < kAccumulators; ++j) e.energy_j[j] += kWeight[k] * dt * rate[j];
+          for (int j = 0; j < eval.effect_states; ++j) xdot_sum[j] += kWeight[k] * xdot[j];
+        }
+        for (int j = 0; j < kAccumulators; ++j) acc[j] += e.energy_j[j];
+        if (stateless) {
+          e.limited = segment_limited;
+          e.scheduled_gear_after = scheduled_gear;
+          seen.insert(key, e);
+        }
+      }
     }
     // Hidden effect states advance with the segment-mean rate (time constants are minutes, segments seconds).
     for (int j = 0; j < eval.effect_states; ++j) x[j] += dt * xdot_sum[j];
