@@ -179,3 +179,68 @@ TEST(SparseBaseline, ThresholdSweepIsConsistentAndHasItsLimits) {
 
 }  // namespace
 }  // namespace rollsim
+
+namespace rollsim {
+namespace {
+
+TEST(ProfileInterval, MatchesAQuadraticProfileInLogParameter) {
+  // n_eff ln(RSS / RSS_min) = ((ln theta - ln theta0) / w)^2: the 95 % interval is theta0 exp(+-w sqrt(3.84)).
+  const double theta0 = 700.0, w = 0.4, n_eff = 30.0;
+  std::vector<double> grid, rss;
+  for (int i = 0; i <= 400; ++i) {
+    const double t = 50.0 * std::pow(2.0, i / 40.0);
+    grid.push_back(t);
+    const double z = (std::log(t) - std::log(theta0)) / w;
+    rss.push_back(5.0e6 * std::exp(z * z / n_eff));
+  }
+  const ProfileInterval p = profile_likelihood_interval(grid, rss, n_eff);
+  EXPECT_NEAR(p.value, theta0, theta0 * 0.01);  // the nearest grid point (steps of 1.7 %)
+  EXPECT_FALSE(p.low_open || p.high_open);
+  // Interpolation is linear in ln theta across one step of ln 2 / 40; the quadratic's error over it is tiny.
+  EXPECT_NEAR(std::log(p.low), std::log(theta0) - w * std::sqrt(3.84), 0.01);
+  EXPECT_NEAR(std::log(p.high), std::log(theta0) + w * std::sqrt(3.84), 0.01);
+}
+
+TEST(ProfileInterval, FlatProfileIsOpenAtBothEndsAndBadInputIsRefused) {
+  const std::vector<double> grid{100.0, 200.0, 400.0, 800.0};
+  const ProfileInterval flat = profile_likelihood_interval(grid, {1.0, 1.0001, 1.0, 1.0002}, 10.0);
+  EXPECT_TRUE(flat.low_open && flat.high_open);
+  EXPECT_EQ(flat.low, 100.0);
+  EXPECT_EQ(flat.high, 800.0);
+  // Open above only: the criterion keeps falling towards the largest value.
+  const ProfileInterval rising = profile_likelihood_interval(grid, {4.0, 2.0, 1.05, 1.0}, 10.0);
+  EXPECT_FALSE(rising.low_open);
+  EXPECT_TRUE(rising.high_open);
+  EXPECT_GT(rising.low, 200.0);
+  EXPECT_LT(rising.low, 400.0);
+  EXPECT_THROW(profile_likelihood_interval({200.0, 100.0}, {1.0, 1.0}, 10.0), InputError);
+  EXPECT_THROW(profile_likelihood_interval({100.0, 200.0}, {1.0}, 10.0), InputError);
+  EXPECT_THROW(profile_likelihood_interval({100.0, 200.0}, {1.0, 0.0}, 10.0), InputError);
+}
+
+TEST(ProfileInterval, FoundWarmupCarriesAProfiledHeatCapacity) {
+  const Vehicle v = ev();
+  SyntheticOptions o;
+  o.tyre_cold_excess = 0.3;
+  o.seed = 1;
+  const Diagnosis d = diagnose(v, {generate_recording(v, o)});
+  const Finding* f = finding(d, "tyre_warmup");
+  ASSERT_NE(f, nullptr) << diagnosis_text(d);
+  bool seen = false;
+  for (const auto& p : f->parameters) {
+    if (p.name != "heat_capacity_j_per_k") continue;
+    seen = true;
+    EXPECT_TRUE(p.profiled);
+    EXPECT_LE(p.ci_low, p.value);
+    EXPECT_GE(p.ci_high, p.value);
+    EXPECT_LT(p.ci_low, p.ci_high) << diagnosis_text(d);  // a real interval, not the grid point repeated
+    EXPECT_GE(p.ci_low, 10000.0);
+    EXPECT_LE(p.ci_high, 400000.0);
+    EXPECT_EQ(f->fitted.at("heat_capacity_j_per_k"), p.value);  // the written vehicle carries the refined value
+  }
+  EXPECT_TRUE(seen);
+  EXPECT_NE(diagnosis_json(d).find("\"interval\": \"profile\""), std::string::npos);
+}
+
+}  // namespace
+}  // namespace rollsim

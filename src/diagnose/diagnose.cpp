@@ -8,6 +8,7 @@
 #include <fstream>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <sstream>
 #include <thread>
 #include <tuple>
@@ -311,6 +312,33 @@ std::string fixed(double v, int digits) {
   return os.str();
 }
 
+// Time-constant parameters profiled when their effect is found: effect, parameter, grid range.
+struct TimeParameter {
+  const char* effect;
+  const char* parameter;
+  double low, high;
+};
+constexpr TimeParameter kTimeParameters[] = {
+    {"tyre_warmup", "heat_capacity_j_per_k", 10000.0, 400000.0},   // tau ~ C / h: ~3-60 min at 20-50 W/K
+    {"engine_warmup", "heat_capacity_j_per_k", 25000.0, 800000.0},  // oil, block and coolant of small to large engines
+};
+// The unexplained basis' decay grid [s]: from 2.5 min to 80 min (the basis' own 300-2400 s lie on it).
+constexpr double kDecayGridLowS = 150.0, kDecayGridHighS = 4800.0;
+
+// low, low 2^(1/k), ... up to high (and `also`, the value already chosen, merged in), ascending.
+std::vector<double> log_grid(double low, double high, int per_octave, double also) {
+  std::vector<double> g;
+  const int k = std::max(1, per_octave);
+  for (int i = 0;; ++i) {
+    const double v = low * std::pow(2.0, static_cast<double>(i) / k);
+    if (v > high * (1.0 + 1e-9)) break;
+    g.push_back(std::abs(v - also) <= 1e-9 * also ? also : v);  // the chosen value itself where it lies on the grid
+  }
+  if (std::find(g.begin(), g.end(), also) == g.end()) g.push_back(also);
+  std::sort(g.begin(), g.end());
+  return g;
+}
+
 // A basis shape of the unexplained-residual description.
 struct BasisShape {
   enum Kind { force, power } kind = force;
@@ -344,6 +372,33 @@ void append_regime_means(const std::vector<std::string>& order, const std::map<s
 }
 
 }  // namespace
+
+ProfileInterval profile_likelihood_interval(const std::vector<double>& grid, const std::vector<double>& rss, double n_eff,
+                                            double critical) {
+  if (grid.empty() || grid.size() != rss.size()) throw InputError("profile", "grid and RSS must be non-empty and of one length");
+  for (std::size_t i = 0; i < grid.size(); ++i) {
+    if (!(grid[i] > 0.0) || (i > 0 && !(grid[i] > grid[i - 1]))) throw InputError("profile", "grid must be positive and ascending");
+    if (!(rss[i] > 0.0)) throw InputError("profile", "RSS must be positive");
+  }
+  ProfileInterval p;
+  p.best = static_cast<std::size_t>(std::min_element(rss.begin(), rss.end()) - rss.begin());
+  p.value = grid[p.best];
+  auto stat = [&](std::size_t i) { return n_eff * std::log(rss[i] / rss[p.best]); };
+  // Where the statistic crosses `critical` between grid points i (inside) and o (outside), in log(parameter).
+  auto crossing = [&](std::size_t i, std::size_t o) {
+    const double si = stat(i), so = stat(o);
+    const double f = so > si ? (critical - si) / (so - si) : 0.0;
+    return std::exp(std::log(grid[i]) + f * (std::log(grid[o]) - std::log(grid[i])));
+  };
+  std::size_t lo = p.best, hi = p.best;
+  while (lo > 0 && stat(lo - 1) < critical) --lo;
+  while (hi + 1 < grid.size() && stat(hi + 1) < critical) ++hi;
+  p.low_open = lo == 0;
+  p.high_open = hi + 1 == grid.size();
+  p.low = p.low_open ? grid.front() : crossing(lo, lo - 1);
+  p.high = p.high_open ? grid.back() : crossing(hi, hi + 1);
+  return p;
+}
 
 DriveCycle cycle_of_recording(const Recording& r) {
   DriveCycle c;
@@ -536,6 +591,10 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
     }
     std::vector<EffectParameters> shapes{{}};
     if (info.id == "tyre_warmup") shapes = {{{"heat_capacity_j_per_k", 20000.0}}, {{"heat_capacity_j_per_k", 50000.0}}, {{"heat_capacity_j_per_k", 120000.0}}};
+    // The engine's heat capacity is tested at its nominal value only, and profiled once the effect is found.
+    if (info.id == "engine_warmup")
+      for (const auto& p : info.parameters)
+        if (p.name == "heat_capacity_j_per_k") shapes = {{{p.name, p.nominal}}};
     const EffectParameterInfo* amp = nullptr;
     for (const auto& p : info.parameters)
       if (p.amplitude) amp = &p;
@@ -567,6 +626,18 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
     }
     basis.push_back({BasisShape::power, ForceShape::constant, tau, {}});  // computed directly below
   }
+  // 1 W at the measured channel, optionally decaying from the start of each recording (no simulation needed).
+  auto power_signature = [&](double decay_s) {
+    Eigen::VectorXd sig(n);
+    for (Eigen::Index w = 0; w < n; ++w) {
+      const auto& win = d.windows[static_cast<std::size_t>(w)];
+      double e = 0.0;
+      for (std::size_t i = win.begin; i < win.end; ++i)
+        e += (decay_s > 0.0 ? std::exp(-cycles[win.rec].time_s[i] / decay_s) : 1.0) * d.dt_s[win.rec][i];
+      sig[w] = e;
+    }
+    return sig;
+  };
   const std::vector<Variant> vars = run_variants(vehicle, cycles, d, extras, opt.threads);
   const Variant& rrc = vars[0];
   const Variant& drag = vars[1];
@@ -591,15 +662,8 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
     for (auto& b : basis) {
       if (b.kind == BasisShape::force) {
         b.signature = vars[k++].window_j - base.window_j;
-      } else {  // 1 W at the measured channel, optionally decaying from the start of each recording
-        b.signature.resize(n);
-        for (Eigen::Index w = 0; w < n; ++w) {
-          const auto& win = d.windows[static_cast<std::size_t>(w)];
-          double e = 0.0;
-          for (std::size_t i = win.begin; i < win.end; ++i)
-            e += (b.decay_s > 0.0 ? std::exp(-cycles[win.rec].time_s[i] / b.decay_s) : 1.0) * d.dt_s[win.rec][i];
-          b.signature[w] = e;
-        }
+      } else {
+        b.signature = power_signature(b.decay_s);
       }
     }
   }
@@ -713,8 +777,51 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
     }
     if (passing.empty()) break;
     std::sort(passing.begin(), passing.end(), [](const Scored& a, const Scored& b) { return a.dbic > b.dbic; });
-    const Scored& best = passing.front();
-    const Candidate& c = cands[best.idx];
+    Scored best = passing.front();
+    Candidate c = cands[best.idx];
+    // A warm-up's heat capacity was chosen from a coarse grid: refine it on a log grid, profile the criterion
+    // (RSS on the effective n) over it, adopt the grid's best if it also fits better held out, and keep the
+    // profile's 95 % interval. Only for a found effect, so a recording with nothing to find costs nothing more.
+    std::optional<ProfileInterval> profile;
+    std::string profiled_name;
+    for (const auto& tp : kTimeParameters) {
+      if (c.id != tp.effect || !c.shape.count(tp.parameter)) continue;
+      profiled_name = tp.parameter;
+      const double selected = c.shape.at(tp.parameter);
+      const std::vector<double> grid = log_grid(tp.low, tp.high, opt.profile_points_per_octave, selected);
+      std::vector<std::vector<std::shared_ptr<const Effect>>> runs;
+      for (double g : grid) {
+        if (g == selected) continue;
+        EffectParameters p = c.shape;
+        p[tp.parameter] = g;
+        p[c.amplitude_name] = c.nominal;
+        runs.push_back({make_effect(c.id, p, ctx)});
+      }
+      const std::vector<Variant> pv = run_variants(vehicle, cycles, d, runs, opt.threads);
+      std::vector<Eigen::VectorXd> sigs;
+      std::vector<double> rss_grid;
+      std::size_t k = 0;
+      for (double g : grid) {
+        sigs.push_back(g == selected ? c.signature : Eigen::VectorXd((pv[k++].window_j - base.window_j) / c.nominal));
+        rss_grid.push_back(least_squares(hcat(x, sigs.back()), d.measured_j, prior).rss);
+      }
+      ProfileInterval pi = profile_likelihood_interval(grid, rss_grid, n_eff);
+      if (grid[pi.best] != selected) {
+        const Eigen::MatrixXd xk = hcat(x, sigs[pi.best]);
+        const Fit f = least_squares(xk, d.measured_j, prior);
+        const double amp = f.coef[f.coef.size() - 1] / f.coef[0];
+        Eigen::VectorXd pred = heldout_prediction(xk, d.measured_j, fold_of, prior);
+        if (amp >= c.amp_min && amp <= c.amp_max && rmse(pred, d.measured_j) < rmse(best.pred, d.measured_j)) {
+          best.fit = f;
+          best.dbic = n_eff * std::log(rss / f.rss) - std::log(n_eff);
+          best.pred = pred;
+          c.signature = sigs[pi.best];
+          c.shape[tp.parameter] = grid[pi.best];
+        }
+      }
+      pi.value = c.shape.at(tp.parameter);
+      profile = pi;
+    }
     Finding fnd;
     fnd.effect = c.id;
     fnd.delta_bic = best.dbic;
@@ -736,8 +843,13 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
                         "ambient_temp_c per trip";
     }
     for (const auto& [k, v] : c.shape) {
-      for (const auto& pi : effect_info(c.id).parameters)
-        if (pi.name == k) fnd.parameters.push_back({k, pi.unit, v, v, v});
+      for (const auto& pi : effect_info(c.id).parameters) {
+        if (pi.name != k) continue;
+        if (profile && k == profiled_name)
+          fnd.parameters.push_back({k, pi.unit, v, profile->low, profile->high, true, profile->low_open, profile->high_open});
+        else
+          fnd.parameters.push_back({k, pi.unit, v, v, v});  // fixed, not fitted
+      }
     }
     const Eigen::VectorXd sb = cleaned(x, c.signature);
     for (std::size_t q = 1; q < passing.size(); ++q) {
@@ -810,7 +922,45 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
       best_pred = pred;
     }
     if (best_k >= 0) {
-      const BasisShape& b = basis[static_cast<std::size_t>(best_k)];
+      BasisShape b = basis[static_cast<std::size_t>(best_k)];
+      // A decaying shape's time constant came from the basis' grid: refine and profile it as for the warm-ups.
+      std::optional<ProfileInterval> profile;
+      if (b.decay_s > 0.0) {
+        const std::vector<double> grid = log_grid(kDecayGridLowS, kDecayGridHighS, opt.profile_points_per_octave, b.decay_s);
+        std::vector<Eigen::VectorXd> sigs(grid.size());
+        std::vector<std::vector<std::shared_ptr<const Effect>>> runs;
+        std::vector<std::size_t> run_of;
+        for (std::size_t g = 0; g < grid.size(); ++g) {
+          const auto same = std::find_if(basis.begin(), basis.end(), [&](const BasisShape& o) {
+            return o.kind == b.kind && o.shape == b.shape && o.decay_s == grid[g] && o.signature.size() == n;
+          });
+          if (same != basis.end()) sigs[g] = same->signature;
+          else if (b.kind == BasisShape::power) sigs[g] = power_signature(grid[g]);
+          else {
+            runs.push_back({std::make_shared<SignatureForce>(b.shape, grid[g])});
+            run_of.push_back(g);
+          }
+        }
+        const std::vector<Variant> pv = run_variants(vehicle, cycles, d, runs, opt.threads);
+        for (std::size_t r = 0; r < pv.size(); ++r) sigs[run_of[r]] = pv[r].window_j - base.window_j;
+        std::vector<double> rss_grid;
+        for (const auto& sg : sigs) rss_grid.push_back(least_squares(hcat(x, sg), d.measured_j, prior).rss);
+        ProfileInterval pi = profile_likelihood_interval(grid, rss_grid, n_eff);
+        if (grid[pi.best] != b.decay_s) {
+          const Eigen::MatrixXd xk = hcat(x, sigs[pi.best]);
+          const Fit f = least_squares(xk, d.measured_j, prior);
+          Eigen::VectorXd pred = heldout_prediction(xk, d.measured_j, fold_of, prior);
+          if (rmse(pred, d.measured_j) < rmse(best_pred, d.measured_j)) {
+            best_fit = f;
+            best_dbic = n_eff * std::log(rss / f.rss) - std::log(n_eff);
+            best_pred = pred;
+            b.decay_s = grid[pi.best];
+            b.signature = sigs[pi.best];
+          }
+        }
+        pi.value = b.decay_s;
+        profile = pi;
+      }
       Finding fnd;
       fnd.effect = "unexplained";
       fnd.delta_bic = best_dbic;
@@ -852,7 +1002,8 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
       fnd.parameters.push_back({name, unit, value, value - 1.96 * se, value + 1.96 * se});
       std::string when;
       if (b.decay_s > 0.0) {
-        fnd.parameters.push_back({"decay_time_constant_s", "s", b.decay_s, b.decay_s, b.decay_s});
+        fnd.parameters.push_back(
+            {"decay_time_constant_s", "s", b.decay_s, profile->low, profile->high, true, profile->low_open, profile->high_open});
         // "Mostly in the first N minutes": when 80 % of the signature's energy has accrued (windows by end time).
         std::vector<std::pair<double, double>> by_end;
         for (Eigen::Index w = 0; w < n; ++w)
@@ -1017,7 +1168,11 @@ std::string diagnosis_json(const Diagnosis& d) {
     for (std::size_t k = 0; k < f.parameters.size(); ++k) {
       const auto& p = f.parameters[k];
       os << (k ? ", " : "") << "\"" << p.name << "\": {\"value\": " << num(p.value) << ", \"ci_low\": " << num(p.ci_low)
-         << ", \"ci_high\": " << num(p.ci_high) << ", \"unit\": \"" << p.unit << "\"}";
+         << ", \"ci_high\": " << num(p.ci_high) << ", \"unit\": \"" << p.unit << "\"";
+      if (p.profiled)
+        os << ", \"interval\": \"profile\", \"ci_low_open\": " << (p.ci_low_open ? "true" : "false")
+           << ", \"ci_high_open\": " << (p.ci_high_open ? "true" : "false");
+      os << "}";
     }
     os << "}, \"confounded_with\": [";
     for (std::size_t k = 0; k < f.confounded_with.size(); ++k) os << (k ? ", " : "") << "\"" << f.confounded_with[k] << "\"";
@@ -1071,8 +1226,17 @@ std::string diagnosis_text(const Diagnosis& d) {
     os << "\n";
     if (!f.description.empty()) os << "    " << f.description << "\n";
     for (const auto& t : f.separating_tests) os << "    to separate from " << t << "\n";
-    for (const auto& p : f.parameters)
-      os << "    " << p.name << " = " << p.value << " [" << p.ci_low << ", " << p.ci_high << "] " << p.unit << "\n";
+    for (const auto& p : f.parameters) {
+      os << "    " << p.name << " = " << p.value;
+      if (p.profiled)
+        os << " [" << (p.ci_low_open ? "< " : "") << p.ci_low << ", " << (p.ci_high_open ? "> " : "") << p.ci_high
+           << "] " << p.unit << " (profile likelihood, 95 %" << (p.ci_low_open || p.ci_high_open ? "; open at the grid's end" : "")
+           << ")\n";
+      else if (p.ci_low == p.value && p.ci_high == p.value)
+        os << " " << p.unit << " (fixed)\n";
+      else
+        os << " [" << p.ci_low << ", " << p.ci_high << "] " << p.unit << "\n";
+    }
     os << "    held-out RMSE " << f.heldout_rmse_before_j / 1e3 << " -> " << f.heldout_rmse_after_j / 1e3
        << " kJ/window, trip energy error " << f.heldout_energy_error_pct_before << " -> " << f.heldout_energy_error_pct_after
        << " %, residual lag-1 autocorrelation " << f.heldout_lag1_autocorrelation_before << " -> "

@@ -25,6 +25,9 @@ struct DiagnoseOptions {
   double soc_quantisation_fraction = 0.02;
   /// Unexplained-residual basis: time constants of the early-trip decay shapes [s].
   std::vector<double> unexplained_decay_s{300.0, 600.0, 1200.0, 2400.0};
+  /// Profile grids (log-spaced, points per factor of two) refining a found effect's time constant: the unexplained
+  /// basis' decay over 150-4800 s, tyre_warmup's heat capacity over 10-400 kJ/K, engine_warmup's over 25-800 kJ/K.
+  int profile_points_per_octave = 2;
   /// ambient_rrc is tested only across recordings whose mean recorded ambients span at least this much [K].
   double ambient_min_spread_k = 5.0;
   /// Trip-to-trip scatter (sd) of the RRC level at one ambient (tyre pressure +-0.1 bar, road surface): ambient_rrc
@@ -35,8 +38,24 @@ struct DiagnoseOptions {
 
 struct ParameterEstimate {
   std::string name, unit;
-  double value = 0.0, ci_low = 0.0, ci_high = 0.0;  ///< 95 %; a shape parameter taken from a grid has ci = value
+  double value = 0.0, ci_low = 0.0, ci_high = 0.0;  ///< 95 %
+  /// A time constant (or heat capacity) from a profile over a log-spaced grid: the interval is where
+  /// n_eff ln(RSS / RSS_min) < 3.84; an end of it that reached the grid's end is open ("< ci_low", "> ci_high").
+  bool profiled = false;
+  bool ci_low_open = false, ci_high_open = false;
 };
+
+/// Profile-likelihood interval over an ascending grid of a positive parameter: the grid point of least RSS, and the
+/// contiguous range about it where n_eff ln(RSS / RSS_min) stays below `critical` (3.84: chi^2 with one degree of
+/// freedom, 95 %), its ends interpolated linearly in log(parameter) between the last point inside and the first
+/// outside; an end still inside at the grid's end is that end, flagged open.
+struct ProfileInterval {
+  std::size_t best = 0;  ///< index of the least RSS
+  double value = 0.0, low = 0.0, high = 0.0;
+  bool low_open = false, high_open = false;
+};
+ProfileInterval profile_likelihood_interval(const std::vector<double>& grid, const std::vector<double>& rss, double n_eff,
+                                            double critical = 3.84);
 
 struct Finding {
   std::string effect;  ///< catalogue identifier, or "unexplained" (described by its signature)
