@@ -1,4 +1,4 @@
-// Benchmarks of the energy simulation: NEDC forward (driver + CVODE) and kinematic replay of ev.yaml.
+// Benchmarks of the energy simulation: forward (driver + CVODE) and kinematic replay of the shipped cars.
 #include <benchmark/benchmark.h>
 
 #include <string>
@@ -7,13 +7,13 @@
 
 namespace {
 
-rollsim::VehicleModel ev_model() {
-  return rollsim::VehicleModel::assemble(rollsim::load_vehicle_file(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/ev.yaml"));
+rollsim::VehicleModel shipped_model(const std::string& file) {
+  return rollsim::VehicleModel::assemble(rollsim::load_vehicle_file(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/" + file));
 }
 
-void BM_SimulateForwardNedcEv(benchmark::State& state) {
-  const auto model = ev_model();
-  const auto cycle = rollsim::load_cycle("nedc");
+void BM_SimulateForward(benchmark::State& state, const std::string& vehicle, const std::string& cycle_name) {
+  const auto model = shipped_model(vehicle);
+  const auto cycle = rollsim::load_cycle(cycle_name);
   rollsim::OdeStats stats;
   const rollsim::SimulationOptions opt;
   for (auto _ : state) {
@@ -25,46 +25,23 @@ void BM_SimulateForwardNedcEv(benchmark::State& state) {
   state.counters["rhs_evals"] = static_cast<double>(stats.rhs_evals);
   state.counters["err_test_fails"] = static_cast<double>(stats.error_test_failures);
   state.counters["restarts"] = static_cast<double>(stats.restarts);
+  if (stats.root_evals > 0) state.counters["root_evals"] = static_cast<double>(stats.root_evals);
 }
-BENCHMARK(BM_SimulateForwardNedcEv)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_SimulateForward, NedcEv, "ev.yaml", "nedc")->Unit(benchmark::kMillisecond);
+// The petrol car: five gears, shifts and kick-downs located as roots.
+BENCHMARK_CAPTURE(BM_SimulateForward, NedcIce, "ice.yaml", "nedc")->Unit(benchmark::kMillisecond);
 
-void BM_SimulateReplayNedcEv(benchmark::State& state) {
-  const auto model = ev_model();
-  const auto cycle = rollsim::load_cycle("nedc");
+void BM_SimulateReplay(benchmark::State& state, const std::string& vehicle, const std::string& cycle_name) {
+  const auto model = shipped_model(vehicle);
+  const auto cycle = rollsim::load_cycle(cycle_name);
   for (auto _ : state) {
     auto r = rollsim::simulate_replay(model, cycle);
     benchmark::DoNotOptimize(r);
   }
 }
-BENCHMARK(BM_SimulateReplayNedcEv)->Unit(benchmark::kMicrosecond);
-
+BENCHMARK_CAPTURE(BM_SimulateReplay, NedcEv, "ev.yaml", "nedc")->Unit(benchmark::kMicrosecond);
 // The replay reuses a repeated segment's integrals, and NEDC repeats its urban cycle four times: WLTC, which
 // repeats nothing, shows the cost per evaluated segment (1800 s).
-void BM_SimulateReplayWltcEv(benchmark::State& state) {
-  const auto model = ev_model();
-  const auto cycle = rollsim::load_cycle("wltc");
-  for (auto _ : state) {
-    auto r = rollsim::simulate_replay(model, cycle);
-    benchmark::DoNotOptimize(r);
-  }
-}
-BENCHMARK(BM_SimulateReplayWltcEv)->Unit(benchmark::kMicrosecond);
-
-void BM_SimulateForwardNedcIce(benchmark::State& state) {
-  const auto model =
-      rollsim::VehicleModel::assemble(rollsim::load_vehicle_file(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/ice.yaml"));
-  const auto cycle = rollsim::load_cycle("nedc");
-  rollsim::OdeStats stats;
-  for (auto _ : state) {
-    auto r = rollsim::simulate_forward(model, cycle);
-    stats = r.solver;
-    benchmark::DoNotOptimize(r);
-  }
-  state.counters["steps"] = static_cast<double>(stats.steps);
-  state.counters["rhs_evals"] = static_cast<double>(stats.rhs_evals);
-  state.counters["roots"] = static_cast<double>(stats.root_evals);
-  state.counters["restarts"] = static_cast<double>(stats.restarts);
-}
-BENCHMARK(BM_SimulateForwardNedcIce)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_SimulateReplay, WltcEv, "ev.yaml", "wltc")->Unit(benchmark::kMicrosecond);
 
 }  // namespace

@@ -22,39 +22,39 @@ namespace {
 double* data(N_Vector v) { return NV_DATA_S(v); }
 sunindextype length(N_Vector v) { return NV_LENGTH_S(v); }
 
+// z[i] = f(i) for every element.
+template <typename F>
+void each(N_Vector z, F&& f) {
+  double* zd = data(z);
+  for (sunindextype i = 0, n = length(z); i < n; ++i) zd[i] = f(i);
+}
+
 void linear_sum(realtype a, N_Vector x, realtype b, N_Vector y, N_Vector z) {
   const double *xd = data(x), *yd = data(y);
-  double* zd = data(z);
-  for (sunindextype i = 0, n = length(z); i < n; ++i) zd[i] = a * xd[i] + b * yd[i];
+  each(z, [&](sunindextype i) { return a * xd[i] + b * yd[i]; });
 }
 void scale(realtype c, N_Vector x, N_Vector z) {
   const double* xd = data(x);
-  double* zd = data(z);
-  for (sunindextype i = 0, n = length(z); i < n; ++i) zd[i] = c * xd[i];
+  each(z, [&](sunindextype i) { return c * xd[i]; });
 }
 void constant(realtype c, N_Vector z) {
-  double* zd = data(z);
-  for (sunindextype i = 0, n = length(z); i < n; ++i) zd[i] = c;
+  each(z, [&](sunindextype) { return c; });
 }
 void absolute(N_Vector x, N_Vector z) {
   const double* xd = data(x);
-  double* zd = data(z);
-  for (sunindextype i = 0, n = length(z); i < n; ++i) zd[i] = std::abs(xd[i]);
+  each(z, [&](sunindextype i) { return std::abs(xd[i]); });
 }
 void inverse(N_Vector x, N_Vector z) {
   const double* xd = data(x);
-  double* zd = data(z);
-  for (sunindextype i = 0, n = length(z); i < n; ++i) zd[i] = 1.0 / xd[i];
+  each(z, [&](sunindextype i) { return 1.0 / xd[i]; });
 }
 void add_constant(N_Vector x, realtype b, N_Vector z) {
   const double* xd = data(x);
-  double* zd = data(z);
-  for (sunindextype i = 0, n = length(z); i < n; ++i) zd[i] = xd[i] + b;
+  each(z, [&](sunindextype i) { return xd[i] + b; });
 }
 void product(N_Vector x, N_Vector y, N_Vector z) {
   const double *xd = data(x), *yd = data(y);
-  double* zd = data(z);
-  for (sunindextype i = 0, n = length(z); i < n; ++i) zd[i] = xd[i] * yd[i];
+  each(z, [&](sunindextype i) { return xd[i] * yd[i]; });
 }
 realtype weighted_square_sum(N_Vector x, N_Vector w) {
   const double *xd = data(x), *wd = data(w);
@@ -64,20 +64,18 @@ realtype weighted_square_sum(N_Vector x, N_Vector w) {
 }
 realtype wrms_norm(N_Vector x, N_Vector w) { return std::sqrt(weighted_square_sum(x, w) / static_cast<double>(length(x))); }
 int linear_combination(int nv, realtype* c, N_Vector* xs, N_Vector z) {
-  double* zd = data(z);
-  for (sunindextype i = 0, n = length(z); i < n; ++i) {
+  each(z, [&](sunindextype i) {
     double sum = 0.0;
     for (int j = 0; j < nv; ++j) sum += c[j] * data(xs[j])[i];
-    zd[i] = sum;
-  }
+    return sum;
+  });
   return 0;
 }
 int scale_add_multi(int nv, realtype* a, N_Vector x, N_Vector* ys, N_Vector* zs) {
   const double* xd = data(x);
   for (int j = 0; j < nv; ++j) {
     const double* yd = data(ys[j]);
-    double* zd = data(zs[j]);
-    for (sunindextype i = 0, n = length(x); i < n; ++i) zd[i] = a[j] * xd[i] + yd[i];
+    each(zs[j], [&](sunindextype i) { return a[j] * xd[i] + yd[i]; });
   }
   return 0;
 }
