@@ -29,14 +29,29 @@ bool has_note(const Diagnosis& d, const std::string& text) {
   return std::any_of(d.notes.begin(), d.notes.end(), [&](const std::string& n) { return n.find(text) != std::string::npos; });
 }
 
+// The air of a trip at `ambient_c`: density ~ 1 / T against the vehicle's at 20 degC, so an extra aero force
+// 0.5 rho_20 CdA (293.15 / T - 1) v^2 (written here, apart from the diagnosis' own correction).
+class AirAt final : public Effect {
+ public:
+  AirAt(const Vehicle& v, double ambient_c)
+      : k_(0.5 * v.body.air_density_kg_per_m3 * v.body.drag_coefficient * v.body.frontal_area_m2 * (293.15 / (ambient_c + 273.15) - 1.0)) {}
+  std::string id() const override { return "test_air"; }
+  double extra_resistance_n(const EffectInputs& in, const double*) const override { return k_ * in.speed_mps * in.speed_mps; }
+
+ private:
+  double k_;
+};
+
 // A trip whose measured power is the catalogue's own ambient_rrc module at a known c (an exact linear law, the
-// analytic limit the fit must recover), with white noise; its recorded ambient is `ambient_c`.
+// analytic limit the fit must recover) in the air of that ambient, with white noise; its recorded ambient is
+// `ambient_c`.
 Recording linear_ambient_trip(const Vehicle& v, const std::string& cycle, double ambient_c, double c_per_k, unsigned seed) {
   const DriveCycle c = load_cycle(cycle);
   VehicleModel m = VehicleModel::assemble(v);
   EffectContext ctx;
   ctx.mass_kg = v.body.test_mass_kg;
   m.effects.push_back(make_effect("ambient_rrc", {{"rrc_change_per_k", c_per_k}, {"ambient_temp_c", ambient_c}, {"reference_temp_c", 20.0}}, ctx));
+  m.effects.push_back(std::make_shared<AirAt>(v, ambient_c));
   SimulationOptions so;
   so.record_trace = true;
   const SimulationResult r = simulate_replay(m, c, so);

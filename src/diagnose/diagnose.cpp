@@ -131,11 +131,14 @@ struct Data {
   std::vector<std::vector<double>> measured_w;  // empty for SOC
   std::string channel;
   int lag_samples = 0;  // measured channel lags the simulation by this many samples (calibration)
+  // Known per-recording physics in every variant (nullptr: none): air density at the recorded ambient.
+  std::vector<std::shared_ptr<const Effect>> per_recording;
 };
 
 // Simulated channel power per sample for one model variant (the base model plus `extra` effects).
 std::vector<std::vector<double>> simulate_power(const Vehicle& vehicle, const std::vector<DriveCycle>& cycles,
-                                                const std::vector<std::shared_ptr<const Effect>>& extra, bool cells) {
+                                                const std::vector<std::shared_ptr<const Effect>>& extra, bool cells,
+                                                const std::vector<std::shared_ptr<const Effect>>& per_recording) {
   VehicleModel model = VehicleModel::assemble(vehicle);
   for (const auto& e : extra) model.effects.push_back(e);
   const bool electric = vehicle.is_electric();
@@ -145,8 +148,12 @@ std::vector<std::vector<double>> simulate_power(const Vehicle& vehicle, const st
   SimulationOptions so;
   so.record_trace = true;
   std::vector<std::vector<double>> out;
-  for (const auto& c : cycles) {
+  for (std::size_t ci = 0; ci < cycles.size(); ++ci) {
+    const auto& c = cycles[ci];
+    const bool own = ci < per_recording.size() && per_recording[ci];
+    if (own) model.effects.push_back(per_recording[ci]);
     const SimulationResult r = simulate_replay(model, c, so);
+    if (own) model.effects.pop_back();
     std::vector<double> p(r.trace.size());
     for (std::size_t i = 0; i < p.size(); ++i) p[i] = sim_power_w(r.trace[i], electric, fuel_j_per_m3, cells);
     out.push_back(std::move(p));
@@ -177,7 +184,7 @@ std::vector<Variant> run_variants(const Vehicle& vehicle, const std::vector<Driv
   auto work = [&] {
     for (std::size_t k = next++; k < extras.size(); k = next++) {
       try {
-        out[k].power_w = simulate_power(vehicle, cycles, extras[k], d.channel == "soc");
+        out[k].power_w = simulate_power(vehicle, cycles, extras[k], d.channel == "soc", d.per_recording);
         out[k].window_j = window_energies(out[k].power_w, d);
       } catch (...) {
         const std::lock_guard<std::mutex> lock(failure_mutex);
@@ -517,9 +524,44 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
     fold_of[static_cast<std::size_t>(w)] = recordings.size() > 1 ? static_cast<int>(d.windows[static_cast<std::size_t>(w)].rec)
                                                                   : static_cast<int>((w / opt.block_windows) % 2);
 
+  // Ambient temperature on RRC moves the RRC level from trip to trip, never within one: within one trip it is the
+  // RRC level (a calibration quantity). It is a candidate only across recordings whose recorded ambients differ.
+  std::vector<double> ambient_k;  // per recording: mean recorded ambient
+  bool ambient_testable = false;
+  if (recordings.size() < 2) {
+    out.notes.push_back("ambient_rrc not tested: one recording (within one trip it is the RRC level, a calibration quantity)");
+  } else if (!std::all_of(recordings.begin(), recordings.end(), [](const Recording& r) { return r.ambient_temp_k.has_value(); })) {
+    out.notes.push_back("ambient_rrc not tested: not every recording has an ambient_temp_c column");
+  } else {
+    for (const auto& r : recordings) {
+      double sum = 0.0;
+      for (double t : *r.ambient_temp_k) sum += t;
+      ambient_k.push_back(sum / static_cast<double>(std::max<std::size_t>(1, r.ambient_temp_k->size())));
+    }
+    const auto [lo, hi] = std::minmax_element(ambient_k.begin(), ambient_k.end());
+    ambient_testable = *hi - *lo >= opt.ambient_min_spread_k;
+    out.notes.push_back(ambient_testable
+                            ? "ambient_rrc tested across " + std::to_string(recordings.size()) + " recordings at " +
+                                  fixed(*lo - 273.15, 1) + " to " + fixed(*hi - 273.15, 1) + " degC (one shared RRC level)"
+                            : "ambient_rrc not tested: recorded ambients span " + fixed(*hi - *lo, 1) + " K, under " +
+                                  fixed(opt.ambient_min_spread_k, 1) + " K (the recordings are at the same ambient)");
+  }
+  // Reference: the recordings' mean ambient, so that the ambient signature is nearly orthogonal to the shared RRC
+  // level (whose prior would otherwise push a level offset into the unpenalised ambient coefficient).
+  double ambient_ref_k = 0.0;
+  for (double t : ambient_k) ambient_ref_k += t / static_cast<double>(ambient_k.size());
   const EffectContext ctx = context_of(vehicle);
+  // Air density follows the recorded ambient (rho ~ 1 / T at one pressure): across trips at different ambients it
+  // moves the aero force by about 0.35 % per K, in the same direction as an RRC rising in the cold, so it is known
+  // physics of the replay, not left for ambient_rrc to absorb. The vehicle's density (or coast-down) is taken at
+  // 20 degC (the coast-down standards' reference). Only where ambient_rrc is tested: within one recording, or at one
+  // ambient, it is a level that the aero calibration absorbs.
+  if (ambient_testable && opt.air_density_from_ambient) {
+    for (double t : ambient_k) d.per_recording.push_back(std::make_shared<DragScale>(293.15 / t - 1.0, ctx.rho_cda_kg_per_m));
+    out.notes.push_back("air density per recording from its recorded ambient (reference 20 degC)");
+  }
   Variant base;
-  base.power_w = simulate_power(vehicle, cycles, {}, d.channel == "soc");
+  base.power_w = simulate_power(vehicle, cycles, {}, d.channel == "soc", d.per_recording);
   // Channel lag (calibration): the shift of the simulated power, 0-10 samples, that best matches the measured.
   if (d.channel != "soc") {
     double best = 1e300;
@@ -547,32 +589,6 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
   extras.push_back({std::make_shared<RrcLevel>(0.1)});
   extras.push_back({std::make_shared<DragScale>(0.1, ctx.rho_cda_kg_per_m)});
   std::vector<Candidate> cands;
-  // Ambient temperature on RRC moves the RRC level from trip to trip, never within one: within one trip it is the
-  // RRC level (a calibration quantity). It is a candidate only across recordings whose recorded ambients differ.
-  std::vector<double> ambient_k;  // per recording: mean recorded ambient
-  bool ambient_testable = false;
-  if (recordings.size() < 2) {
-    out.notes.push_back("ambient_rrc not tested: one recording (within one trip it is the RRC level, a calibration quantity)");
-  } else if (!std::all_of(recordings.begin(), recordings.end(), [](const Recording& r) { return r.ambient_temp_k.has_value(); })) {
-    out.notes.push_back("ambient_rrc not tested: not every recording has an ambient_temp_c column");
-  } else {
-    for (const auto& r : recordings) {
-      double sum = 0.0;
-      for (double t : *r.ambient_temp_k) sum += t;
-      ambient_k.push_back(sum / static_cast<double>(std::max<std::size_t>(1, r.ambient_temp_k->size())));
-    }
-    const auto [lo, hi] = std::minmax_element(ambient_k.begin(), ambient_k.end());
-    ambient_testable = *hi - *lo >= opt.ambient_min_spread_k;
-    out.notes.push_back(ambient_testable
-                            ? "ambient_rrc tested across " + std::to_string(recordings.size()) + " recordings at " +
-                                  fixed(*lo - 273.15, 1) + " to " + fixed(*hi - 273.15, 1) + " degC (one shared RRC level)"
-                            : "ambient_rrc not tested: recorded ambients span " + fixed(*hi - *lo, 1) + " K, under " +
-                                  fixed(opt.ambient_min_spread_k, 1) + " K (the recordings are at the same ambient)");
-  }
-  // Reference: the recordings' mean ambient, so that the ambient signature is nearly orthogonal to the shared RRC
-  // level (whose prior would otherwise push a level offset into the unpenalised ambient coefficient).
-  double ambient_ref_k = 0.0;
-  for (double t : ambient_k) ambient_ref_k += t / static_cast<double>(ambient_k.size());
   for (const auto& info : effect_catalogue()) {
     if (info.id == "ambient_rrc") {
       if (!ambient_testable) continue;
@@ -708,7 +724,8 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
   };
   const double inflate = std::sqrt(static_cast<double>(n) / n_eff);  // autocorrelated windows carry less information
   // ambient_rrc's evidence lives in a few per-trip RRC levels, not in the windows: a trip's RRC level also moves with
-  // tyre pressure and road surface, so windows alone would take any such trip-to-trip scatter for an ambient law.
+  // tyre pressure and road surface (and its aero force with the weather), so windows alone would take any such
+  // trip-to-trip scatter for an ambient law.
   // The trips' own RRC levels (model `xm` with the shared RRC column split per recording) are regressed on ambient
   // by generalised least squares with their covariance plus that scatter (opt.trip_rrc_scatter, fixed in advance);
   // returns the coefficient c [1/K], its standard error and the trips' Delta BIC (chi^2 - ln trips).
@@ -731,6 +748,18 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
     const double tau_coef = opt.trip_rrc_scatter * std::abs(s) / 0.1;  // coefficients are per 10 % RRC
     Eigen::MatrixXd v = f.cov.block(1, 1, nr, nr) * (inflate * inflate);
     v.diagonal().array() += tau_coef * tau_coef;
+    // The day's unrecorded barometric pressure moves the trip's aero force; projected onto that trip's RRC level
+    // (least squares of the aero signature on the RRC signature over the trip's windows), it is more scatter.
+    for (Eigen::Index r = 0; r < nr; ++r) {
+      double sa = 0.0, ss = 0.0;
+      for (Eigen::Index w = 0; w < n; ++w) {
+        if (static_cast<Eigen::Index>(d.windows[static_cast<std::size_t>(w)].rec) != r) continue;
+        sa += xm(w, 2) * xm(w, 1);
+        ss += xm(w, 1) * xm(w, 1);
+      }
+      const double air_coef = ss > 0.0 ? opt.trip_air_density_scatter * std::abs(s) / 0.1 * sa / ss : 0.0;
+      v(r, r) += air_coef * air_coef;
+    }
     Eigen::MatrixXd design(nr, 2);
     Eigen::VectorXd a(nr);
     for (Eigen::Index r = 0; r < nr; ++r) {

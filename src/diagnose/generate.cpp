@@ -88,6 +88,22 @@ class AmbientCompoundTruth final : public Effect {
   bool cold_start_;
 };
 
+// Truth air: density at the trip's ambient and barometric pressure, rho = p / (R T), against the vehicle's at 20 degC
+// and 1013 hPa; the extra (or missing) aero force 0.5 (rho - rho_20) CdA v^2.
+class AirDensityTruth final : public Effect {
+ public:
+  AirDensityTruth(double rho_cda_20, double ambient_c, double pressure_ratio)
+      : k_(0.5 * rho_cda_20 * (pressure_ratio * 293.15 / (ambient_c + 273.15) - 1.0)) {}
+  std::string id() const override { return "truth_air_density"; }
+  double extra_resistance_n(const EffectInputs& in, const double*) const override {
+    const double v = std::max(in.speed_mps, 0.0);
+    return k_ * v * v;
+  }
+
+ private:
+  double k_;
+};
+
 // Truth auxiliary load: an A/C compressor cycling on and off (period 240-360 s, 40 % duty, random phase) plus a
 // blower at a quarter of the mean, not the catalogue's constant load. `mean_w` is the time-averaged power.
 class CompressorTruth final : public Effect {
@@ -339,6 +355,14 @@ Recording generate_case(const Vehicle& vehicle, const SyntheticCase& o) {
   const double level = o.rrc_level.value_or(level_draw);
   truths.push_back(std::make_shared<RrcLevelTruth>(level));
   const double rho_cda = vehicle.body.air_density_kg_per_m3 * vehicle.body.drag_coefficient * vehicle.body.frontal_area_m2;
+  if (o.ambient_temp_c) {
+    // The day's air: density at the trip's ambient, and a barometric pressure of 1013 hPa +-1.5 % (weather), which
+    // the recording does not carry. Its own stream, so the other truths' draws stay put.
+    std::mt19937 air_rng(o.seed * 15485863u + 11u);
+    const double pressure_ratio = 1.0 + 0.015 * std::uniform_real_distribution<double>(-1.0, 1.0)(air_rng);
+    const double road_rho_cda = vehicle.coastdown ? 2.0 * vehicle.coastdown->c_n_s2_per_m2 : rho_cda;
+    truths.push_back(std::make_shared<AirDensityTruth>(road_rho_cda, *o.ambient_temp_c, pressure_ratio));
+  }
   const double weight_n = vehicle.body.test_mass_kg * kG;
   double engine_cold_excess = 0.0, battery_extra_ohm = 0.0;  // post-run truths, applied to the channel below
   for (const auto& e : o.effects) {

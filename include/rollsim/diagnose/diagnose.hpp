@@ -33,6 +33,11 @@ struct DiagnoseOptions {
   /// Trip-to-trip scatter (sd) of the RRC level at one ambient (tyre pressure +-0.1 bar, road surface): ambient_rrc
   /// must explain the trips' RRC levels beyond it.
   double trip_rrc_scatter = 0.01;
+  /// Trip-to-trip scatter (sd) of the air density that the recorded ambient does not explain (barometric pressure,
+  /// about +-10 hPa day to day), projected onto each trip's RRC level and added to the scatter above.
+  double trip_air_density_scatter = 0.01;
+  /// Where ambient_rrc is tested, each recording is replayed with the air density of its recorded ambient.
+  bool air_density_from_ambient = true;
   unsigned threads = 0;  ///< simulator runs in parallel (0: hardware concurrency)
 };
 
