@@ -32,3 +32,43 @@ TEST(CliDiagnose, MisspeltMappingColumnIsNamed) {
   EXPECT_NE(r.err.find("fuel_rate_lhp"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("camry_bad_mapping.yaml"), std::string::npos) << r.err;
 }
+
+#include <cstdio>
+#include <vector>
+
+#include "rollsim/diagnose/generate.hpp"
+
+// Several recordings at different ambients, as CSV files with an ambient_temp_c column: `diagnose` names
+// ambient_rrc with its coefficient and interval in the JSON, and `--write-vehicle` switches it on.
+TEST(CliDiagnose, AmbientRrcAcrossRecordedAmbients) {
+  const rollsim::Vehicle ev = rollsim::load_vehicle_file(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/ev.yaml");
+  rollsim::MultiTripCase m;
+  m.seed = 5;
+  m.effects = {{"ambient_compound", 0.012}};
+  const std::vector<rollsim::Recording> trips = rollsim::generate_trips(ev, m);
+  std::string args;
+  for (std::size_t k = 0; k < trips.size(); ++k) {
+    const auto path = rollsim::test::temp_dir() / ("trip" + std::to_string(k) + ".csv");
+    std::FILE* f = std::fopen(path.string().c_str(), "w");
+    ASSERT_NE(f, nullptr);
+    std::fprintf(f, "time_s,speed_kmh,battery_power_kw,ambient_temp_c\n");
+    const auto& t = trips[k];
+    for (std::size_t i = 0; i < t.time_s.size(); ++i)
+      std::fprintf(f, "%.1f,%.4f,%.4f,%.2f\n", t.time_s[i], t.speed_mps[i] * 3.6, (*t.battery_power_w)[i] / 1000.0,
+                   (*t.ambient_temp_k)[i] - 273.15);
+    std::fclose(f);
+    args += " --recording '" + path.string() + "'";
+  }
+  const auto json = rollsim::test::temp_dir() / "ambient.json";
+  const auto fitted = rollsim::test::temp_dir() / "ev_ambient.yaml";
+  std::filesystem::remove(fitted);
+  const auto r = rollsim::test::run_rollsim("diagnose --vehicle ev" + args + " --json '" + json.string() + "' --write-vehicle '" +
+                                            fitted.string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("ambient_rrc tested across 4 recordings"), std::string::npos) << r.out;
+  const std::string j = rollsim::test::slurp(json);
+  const auto at = j.find("\"effect\": \"ambient_rrc\"");
+  ASSERT_NE(at, std::string::npos) << j;
+  EXPECT_NE(j.find("\"rrc_change_per_k\": {\"value\": ", at), std::string::npos) << j;
+  EXPECT_NE(rollsim::test::slurp(fitted).find("ambient_rrc:"), std::string::npos);
+}
