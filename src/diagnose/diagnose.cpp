@@ -848,7 +848,10 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
           c.shape[tp.parameter] = grid[pi.best];
         }
       }
+      // The value kept is the selection's when the profile's best did not also fit better held out: keep it inside.
       pi.value = c.shape.at(tp.parameter);
+      pi.low = std::min(pi.low, pi.value);
+      pi.high = std::max(pi.high, pi.value);
       profile = pi;
     }
     Finding fnd;
@@ -988,6 +991,8 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
           }
         }
         pi.value = b.decay_s;
+        pi.low = std::min(pi.low, pi.value);
+        pi.high = std::max(pi.high, pi.value);
         profile = pi;
       }
       Finding fnd;
