@@ -326,7 +326,7 @@ struct TimeParameter {
   double low, high;
 };
 constexpr TimeParameter kTimeParameters[] = {
-    {"tyre_warmup", "heat_capacity_j_per_k", 10000.0, 400000.0},   // tau ~ C / h: ~3-60 min at 20-50 W/K
+    {"tyre_warmup", "heat_capacity_j_per_k", 10000.0, 320000.0},   // tau ~ C / h: ~3-60 min at 20-50 W/K
     {"engine_warmup", "heat_capacity_j_per_k", 25000.0, 800000.0},  // oil, block and coolant of small to large engines
 };
 // The unexplained basis' decay grid [s]: from 2.5 min to 80 min (the basis' own 300-2400 s lie on it).

@@ -26,7 +26,7 @@ struct DiagnoseOptions {
   /// Unexplained-residual basis: time constants of the early-trip decay shapes [s].
   std::vector<double> unexplained_decay_s{300.0, 600.0, 1200.0, 2400.0};
   /// Profile grids (log-spaced, points per factor of two) refining a found effect's time constant: the unexplained
-  /// basis' decay over 150-4800 s, tyre_warmup's heat capacity over 10-400 kJ/K, engine_warmup's over 25-800 kJ/K.
+  /// basis' decay over 150-4800 s, tyre_warmup's heat capacity over 10-320 kJ/K, engine_warmup's over 25-800 kJ/K.
   int profile_points_per_octave = 2;
   /// ambient_rrc is tested only across recordings whose mean recorded ambients span at least this much [K].
   double ambient_min_spread_k = 5.0;
