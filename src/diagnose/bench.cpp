@@ -457,23 +457,24 @@ BenchResult run_discovery_bench(const Vehicle& vehicle, const BenchOptions& opt)
   // the most effects named (alone or confounded) among thresholds whose pooled null false-discovery rate is at most
   // 5 %; if none is, the threshold with the lowest null rate (ties: the most named).
   {
+    // Null rows count false discoveries; effect rows (not the time-reversed one) count what was named.
+    auto pool = [](SparseThresholdSummary& m, const std::string& group, const Score& sc) {
+      if (group == "null") {
+        m.null_false += sc.mistaken;
+        m.null_n += sc.n();
+      } else if (group != "reversed") {
+        m.named += sc.named;
+        m.confounded += sc.confounded;
+        m.mistaken += sc.mistaken;
+        m.effect_n += sc.n();
+      }
+    };
     int best = 0;
     std::vector<SparseThresholdSummary> sums(nt);
     for (std::size_t t = 0; t < nt; ++t) {
       auto& m = sums[t];
       m.threshold = sparse_thresholds()[t];
-      for (const auto& row : res.rows) {
-        const Score& sc = row.sparse_by_threshold[t];
-        if (row.group == "null") {
-          m.null_false += sc.mistaken;
-          m.null_n += sc.n();
-        } else if (row.group != "reversed") {
-          m.named += sc.named;
-          m.confounded += sc.confounded;
-          m.mistaken += sc.mistaken;
-          m.effect_n += sc.n();
-        }
-      }
+      for (const auto& row : res.rows) pool(m, row.group, row.sparse_by_threshold[t]);
     }
     auto ok = [](const SparseThresholdSummary& m) { return m.null_false <= 0.05 * m.null_n; };
     auto hits = [](const SparseThresholdSummary& m) { return m.named + m.confounded; };
@@ -490,18 +491,7 @@ BenchResult run_discovery_bench(const Vehicle& vehicle, const BenchOptions& opt)
     res.sparse_summary = std::move(sums);
     // BIC's own choice, pooled the same way.
     SparseThresholdSummary bic;
-    for (const auto& row : res.rows) {
-      const Score& sc = row.sparse_bic;
-      if (row.group == "null") {
-        bic.null_false += sc.mistaken;
-        bic.null_n += sc.n();
-      } else if (row.group != "reversed") {
-        bic.named += sc.named;
-        bic.confounded += sc.confounded;
-        bic.mistaken += sc.mistaken;
-        bic.effect_n += sc.n();
-      }
-    }
+    for (const auto& row : res.rows) pool(bic, row.group, row.sparse_bic);
     res.sparse_bic_summary = bic;
   }
   res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
