@@ -89,6 +89,14 @@ std::vector<std::string> write_diagnosis_report(const std::string& dir, const Di
   }
   const std::string dat = "'" + report::gnuplot_escape((work / "windows.dat").string()) + "'";
   const std::string after = report::gnuplot_escape(d.findings.empty() ? "after (no findings: same as before)" : "after the findings' effects");
+  // Window residuals before and after, as points against one signature variable (a column of windows.dat).
+  auto residual_against = [&](const std::string& file, const std::string& what, const std::string& xlabel, int column) {
+    std::ostringstream script;
+    script << "set xlabel '" << xlabel << "'\nset ylabel 'residual mean power [W]'\nplot " << dat << " u " << column
+           << ":11 w p pt 7 ps 0.6 t 'before', " << dat << " u " << column << ":12 w p pt 6 ps 0.6 t '" << after
+           << "', 0 w l lc 'black' notitle\n";
+    return Figure{file, "Window residual against " + what, script.str()};
+  };
   std::vector<Figure> figs{
       {"energy.svg", "Measured against simulated mean power per window (" + d.channel + " channel)",
        "set xlabel 'time, recordings one after another [min]'\nset ylabel 'mean power per window [W]'\nplot " + dat +
@@ -97,15 +105,9 @@ std::vector<std::string> write_diagnosis_report(const std::string& dir, const Di
       {"cumulative.svg", "Cumulative residual (measured minus model) over time",
        "set xlabel 'time, recordings one after another [min]'\nset ylabel 'cumulative residual energy [kJ]'\nplot " + dat +
            " u 1:6 w l lw 2 t 'before (calibrated)', " + dat + " u 1:7 w l lw 2 t '" + after + "'\n"},
-      {"residual_speed.svg", "Window residual against mean speed",
-       "set xlabel 'mean speed in the window [km/h]'\nset ylabel 'residual mean power [W]'\nplot " + dat +
-           " u 8:11 w p pt 7 ps 0.6 t 'before', " + dat + " u 8:12 w p pt 6 ps 0.6 t '" + after + "', 0 w l lc 'black' notitle\n"},
-      {"residual_accel.svg", "Window residual against mean positive acceleration",
-       "set xlabel 'mean of max(0, a) in the window [m/s^2]'\nset ylabel 'residual mean power [W]'\nplot " + dat +
-           " u 9:11 w p pt 7 ps 0.6 t 'before', " + dat + " u 9:12 w p pt 6 ps 0.6 t '" + after + "', 0 w l lc 'black' notitle\n"},
-      {"residual_time.svg", "Window residual against time since the start of its recording",
-       "set xlabel 'time since the start of the recording [min]'\nset ylabel 'residual mean power [W]'\nplot " + dat +
-           " u 10:11 w p pt 7 ps 0.6 t 'before', " + dat + " u 10:12 w p pt 6 ps 0.6 t '" + after + "', 0 w l lc 'black' notitle\n"},
+      residual_against("residual_speed.svg", "mean speed", "mean speed in the window [km/h]", 8),
+      residual_against("residual_accel.svg", "mean positive acceleration", "mean of max(0, a) in the window [m/s^2]", 9),
+      residual_against("residual_time.svg", "time since the start of its recording", "time since the start of the recording [min]", 10),
   };
   std::vector<std::string> svgs;
   for (const auto& f : figs) {
