@@ -4,6 +4,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "rollsim/common/atomic_file.hpp"
 #include "rollsim/report/table.hpp"
 #include "rollsim/selection/common.hpp"
 #include "rollsim/selection/regress.hpp"
@@ -21,6 +22,7 @@ std::string signed_pct(double v) { return (v > 0 ? "+" : "") + report::fixed(v, 
 
 int run_regress(const RegressOptionsText& o) {
   const selection::Baseline b = selection::load_baseline(o.file);
+  if (o.update) check_output_file(o.file, "--update");
   const auto outcomes = selection::run_baseline(b);
   report::TextTable t({"case", "vehicle", "tyre", "cycle", "expected", "actual", "unit", "drift [%]", "tol [%]", "status"});
   for (std::size_t c : {0u, 1u, 2u, 3u, 6u, 9u}) t.set_left_aligned(c);
@@ -33,7 +35,7 @@ int run_regress(const RegressOptionsText& o) {
   }
   std::cout << t.render();
   if (o.update) {
-    selection::write_file_atomically(o.file, selection::baseline_yaml(b, outcomes), "--update");
+    write_files_atomically({{o.file, "--update", selection::baseline_yaml(b, outcomes)}});
     std::size_t changed = 0;
     for (const auto& r : outcomes) {
       if (r.actual != r.c.expected) {

@@ -41,6 +41,7 @@ void run_simulate(const SimulateOptions& o) {
   for (const auto& c : o.cycles.empty() ? std::vector<std::string>{"nedc"} : o.cycles) cycles.push_back(load_cycle(c));
   if (!o.trace_path.empty() && tyre_sets.size() * cycles.size() > 1)
     throw InputError("--trace", "writes the time series of one run; give one --tyre and one --cycle with it");
+  if (!o.trace_path.empty()) check_output_file(o.trace_path, "--trace");
 
   SimulationOptions sim_opt;
   sim_opt.record_trace = !o.trace_path.empty();
