@@ -3,6 +3,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
@@ -32,6 +33,9 @@ class Progress {
   void operator()(std::size_t done, std::size_t total) {
     if (!on_) return;
     std::lock_guard<std::mutex> lock(m_);
+    // At most one line per per-mille: a million-point tyre sweep must not spend its time printing.
+    const std::size_t step = std::max<std::size_t>(1, total / 1000);
+    if (done % step != 0 && done != total) return;
     std::fprintf(stderr, "\r%zu/%zu points", done, total);
     if (done == total) std::fprintf(stderr, "\n");
     std::fflush(stderr);

@@ -86,18 +86,33 @@ TyreSpec with_parameter(const TyreSpec& tyre, SweepParam p, double value) {
 
 namespace {
 
-std::vector<std::vector<double>> grid(const std::vector<SweepAxis>& axes) {
+// The grid's points in output order (first axis outer, last axis fastest), checked against the limit before
+// anything is allocated: a grid is the product of its axes' steps, and 10^6 x 10^6 would not fit in memory.
+std::vector<std::vector<double>> grid(const std::vector<SweepAxis>& axes, std::size_t max_points, const char* what) {
+  std::size_t n = 1;
+  std::string sizes;
+  for (const auto& a : axes) {
+    const auto steps = static_cast<std::size_t>(std::max(a.steps, 1));
+    n = n > max_points / steps ? max_points + 1 : n * steps;
+    sizes += (sizes.empty() ? "" : " x ") + std::to_string(a.steps);
+  }
+  if (n > max_points) {
+    throw InputError("--steps", sizes + " points is more than the " + std::to_string(max_points) + " allowed for " + what +
+                                    "; use fewer --steps or a narrower --from/--to");
+  }
   std::vector<std::vector<double>> pts{{}};
   for (const auto& a : axes) {
     std::vector<std::vector<double>> next;
+    next.reserve(pts.size() * static_cast<std::size_t>(a.steps));
+    const auto values = a.values();
     for (const auto& p : pts) {
-      for (double v : a.values()) {
+      for (double v : values) {
         auto q = p;
         q.push_back(v);
-        next.push_back(q);
+        next.push_back(std::move(q));
       }
     }
-    pts = next;
+    pts = std::move(next);
   }
   return pts;
 }
@@ -170,8 +185,9 @@ SweepResult sweep_tyre(const TyreSpec& tyre, const SweepOptions& o) {
   check_options(tyre, o);
   SweepResult r;
   r.axes = o.axes;
-  const auto pts = grid(o.axes);
+  const auto pts = grid(o.axes, kMaxTyreSweepPoints, "a tyre sweep");
   r.planned_points = pts.size();
+  r.points.reserve(pts.size());
   for (const auto& values : pts) {
     const PointSetup s = setup(tyre, o, values);
     try {
@@ -204,7 +220,7 @@ SweepResult sweep_vehicle(const Vehicle& vehicle, const TyreSpec& tyre, const Dr
   r.axes = o.axes;
   r.vehicle = true;
   r.energy_unit = energy_unit(vehicle);
-  const auto pts = grid(o.axes);
+  const auto pts = grid(o.axes, kMaxVehicleSweepPoints, "a sweep with a car (one simulation per point)");
   r.planned_points = pts.size();
 
   struct Slot {
