@@ -104,6 +104,12 @@ TEST_F(Hardening, ErrorsDeepInParsingNameFileAndPlace) {
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_TRUE(has(r.err, dir_.string() + ": is a folder")) << r.err;
 
+  // Found by fuzz_tyre in the duplicate-key walk: an alias inside its own anchor is an endless tree.
+  const std::string loop = write("loop.yaml", "a: &x [1, *x, *x]\nsize: \"175/70 R14 84T\"\n");
+  r = run_rollsim("tyre '" + loop + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, loop + ": line 1: nested more than 64 levels")) << r.err;
+
   // A list item's key is written item.key.
   const std::string neg = write("neg.yaml", "cases:\n  - {name: a, vehicle: ev, tyre: nominal, cycle: nedc, unit: kwh_per_10km, "
                                              "expected: -1, tolerance_pct: 1}\n");
@@ -118,6 +124,9 @@ TEST_F(Hardening, MessagesSayWhatIsWrong) {
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_TRUE(has(r.err, "is a folder")) << r.err;
   r = run_rollsim("simulate --vehicle ev --tyre '" + dir_.string() + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, "is a folder")) << r.err;
+  r = run_rollsim("simulate --vehicle ev --cycle '" + dir_.string() + "'");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_TRUE(has(r.err, "is a folder")) << r.err;
 
