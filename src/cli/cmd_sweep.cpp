@@ -77,7 +77,7 @@ std::string render_plot(const selection::SweepResult& r, const std::string& tyre
   }
   data.close();
   const auto& a0 = r.axes[0];
-  std::string load_text = report::fixed(r.points.front().load_n, 0) + " N";
+  std::string load_text = fixed(r.points.front().load_n, 0) + " N";
   std::string title = "RRC of " + tyre_name;
   if (a0.param != selection::SweepParam::Load && a0.param != selection::SweepParam::LoadPct &&
       (r.axes.size() < 2 || (r.axes[1].param != selection::SweepParam::Load &&
@@ -85,7 +85,7 @@ std::string render_plot(const selection::SweepResult& r, const std::string& tyre
     title += " at " + load_text;
   }
   if (a0.param != selection::SweepParam::Speed && (r.axes.size() < 2 || r.axes[1].param != selection::SweepParam::Speed)) {
-    title += ", " + report::fixed(r.points.front().speed_kmh, 0) + " km/h";
+    title += ", " + fixed(r.points.front().speed_kmh, 0) + " km/h";
   }
   const fs::path figure = work / ("figure" + ext);
   std::ofstream gp(work / "plot.gp");
@@ -174,7 +174,7 @@ void run_sweep(const SweepOptionsText& o) {
   if (o.json) {
     std::ostringstream out;
     for (const auto& p : r.points) {
-      report::JsonObject j;
+      JsonObject j;
       for (std::size_t i = 0; i < r.axes.size(); ++i) {
         j.add(selection::sweep_param_key(r.axes[i].param) + "_" + selection::sweep_param_unit(r.axes[i].param), p.values[i]);
       }

@@ -22,7 +22,7 @@ inline double parse_option_number(const std::string& text, const std::string& op
   if (text.empty() || end != text.c_str() + text.size()) {
     throw InputError(option, "'" + text + "' is not a number; " + range.describe());
   }
-  if (!range.contains(v)) throw InputError(option, format_value(v) + " is not allowed: " + range.describe());
+  if (!range.contains(v)) throw InputError(option, format_value(v) + " is not allowed: " + range.describe_for(v));
   return v;
 }
 
