@@ -1,4 +1,5 @@
 // Diagnosis report: per-window data to gnuplot (SVG), and one HTML page with the SVGs inline.
+#include "rollsim/common/units.hpp"
 #include "rollsim/diagnose/report.hpp"
 
 #include <unistd.h>
@@ -79,7 +80,7 @@ std::vector<OutputFile> render_diagnosis_report(const std::string& dir, const Di
       cum_after += (w.measured_j - w.fitted_j) / 1e3;
       data << (offset_s + 0.5 * (w.start_s + w.end_s)) / 60.0 << " " << w.measured_j / dur << " " << w.simulated_j / dur << " "
            << w.calibrated_j / dur << " " << w.fitted_j / dur << " " << cum_before << " " << cum_after << " "
-           << 3.6 * w.mean_speed_mps << " " << w.mean_positive_accel_mps2 << " " << 0.5 * (w.start_s + w.end_s) / 60.0 << " "
+           << units::mps_to_kmh(w.mean_speed_mps) << " " << w.mean_positive_accel_mps2 << " " << 0.5 * (w.start_s + w.end_s) / 60.0 << " "
            << (w.measured_j - w.calibrated_j) / dur << " " << (w.measured_j - w.fitted_j) / dur << "\n";
     }
   }
