@@ -28,8 +28,7 @@ TEST(EnergyBalance, ClosesToOneIn1e4OnEveryShippedCycleForBothCars) {
       const auto r = simulate_forward(m, load_cycle(cycle));
       SCOPED_TRACE(std::string(vehicle) + " " + cycle);
       EXPECT_LT(std::abs(r.energy.wheel_residual_j()) / r.energy.traction_j, 1e-4);
-      const double source_j = r.electric ? r.energy.battery_terminal_j : r.energy.fuel_j;
-      EXPECT_LT(std::abs(r.energy.powertrain_residual_j(r.electric)) / source_j, 1e-9);
+      EXPECT_LT(std::abs(r.energy.powertrain_residual_j()) / r.source_energy_j(), 1e-9);
     }
   }
 }
@@ -53,7 +52,7 @@ TEST(EnergyBalance, WorkingToleranceConvergesToATightReference) {
       const auto work = simulate_forward(m, c);
       const auto coarse = simulate_forward(m, c, loose);
       SCOPED_TRACE(std::string(vehicle) + " " + cycle);
-      const double scale_j = ref.electric ? ref.energy.battery_terminal_j : ref.energy.fuel_j;
+      const double scale_j = ref.source_energy_j();
       auto terms = [](const SimulationResult& r) {
         const auto& e = r.energy;
         return std::vector<double>{e.traction_j, e.rolling_j, e.aero_j, e.friction_brake_j, e.regen_wheel_j,

@@ -125,8 +125,9 @@ class WeakBrakes final : public Powertrain {
   double max_wheel_force_n(int g, double v, double r) const override { return inner_->max_wheel_force_n(g, v, r); }
   std::vector<double> shift_speeds_mps(int g) const override { return inner_->shift_speeds_mps(g); }
   std::vector<double> regime_speeds_mps() const override { return inner_->regime_speeds_mps(); }
-  double usable_battery_energy_j() const override { return inner_->usable_battery_energy_j(); }
-  bool is_electric() const override { return inner_->is_electric(); }
+  const BatteryParams* battery() const override { return inner_->battery(); }
+  const FuelParams* fuel() const override { return inner_->fuel(); }
+  void add_electric_load(double power_w, PowerFlow& flow) const override { inner_->add_electric_load(power_w, flow); }
 
  private:
   std::shared_ptr<const Powertrain> inner_;
@@ -169,7 +170,7 @@ TEST(BatteryDepletion, TwentyFourHoursOfNedcRunTheBatteryEmptyWhereTheEnergySays
   const auto one = simulate_forward(m, load_cycle("nedc"));
   EXPECT_FALSE(one.battery_empty);
   const double lap_j = one.energy.battery_terminal_j + one.energy.battery_loss_j;
-  const double charge_j = one.initial_soc * one.usable_battery_j;
+  const double charge_j = one.battery->initial_soc * one.battery->usable_j;
   const int laps = static_cast<int>(24 * 3600 / 1180);
   const auto forward = simulate_forward(m, repeated_nedc(laps));
   const auto replay = simulate_replay(m, repeated_nedc(laps));
@@ -179,7 +180,7 @@ TEST(BatteryDepletion, TwentyFourHoursOfNedcRunTheBatteryEmptyWhereTheEnergySays
     const double whole_laps = std::floor(charge_j / lap_j);
     EXPECT_GE(r->battery_empty->time_s, whole_laps * 1180.0);
     EXPECT_LE(r->battery_empty->time_s, (whole_laps + 1.0) * 1180.0);
-    EXPECT_LT(r->final_soc, 0.0);
+    EXPECT_LT(r->battery->final_soc, 0.0);
     // The distance at that time is the trace's own distance up to it.
     DriveCycle upto = repeated_nedc(laps);
     double d = 0.0;

@@ -127,6 +127,11 @@ PowerFlow ElectricPowertrain::deliver(double wheel_force_n, double speed_mps, in
   return out;
 }
 
+void ElectricPowertrain::add_electric_load(double power_w, PowerFlow& flow) const {
+  flow.aux_power_w += power_w;
+  flow.battery_terminal_power_w += power_w;
+}
+
 std::vector<double> ElectricPowertrain::regime_speeds_mps() const {
   std::vector<double> s;
   if (p_.regen.min_speed_mps > 0.0) s.push_back(p_.regen.min_speed_mps);

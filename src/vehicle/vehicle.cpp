@@ -214,6 +214,7 @@ Vehicle load_vehicle_file(const std::string& path) {
   // A vehicle may name its logger's columns; the recording module reads these blocks (rollsim diagnose).
   root.accept("recording_columns");
   root.accept("recording_scale");
+  root.accept("calibration_priors");  // read by the diagnosis (calibration_priors_from_yaml)
   root.finish();
 
   check_tyre_loads(v, path);

@@ -33,13 +33,6 @@ struct ReductionParams {
   double efficiency = 1.0;   ///< (0, 1], both directions
 };
 
-struct BatteryParams {
-  double open_circuit_voltage_v = 0.0;
-  double internal_resistance_ohm = 0.0;
-  double usable_capacity_j = 0.0;
-  double initial_soc = 1.0;  ///< fraction of usable capacity at the start
-};
-
 /// Regenerative braking and its blending with the friction brakes.
 struct RegenParams {
   double max_power_w = 0.0;            ///< electrical power the battery/inverter accept while braking
@@ -66,8 +59,10 @@ class ElectricPowertrain final : public Powertrain {
   std::vector<double> shift_speeds_mps(int) const override { return {}; }
   std::vector<double> regime_speeds_mps() const override;
   double max_wheel_force_n(int gear, double speed_mps, double wheel_radius_m) const override;
-  double usable_battery_energy_j() const override { return p_.battery.usable_capacity_j; }
-  bool is_electric() const override { return true; }
+  const BatteryParams* battery() const override { return &p_.battery; }
+  /// From the battery terminals (its own I^2 R for the extra current is neglected: under 1 % of the load at
+  /// these currents).
+  void add_electric_load(double power_w, PowerFlow& flow) const override;
   const ElectricPowertrainParams& params() const { return p_; }
 
   /// Battery current [A] (+ discharging) for a terminal power [W]; throws ModelDomainError when the battery
