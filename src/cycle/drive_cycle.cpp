@@ -110,6 +110,7 @@ DriveCycle load_cycle(const std::string& name_or_path, const std::string& option
     return read_cycle_csv(resolve_data_file(key, "cycles", ".csv", option), key);
   }
   namespace fs = std::filesystem;
+  if (fs::is_directory(name_or_path)) throw InputError(option + " '" + name_or_path + "'", "is a folder; a file is expected here");
   if (!fs::is_regular_file(name_or_path)) {
     std::string list;
     for (std::size_t i = 0; i < names.size(); ++i) list += (i ? ", " : "") + names[i];

@@ -112,11 +112,11 @@ std::string summary_text(const SimulationResult& r, bool solver_stats) {
   };
   o << "  energy balance closes to " << closure(e.wheel_residual_j(), e.traction_j) << " at the wheels and "
     << closure(e.powertrain_residual_j(), source_j) << " in the powertrain\n";
-  o << "  speed tracking: max error " << fixed(r.max_speed_error_mps * 3.6, 2) << " km/h at t = "
+  o << "  speed tracking: max error " << fixed(units::mps_to_kmh(r.max_speed_error_mps), 2) << " km/h at t = "
     << fixed(r.max_speed_error_time_s, 1) << " s\n";
   for (const auto& s : r.shortfalls) {
     o << "  WARNING: the car could not follow the trace from t = " << fixed(s.start_s, 0) << " to " << fixed(s.end_s, 0)
-      << " s" << (s.max_deficit_mps > 0.0 ? ", falling behind by up to " + fixed(s.max_deficit_mps * 3.6, 1) +
+      << " s" << (s.max_deficit_mps > 0.0 ? ", falling behind by up to " + fixed(units::mps_to_kmh(s.max_deficit_mps), 1) +
                                                 " km/h at t = " + fixed(s.at_s, 0) + " s"
                                           : " (powertrain at its limit)")
       << "\n";
@@ -175,7 +175,7 @@ JsonObject to_json(const SimulationResult& r, const std::string& tyre_label) {
     j.add_null("energy_balance_residual_pct");
   }
   j.add("energy_balance_residual_j", r.energy.wheel_residual_j());
-  j.add("max_speed_error_kmh", r.max_speed_error_mps * 3.6);
+  j.add("max_speed_error_kmh", units::mps_to_kmh(r.max_speed_error_mps));
   j.add("shortfalls", static_cast<int>(r.shortfalls.size()));
   if (r.mode == "forward") {
     JsonObject s;
@@ -193,10 +193,10 @@ void write_trace_csv(std::ostream& out, const SimulationResult& r) {
          "wheel_force_n,traction_power_kw,battery_power_kw,battery_current_a,fuel_rate_lph,tyre_rrc,soc_pct\n";
   out.precision(8);
   for (const auto& p : r.trace) {
-    out << p.time_s << ',' << p.target_speed_mps * 3.6 << ',' << p.speed_mps * 3.6 << ',' << p.accel_mps2 << ','
+    out << p.time_s << ',' << units::mps_to_kmh(p.target_speed_mps) << ',' << units::mps_to_kmh(p.speed_mps) << ',' << p.accel_mps2 << ','
         << p.grade * 100.0 << ',' << p.gear << ',' << p.rolling_force_n << ',' << p.aero_force_n << ','
         << p.grade_force_n << ',' << p.wheel_force_n << ',' << p.traction_power_w / 1e3 << ','
-        << p.battery_power_w / 1e3 << ',' << p.battery_current_a << ',' << p.fuel_rate_m3_per_s * 3.6e6 << ','
+        << p.battery_power_w / 1e3 << ',' << p.battery_current_a << ',' << p.fuel_rate_m3_per_s / units::kM3PerLitre * 3600.0 << ','
         << p.rrc << ',' << p.soc * 100.0 << '\n';
   }
 }
