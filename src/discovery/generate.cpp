@@ -229,7 +229,7 @@ std::vector<double> oil_coolant_fuel_power_w(const SimulationResult& r, double f
   std::vector<double> p(r.trace.size());
   for (std::size_t i = 0; i < r.trace.size(); ++i) {
     const double rise = oil_k < kRefK ? (std::exp(kViscosityPerK * (kRefK - oil_k)) - 1.0) / norm : 0.0;
-    p[i] = r.trace[i].fuel_rate_m3_per_s * fuel_j_per_m3 * (1.0 + cold_excess * rise);
+    p[i] = r.trace[i].segment_fuel_rate_m3_per_s * fuel_j_per_m3 * (1.0 + cold_excess * rise);
     if (i + 1 == r.trace.size()) break;
     const double dt = r.trace[i + 1].time_s - r.trace[i].time_s;
     const double loss_w = std::max(0.0, p[i] - std::max(0.0, r.trace[i].traction_power_w));
@@ -253,7 +253,7 @@ std::vector<double> soc_with_resistance(const SimulationResult& r, const Battery
     soc[i] = x;
     if (i + 1 == r.trace.size()) break;
     const double dt = r.trace[i + 1].time_s - r.trace[i].time_s;
-    const double p = r.trace[i].battery_power_w;
+    const double p = r.trace[i].segment_battery_power_w;
     const double ocv = b.open_circuit_voltage_v * (0.92 + 0.16 * std::clamp(x, 0.0, 1.0));
     const double ohm = b.internal_resistance_ohm + extra_ohm * (1.0 + 2.0 * std::pow(1.0 - std::clamp(x, 0.0, 1.0), 2));
     // Discharge root of R I^2 - OCV I + P = 0 (the smaller current); beyond the maximum power, the peak current.
@@ -477,7 +477,7 @@ Recording generate_case(const Vehicle& vehicle, const SyntheticCase& o) {
   std::normal_distribution<double> noise(0.0, o.noise_w);
   std::vector<double> p(n);
   for (std::size_t i = 0; i < n; ++i) {
-    const double truth = r.trace[i >= lag ? i - lag : 0].battery_power_w * scale + noise(rng);
+    const double truth = r.trace[i >= lag ? i - lag : 0].segment_battery_power_w * scale + noise(rng);
     p[i] = o.quantum_w > 0.0 ? o.quantum_w * std::round(truth / o.quantum_w) : truth;
   }
   rec.battery_power_w = p;
