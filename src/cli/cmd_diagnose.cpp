@@ -13,6 +13,7 @@
 #include "rollsim/diagnose/report.hpp"
 #include "rollsim/recording/recording.hpp"
 #include "rollsim/tyre/tyre_spec.hpp"
+#include "rollsim/vehicle/vehicle_file.hpp"
 
 namespace rollsim::cli {
 namespace {
@@ -26,7 +27,8 @@ struct DiagnoseCliOptions {
 void run_diagnose(const DiagnoseCliOptions& o) {
   const std::string vehicle_path = resolve_data_file(o.vehicle, "vehicles", ".yaml", "--vehicle");
   Vehicle v = load_vehicle_file(vehicle_path);
-  if (!o.tyre.empty()) fit_tyres(v, load_tyre_file(resolve_data_file(o.tyre, "tyres", ".yaml", "--tyre")));
+  const std::string tyre_path = o.tyre.empty() ? "" : resolve_data_file(o.tyre, "tyres", ".yaml", "--tyre");
+  if (!o.tyre.empty()) fit_tyres(v, load_tyre_file(tyre_path));
   if (!o.report.empty()) check_report_dir(o.report);  // fail before the diagnosis, not after it
   // Column mapping: a preset, then the vehicle file's own logger mapping, then the command line's options.
   ColumnMapping mapping;
@@ -42,7 +44,7 @@ void run_diagnose(const DiagnoseCliOptions& o) {
   std::vector<Recording> recs;
   for (const auto& r : o.recordings) recs.push_back(load_recording(r, mapping));
   for (const auto& r : recs)
-    for (const auto& rep : r.repairs) std::cout << r.source << ": " << rep << "\n";
+    for (const auto& rep : r.repairs) (rep.rfind("warning:", 0) == 0 ? std::cerr : std::cout) << r.source << ": " << rep << "\n";
   DiagnoseOptions dopt;
   if (o.window_s > 0.0) dopt.window_s = o.window_s;
   const Diagnosis d = diagnose(v, recs, dopt);
@@ -53,7 +55,9 @@ void run_diagnose(const DiagnoseCliOptions& o) {
     std::cout << "report written to " << o.report << " (" << files.size() << " files, report.html)\n";
   }
   if (!o.write_vehicle.empty()) {
-    write_file_atomically(o.write_vehicle, "--write-vehicle", [&](std::ostream& os) { os << fitted_vehicle_yaml(vehicle_path, d); });
+    // The files it names resolved (and the --tyre used), so it loads from the folder it is written to.
+    const std::string text = portable_vehicle_yaml(fitted_vehicle_yaml(vehicle_path, d), vehicle_path, tyre_path);
+    write_file_atomically(o.write_vehicle, "--write-vehicle", [&](std::ostream& os) { os << text; });
     std::cout << "fitted vehicle written to " << o.write_vehicle << "\n";
   }
 }
@@ -67,7 +71,8 @@ void register_diagnose_command(CLI::App& app) {
   sub->add_option("--tyre", o->tyre, "Tyre YAML fitted to all four wheels")->type_name("FILE");
   sub->add_option("--recording", o->recordings, "Recording CSV (repeatable)")->required()->type_name("CSV");
   sub->add_option("--preset", o->preset, "Column mapping preset: anl_d3, rsk_twizy")->type_name("NAME");
-  sub->add_option("--column", o->columns, "CANONICAL=SOURCE column mapping (repeatable)")->type_name("C=S");
+  sub->add_option("--column", o->columns, "CANONICAL=SOURCE column mapping (repeatable); CANONICAL= drops a column")
+      ->type_name("C=S");
   sub->add_option("--scale", o->scales, "CANONICAL=FACTOR scale (repeatable)")->type_name("C=F");
   sub->add_option("--json", o->json, "Write the diagnosis as JSON")->type_name("FILE");
   sub->add_option("--window-s", o->window_s, "Energy window length [s] (default 60; SOC channels lengthen it by the quantum)")
