@@ -461,7 +461,7 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
     if (!r.grade && r.elevation_m) {
       const ElevationGrade eg = grade_from_elevation(r.time_s, r.speed_mps, *r.elevation_m);
       out.notes.push_back(r.source + ": grade from recorded elevation (" + std::to_string(eg.rejected_steps) +
-                          " elevation steps rejected as glitches, filtered over 200 m)");
+                          " elevation steps rejected as glitches, Savitzky-Golay slope over 300 m)");
     }
   }
   // SOC: lengthen the windows until the quantisation error is small against a window's energy.
