@@ -271,6 +271,9 @@ TracePoint trace_point(const VehicleModel& m, double t, double target_mps, doubl
   p.battery_current_a = s.flow.battery_current_a;
   p.battery_loss_w = s.flow.battery_loss_w;
   p.fuel_rate_m3_per_s = s.flow.fuel_rate_m3_per_s;
+  p.segment_battery_power_w = p.battery_power_w;
+  p.segment_battery_loss_w = p.battery_loss_w;
+  p.segment_fuel_rate_m3_per_s = p.fuel_rate_m3_per_s;
   const double normal_n = m.mass_kg * units::kStandardGravity_mps2 / std::sqrt(1.0 + grade * grade);
   p.rrc = s.rolling_n / normal_n;
   p.soc = soc;
@@ -801,6 +804,7 @@ SimulationResult simulate_replay(const VehicleModel& m, const DriveCycle& c, con
     const RoadLoadCoeffs& rl = loads[i];
     bool segment_limited = false;
     double soc_before_ramp = 0.0;
+    std::array<double, kAccumulators> segment_energy_j{};  // a ramp's integral (for the trace)
     if (opt.record_trace) {
       const int g = gear;
       evaluate_at(t0, v0, a, grade, rl, distance_m);
@@ -833,6 +837,7 @@ SimulationResult simulate_replay(const VehicleModel& m, const DriveCycle& c, con
       const SegmentKey key{v0, c.speed_mps[i + 1], dt, grade, scheduled_gear};
       if (const SegmentEnergy* hit = stateless ? seen.find(key) : nullptr) {
         for (int j = 0; j < kAccumulators; ++j) acc[j] += hit->energy_j[j];
+        segment_energy_j = hit->energy_j;
         segment_limited = hit->limited;
         scheduled_gear = hit->scheduled_gear_after;
       } else {
@@ -846,6 +851,7 @@ SimulationResult simulate_replay(const VehicleModel& m, const DriveCycle& c, con
           for (int j = 0; j < eval.effect_states; ++j) xdot_sum[j] += kWeight[k] * xdot[j];
         }
         for (int j = 0; j < kAccumulators; ++j) acc[j] += e.energy_j[j];
+        segment_energy_j = e.energy_j;
         if (stateless) {
           e.limited = segment_limited;
           e.scheduled_gear_after = scheduled_gear;
@@ -854,6 +860,14 @@ SimulationResult simulate_replay(const VehicleModel& m, const DriveCycle& c, con
       }
     }
     if (a != 0.0) watch_battery(soc_before_ramp, t0, t0 + dt, distance_m, distance_m + (v0 + c.speed_mps[i + 1]) / 2.0 * dt);
+    if (opt.record_trace) {
+      // The segment's integrated powers (a cruise is evaluated per segment when recording, so `rate` is its own).
+      const auto seg = [&](int j) { return a == 0.0 ? cruise_rate[j] : segment_energy_j[j] / dt; };
+      TracePoint& p = r.trace.back();
+      p.segment_battery_power_w = seg(kTerminal);
+      p.segment_battery_loss_w = seg(kBatteryLoss);
+      p.segment_fuel_rate_m3_per_s = seg(kFuelVolume);
+    }
     // Hidden effect states advance with the segment-mean rate (time constants are minutes, segments seconds).
     for (int j = 0; j < eval.effect_states; ++j) x[j] += dt * xdot_sum[j];
     distance_m += (v0 + c.speed_mps[i + 1]) / 2.0 * dt;

@@ -9,6 +9,7 @@
 #include "rollsim/common/units.hpp"
 #include "rollsim/common/yaml_reader.hpp"
 #include "rollsim/tyre/tyre_model.hpp"
+#include "rollsim/vehicle/vehicle_file.hpp"
 
 namespace rollsim {
 namespace {
@@ -17,16 +18,7 @@ constexpr double kRadPerSPerRpm = 2.0 * std::numbers::pi / 60.0;
 
 // A tyre named in a vehicle file: relative to the vehicle file first, then the shipped tyres/ folder.
 TyreSpec load_tyre_named(const std::string& name, const YamlMap& m, const std::string& key) {
-  namespace fs = std::filesystem;
-  const fs::path beside = fs::path(m.file()).parent_path() / name;
-  for (const fs::path& p : {beside, fs::path(beside.string() + ".yaml")}) {
-    if (fs::is_regular_file(p)) return load_tyre_file(p.string());
-  }
-  try {
-    return load_tyre_file(resolve_data_file(name, "tyres", ".yaml", m.where(key)));
-  } catch (const InputError&) {
-    throw InputError(m.where(key), "tyre file '" + name + "' not found beside the vehicle file or in the shipped tyres/");
-  }
+  return load_tyre_file(resolve_tyre_path(name, m.file(), m.where(key)));
 }
 
 BodyParams read_body(YamlMap m) {

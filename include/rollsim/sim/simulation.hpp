@@ -96,6 +96,10 @@ struct TracePoint {
   double rolling_force_n, aero_force_n, grade_force_n, wheel_force_n;
   double traction_power_w, battery_power_w, battery_current_a, fuel_rate_m3_per_s;
   double battery_loss_w;  ///< inside the cells (I^2 R and effects'); a state of charge sees terminal + this
+  /// Means over the segment from this sample to the next, as the run integrates them (replay: the segment's
+  /// quadrature / its length; forward and the last sample: the point values). A channel summed as mean x dt over
+  /// the trace adds up to the run's energy totals; the point values, a left-end rule, do not.
+  double segment_battery_power_w, segment_battery_loss_w, segment_fuel_rate_m3_per_s;
   double rrc;  ///< rolling force / total normal load
   double soc;  ///< state of charge, fraction (electric)
   int gear;
