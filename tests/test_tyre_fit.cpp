@@ -261,6 +261,10 @@ TEST(CliTyreFit, OnePointFileIsANormalTyreFileThatReproducesThePoint) {
   ASSERT_EQ(t.exit_code, 0) << t.err;
   EXPECT_NEAR(json_number(t.out, "rrc"), 0.0085, 0.0085 * 1e-7);
   EXPECT_TRUE(has(t.out, "\"model\": \"hysteresis\""));
+  // The thesis' mechanisms do not describe this model: --explain says so instead of printing them.
+  const CmdResult x = rollsim::test::run_rollsim("tyre '" + out.string() + "' --explain");
+  EXPECT_EQ(x.exit_code, 2);
+  EXPECT_TRUE(has(x.err, "hysteresis model")) << x.err;
 }
 
 TEST(CliTyreFit, J2452SetAndLabelGiveFittedConstantsWithIntervals) {
