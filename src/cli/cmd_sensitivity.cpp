@@ -99,7 +99,7 @@ void run_sensitivity(const SensitivityOptionsText& o) {
   }
   std::cout << t.render();
   std::cout << "Matters most for RR power: " << s.dominant_power;
-  if (vehicle) std::cout << "; for the car's " << (vehicle->is_electric() ? "energy" : "fuel") << ": " << s.dominant_energy;
+  if (vehicle) std::cout << "; for the car's " << (s.energy_unit == "kwh_per_10km" ? "energy" : "fuel") << ": " << s.dominant_energy;
   std::cout << "\n";
   if (vehicle) {
     std::cout << "(car: load = test mass, all wheel loads scaled together; diameter also changes the gearing)\n";

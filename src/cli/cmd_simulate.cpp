@@ -91,7 +91,7 @@ void run_simulate(const SimulateOptions& o) {
   // Several runs: one table, each against the first run on the same cycle.
   const std::string unit = report::headline_unit(runs.front().result);
   report::TextTable t({"cycle", "tyre", unit, "diff %", "rolling kWh", "rolling diff %",
-                       runs.front().result.electric ? "range km" : "CO2 g/km", "max err km/h"});
+                       runs.front().result.fuel ? "CO2 g/km" : "range km", "max err km/h"});
   t.set_left_aligned(0);
   t.set_left_aligned(1);
   for (std::size_t i = 0; i < runs.size(); ++i) {
@@ -101,7 +101,7 @@ void run_simulate(const SimulateOptions& o) {
     t.add_row({r.cycle, runs[i].tyre_label, report::fixed(value, 3), report::fixed(100.0 * (value / ref_value - 1.0), 2),
                report::fixed(r.energy.rolling_j / 3.6e6, 4),
                report::fixed(100.0 * (r.energy.rolling_j / ref.energy.rolling_j - 1.0), 2),
-               r.electric ? report::fixed(r.range_km(), 1) : report::fixed(r.co2_g_per_km(), 1),
+               r.fuel ? report::fixed(r.co2_g_per_km(), 1) : report::fixed(r.range_km(), 1),
                report::fixed(r.max_speed_error_mps * 3.6, 2)});
   }
   std::cout << base.name << " (" << (o.replay ? "replay" : "forward") << " simulation)\n" << t.render();

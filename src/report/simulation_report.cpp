@@ -24,11 +24,12 @@ std::vector<std::pair<std::string, double>> energy_terms_kwh(const SimulationRes
       {"gearbox", k(e.gearbox_loss_j)},
       {"auxiliaries", k(e.aux_j)},
   };
-  if (r.electric) {
+  if (r.battery) {
     t.push_back({"motor", k(e.motor_loss_j)});
     t.push_back({"battery_internal", k(e.battery_loss_j)});
     t.push_back({"battery_terminals", k(e.battery_terminal_j)});
-  } else {
+  }
+  if (r.fuel) {
     t.push_back({"engine", k(e.engine_loss_j)});
     t.push_back({"clutch", k(e.clutch_loss_j)});
     t.push_back({"fuel", k(e.fuel_j)});
@@ -36,8 +37,9 @@ std::vector<std::pair<std::string, double>> energy_terms_kwh(const SimulationRes
   return t;
 }
 
-double headline_value(const SimulationResult& r) { return r.electric ? r.aec_kwh_per_10km() : r.fuel_l_per_100km(); }
-std::string headline_unit(const SimulationResult& r) { return r.electric ? "kWh/10 km" : "l/100 km"; }
+// A car that burns fuel is judged by its fuel (a hybrid's battery ends where it started); one without, by its battery.
+double headline_value(const SimulationResult& r) { return r.fuel ? r.fuel_l_per_100km() : r.aec_kwh_per_10km(); }
+std::string headline_unit(const SimulationResult& r) { return r.fuel ? "l/100 km" : "kWh/10 km"; }
 
 std::string summary_text(const SimulationResult& r, bool solver_stats) {
   std::ostringstream o;
@@ -46,17 +48,18 @@ std::string summary_text(const SimulationResult& r, bool solver_stats) {
   o << r.vehicle << " on " << r.cycle << " (" << r.mode << " simulation; road load: " << r.road_load << ")\n";
   o << "  distance " << fixed(km, 3) << " km in " << fixed(r.duration_s, 0) << " s, mean speed "
     << fixed(km / (r.duration_s / 3600.0), 1) << " km/h\n";
-  if (r.electric) {
+  if (r.battery) {
     o << "  energy at the battery terminals: " << fixed(r.aec_kwh_per_10km(), 3) << " kWh/10 km = "
       << fixed(r.aec_kwh_per_10km() * 10.0, 2) << " kWh/100 km = " << fixed(r.aec_kwh_per_10km() * 100.0, 1) << " Wh/km\n";
-    o << "  range on the usable battery (" << fixed(units::j_to_kwh(r.usable_battery_j), 1) << " kWh): "
-      << fixed(r.range_km(), 0) << " km; state of charge " << fixed(r.initial_soc * 100, 1) << " % -> "
-      << fixed(r.final_soc * 100, 1) << " %\n";
-  } else {
-    o << "  fuel: " << fixed(r.fuel_l_per_100km(), 3) << " l/100 km (" << fixed(r.fuel_volume_m3 * 1e3, 3)
+    o << "  range on the usable battery (" << fixed(units::j_to_kwh(r.battery->usable_j), 1) << " kWh): "
+      << fixed(r.range_km(), 0) << " km; state of charge " << fixed(r.battery->initial_soc * 100, 1) << " % -> "
+      << fixed(r.battery->final_soc * 100, 1) << " %\n";
+  }
+  if (r.fuel) {
+    o << "  fuel: " << fixed(r.fuel_l_per_100km(), 3) << " l/100 km (" << fixed(r.fuel->volume_m3 * 1e3, 3)
       << " l), CO2 " << fixed(r.co2_g_per_km(), 1) << " g/km\n";
   }
-  const double source_j = r.electric ? e.battery_terminal_j : e.fuel_j;
+  const double source_j = r.source_energy_j();
   TextTable t({"energy", "kWh", "share %"});
   t.set_left_aligned(0);
   auto row = [&](const std::string& name, double j, double of_j) {
@@ -68,18 +71,19 @@ std::string summary_text(const SimulationResult& r, bool solver_stats) {
   if (e.grade_j != 0.0) row("  grade (net climb)", e.grade_j, e.traction_j);
   if (e.other_resistance_j != 0.0) row("  other resistance (effects)", e.other_resistance_j, e.traction_j);
   row("  braking lost (friction)", e.friction_brake_j, e.traction_j);
-  if (r.electric) row("  regenerated at the wheels", e.regen_wheel_j, e.traction_j);
+  if (r.battery) row("  regenerated at the wheels", e.regen_wheel_j, e.traction_j);
   if (e.wheel_loss_j != 0.0) row("  tyre slip", e.wheel_loss_j, e.traction_j);
   row("  kinetic energy change", e.kinetic_change_j, e.traction_j);
   if (e.unmet_demand_j != 0.0) row("demanded beyond the powertrain (replay)", e.unmet_demand_j, e.traction_j);
-  if (r.electric) {
+  if (r.battery) {
     row("battery terminals (net)", e.battery_terminal_j, source_j);
     row("  traction - regenerated", e.traction_j - e.regen_wheel_j, source_j);
     row("  reduction gear", e.gearbox_loss_j, source_j);
     row("  motor and inverter", e.motor_loss_j, source_j);
     row("  auxiliaries", e.aux_j, source_j);
     row("battery internal loss (extra)", e.battery_loss_j, source_j);
-  } else {
+  }
+  if (r.fuel) {
     row("fuel (lower heating value)", e.fuel_j, source_j);
     row("  engine loss (heat, friction)", e.engine_loss_j, source_j);
     row("  traction", e.traction_j, source_j);
@@ -89,7 +93,7 @@ std::string summary_text(const SimulationResult& r, bool solver_stats) {
   }
   o << t.render();
   o << "  energy balance closes to " << fixed(100.0 * std::abs(e.wheel_residual_j()) / e.traction_j, 4)
-    << " % at the wheels and " << fixed(100.0 * std::abs(e.powertrain_residual_j(r.electric)) / std::abs(source_j), 4)
+    << " % at the wheels and " << fixed(100.0 * std::abs(e.powertrain_residual_j()) / std::abs(source_j), 4)
     << " % in the powertrain\n";
   o << "  speed tracking: max error " << fixed(r.max_speed_error_mps * 3.6, 2) << " km/h at t = "
     << fixed(r.max_speed_error_time_s, 1) << " s\n";
@@ -112,17 +116,20 @@ std::string summary_text(const SimulationResult& r, bool solver_stats) {
 JsonObject to_json(const SimulationResult& r, const std::string& tyre_label) {
   JsonObject j;
   j.add("vehicle", r.vehicle).add("tyre", tyre_label).add("road_load", r.road_load).add("cycle", r.cycle);
-  j.add("mode", r.mode).add("powertrain", r.electric ? "electric" : "combustion");
+  j.add("mode", r.mode).add("powertrain", r.battery && r.fuel ? "hybrid" : r.battery ? "electric" : "combustion");
   j.add("distance_km", r.distance_m / 1000.0).add("duration_s", r.duration_s);
-  if (r.electric) {
+  if (r.battery) {
     j.add("aec_kwh_per_10km", r.aec_kwh_per_10km()).add("aec_kwh_per_100km", r.aec_kwh_per_10km() * 10.0);
     j.add("aec_wh_per_km", r.aec_kwh_per_10km() * 100.0).add("range_km", r.range_km());
-    j.add("final_soc_pct", r.final_soc * 100.0);
-    j.add_null("fuel_l_per_100km");
-    j.add("co2_g_per_km", 0.0);
+    j.add("final_soc_pct", r.battery->final_soc * 100.0);
   } else {
     j.add_null("aec_kwh_per_10km");
+  }
+  if (r.fuel) {
     j.add("fuel_l_per_100km", r.fuel_l_per_100km()).add("co2_g_per_km", r.co2_g_per_km());
+  } else {
+    j.add_null("fuel_l_per_100km");
+    j.add("co2_g_per_km", 0.0);
   }
   JsonObject b;
   for (const auto& [k, v] : energy_terms_kwh(r)) b.add(k, v);

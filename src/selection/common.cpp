@@ -11,7 +11,7 @@
 
 namespace rollsim::selection {
 
-std::string energy_unit(const Vehicle& vehicle) { return vehicle.is_electric() ? "kwh_per_10km" : "l_per_100km"; }
+std::string energy_unit(const Vehicle& vehicle) { return make_powertrain(vehicle)->fuel() ? "l_per_100km" : "kwh_per_10km"; }
 
 std::string energy_unit_label(const std::string& unit) {
   return unit == "kwh_per_10km" ? "kWh/10 km" : unit == "l_per_100km" ? "l/100 km" : unit;
@@ -19,13 +19,13 @@ std::string energy_unit_label(const std::string& unit) {
 
 EnergyFigure energy_figure(const SimulationResult& r) {
   EnergyFigure f;
-  if (r.electric) {
+  if (r.fuel) {
+    f.value = r.fuel_l_per_100km();
+    f.unit = "l_per_100km";
+  } else {
     f.value = r.aec_kwh_per_10km();
     f.unit = "kwh_per_10km";
     f.range_km = r.range_km();
-  } else {
-    f.value = r.fuel_l_per_100km();
-    f.unit = "l_per_100km";
   }
   return f;
 }

@@ -90,8 +90,8 @@ Comparison compare_tyres(const Vehicle& vehicle, const std::vector<TyreSpec>& ca
   Comparison cmp;
   cmp.vehicle = vehicle.name;
   cmp.cycle = cycle.name;
-  cmp.electric = vehicle.is_electric();
   cmp.unit = energy_unit(vehicle);
+  cmp.shows_range = cmp.unit == "kwh_per_10km";
 
   CandidateResult own_result = evaluate(vehicle, own, own, cycle, o);
   if (!own_result.simulated) throw InputError(vehicle.source, "cannot run the car on its own tyre: " + own_result.error);

@@ -29,21 +29,24 @@ double EnergyBreakdown::wheel_residual_j() const {
                        wheel_loss_j + kinetic_change_j);
 }
 
-double EnergyBreakdown::powertrain_residual_j(bool electric) const {
-  if (electric) return battery_terminal_j - (traction_j - regen_wheel_j + gearbox_loss_j + motor_loss_j + aux_j);
-  return fuel_j - (engine_loss_j + traction_j + gearbox_loss_j + clutch_loss_j + aux_j);
+double EnergyBreakdown::powertrain_residual_j() const {
+  // Each source books only the flows it carries, so one sum holds for electric, combustion and hybrid cars.
+  return battery_terminal_j + fuel_j -
+         (traction_j - regen_wheel_j + gearbox_loss_j + motor_loss_j + engine_loss_j + clutch_loss_j + aux_j);
 }
+
+double SimulationResult::source_energy_j() const { return energy.battery_terminal_j + energy.fuel_j; }
 
 double SimulationResult::aec_kwh_per_10km() const {
   return units::j_to_kwh(energy.battery_terminal_j) / (distance_m / 10000.0);
 }
 double SimulationResult::fuel_l_per_100km() const {
-  return fuel_volume_m3 / units::kM3PerLitre / (distance_m / 100000.0);
+  return (fuel ? fuel->volume_m3 : 0.0) / units::kM3PerLitre / (distance_m / 100000.0);
 }
-double SimulationResult::co2_g_per_km() const { return co2_kg * 1e3 / (distance_m / 1000.0); }
+double SimulationResult::co2_g_per_km() const { return (fuel ? fuel->co2_kg : 0.0) * 1e3 / (distance_m / 1000.0); }
 double SimulationResult::range_km() const {
   const double per_m = (energy.battery_terminal_j + energy.battery_loss_j) / distance_m;
-  return per_m > 0.0 ? usable_battery_j / per_m / 1000.0 : 0.0;
+  return battery && per_m > 0.0 ? battery->usable_j / per_m / 1000.0 : 0.0;
 }
 
 namespace {
@@ -156,26 +159,9 @@ struct Evaluator {
     }
     double extra_electric_w = 0.0;
     for (std::size_t i = 0; i < m.effects.size(); ++i) extra_electric_w += m.effects[i]->extra_electric_power_w(in, x + effect_state_offset[i]);
-    if (extra_electric_w != 0.0) add_electric_load(extra_electric_w, out.flow);
+    if (extra_electric_w != 0.0) m.powertrain->add_electric_load(extra_electric_w, out.flow);
     // Effects' battery loss (extra internal resistance) drains the cells, not the terminals: SOC sees it.
     for (std::size_t i = 0; i < m.effects.size(); ++i) out.flow.battery_loss_w += m.effects[i]->battery_loss_w(in, out.flow.battery_terminal_power_w, x + effect_state_offset[i]);
-  }
-
-  // An extra electrical load: from the battery terminals (its own I^2 R is neglected: under 1 % of it at these
-  // currents), or from the alternator at the engine's marginal (Willans) efficiency, even in fuel cut-off.
-  void add_electric_load(double p_w, PowerFlow& flow) const {
-    flow.aux_power_w += p_w;
-    if (m.powertrain->is_electric()) {
-      flow.battery_terminal_power_w += p_w;
-      return;
-    }
-    if (const auto* c = dynamic_cast<const CombustionPowertrain*>(m.powertrain.get())) {
-      const auto& cp = c->params();
-      const double fuel_w = p_w / (cp.alternator_efficiency * cp.engine.indicated_efficiency);
-      flow.fuel_power_w += fuel_w;
-      flow.engine_loss_w += fuel_w - p_w;
-      flow.fuel_rate_m3_per_s += fuel_w / (cp.fuel.lower_heating_value_j_per_kg * cp.fuel.density_kg_per_m3);
-    }
   }
 };
 
@@ -205,7 +191,8 @@ void accumulate(const Instant& s, double speed_mps, double* d) {
 // The accumulators that can be non-zero for this car and trace; the others are zero by construction, and every
 // quadrature costs vector arithmetic in each CVODES step.
 std::vector<int> active_accumulators_for(const VehicleModel& m, const DriveCycle& c, bool unmet_demand) {
-  const bool electric = m.powertrain->is_electric();
+  const bool battery = m.powertrain->battery() != nullptr;
+  const bool fuel = m.powertrain->fuel() != nullptr;
   const bool graded = std::any_of(c.grade.begin(), c.grade.end(), [](double g) { return g != 0.0; });
   const bool effects = !m.effects.empty();
   std::vector<int> active;
@@ -213,8 +200,8 @@ std::vector<int> active_accumulators_for(const VehicleModel& m, const DriveCycle
     const bool needed = k == kGrade                              ? graded
                         : (k == kOther || k == kWheelLoss)       ? effects
                         : k == kUnmet                            ? unmet_demand
-                        : (k == kRegen || k == kMotor || k == kBatteryLoss || k == kTerminal) ? electric
-                        : (k == kFuelEnergy || k == kEngineLoss || k == kClutch || k == kFuelVolume) ? !electric || effects
+                        : (k == kRegen || k == kMotor || k == kBatteryLoss || k == kTerminal) ? battery
+                        : (k == kFuelEnergy || k == kEngineLoss || k == kClutch || k == kFuelVolume) ? fuel || effects
                         : true;
     if (needed) active.push_back(k);
   }
@@ -243,36 +230,24 @@ EnergyBreakdown breakdown_from(const double* acc) {
   return e;
 }
 
-double fuel_mass_per_volume(const VehicleModel& m) {
-  if (const auto* c = dynamic_cast<const CombustionPowertrain*>(m.powertrain.get())) return c->params().fuel.density_kg_per_m3;
-  return 0.0;
-}
-double co2_per_fuel_mass(const VehicleModel& m) {
-  if (const auto* c = dynamic_cast<const CombustionPowertrain*>(m.powertrain.get())) return c->params().fuel.co2_kg_per_kg;
-  return 0.0;
-}
-double initial_soc(const VehicleModel& m) {
-  if (const auto* e = dynamic_cast<const ElectricPowertrain*>(m.powertrain.get())) return e->params().battery.initial_soc;
-  return 0.0;
-}
-
 void finish_result(const VehicleModel& m, const DriveCycle& c, double distance_m, const double* acc, double v_start,
                    double v_end, SimulationResult& r) {
   r.vehicle = m.name;
   r.road_load = m.road_load_description;
   r.cycle = c.name;
-  r.electric = m.powertrain->is_electric();
   r.duration_s = c.duration_s();
   r.distance_m = distance_m;
   r.energy = breakdown_from(acc);
   r.energy.kinetic_change_j = 0.5 * m.inertial_mass_kg() * (v_end * v_end - v_start * v_start);
-  r.fuel_volume_m3 = acc[kFuelVolume];
-  r.co2_kg = r.fuel_volume_m3 * fuel_mass_per_volume(m) * co2_per_fuel_mass(m);
-  r.usable_battery_j = m.powertrain->usable_battery_energy_j();
-  r.initial_soc = initial_soc(m);
-  r.final_soc = r.usable_battery_j > 0.0
-                    ? r.initial_soc - (r.energy.battery_terminal_j + r.energy.battery_loss_j) / r.usable_battery_j
-                    : 0.0;
+  if (const FuelParams* f = m.powertrain->fuel()) {
+    r.fuel = FuelFigures{acc[kFuelVolume], acc[kFuelVolume] * f->density_kg_per_m3 * f->co2_kg_per_kg};
+  }
+  if (const BatteryParams* b = m.powertrain->battery()) {
+    const double final_soc = b->usable_capacity_j > 0.0
+                                 ? b->initial_soc - (r.energy.battery_terminal_j + r.energy.battery_loss_j) / b->usable_capacity_j
+                                 : 0.0;
+    r.battery = BatteryFigures{b->usable_capacity_j, b->initial_soc, final_soc};
+  }
 }
 
 TracePoint trace_point(const VehicleModel& m, double t, double target_mps, double v, double a, double grade,
@@ -457,8 +432,8 @@ class ForwardSystem final : public OdeSystem {
 };
 
 double soc_of(const VehicleModel& m, const double* acc) {
-  const double cap = m.powertrain->usable_battery_energy_j();
-  return cap > 0.0 ? initial_soc(m) - (acc[kTerminal] + acc[kBatteryLoss]) / cap : 0.0;
+  const BatteryParams* b = m.powertrain->battery();
+  return b && b->usable_capacity_j > 0.0 ? b->initial_soc - (acc[kTerminal] + acc[kBatteryLoss]) / b->usable_capacity_j : 0.0;
 }
 
 }  // namespace
@@ -517,6 +492,7 @@ SimulationResult simulate_forward(const VehicleModel& m, const DriveCycle& c, co
   std::size_t record_hint = 0;
   Shortfall open{};
   bool in_shortfall = false;
+  double standstill_brake_j = 0.0;  // kinetic energy braked away where a standstill segment starts
   auto record = [&](double t, const std::vector<double>& y) {
     const double target = c.speed_mps_at(t, record_hint);
     const double err = target - y[kSpeed];
@@ -578,7 +554,10 @@ SimulationResult simulate_forward(const VehicleModel& m, const DriveCycle& c, co
     } else if (t >= t_stop && t < t_end) {
       std::vector<double> y = integ.state();
       if (sys.standstill_segment(t)) {
-        y[kSpeed] = 0.0;  // stopped and braked: the driver releases the pedal
+        // Stopped and braked: the driver holds the car on its brakes. Whatever speed is left (the integration's
+        // error, or a car the trace left running) is braked away by friction, and booked so the balance closes.
+        standstill_brake_j += 0.5 * m.inertial_mass_kg() * y[kSpeed] * y[kSpeed];
+        y[kSpeed] = 0.0;
         y[kDriverIntegral] = 0.0;
       }
       // The demand jumps at a kink of the trace: choose the gear for the segment that starts here.
@@ -592,8 +571,9 @@ SimulationResult simulate_forward(const VehicleModel& m, const DriveCycle& c, co
   }
   if (in_shortfall) r.shortfalls.push_back(open);
   r.solver = integ.stats();
-  finish_result(m, c, integ.state()[kDistance], all_accumulators(integ.quadratures()).data(), c.speed_mps.front(),
-                integ.state()[kSpeed], r);
+  auto acc = all_accumulators(integ.quadratures());
+  acc[kFriction] += standstill_brake_j;
+  finish_result(m, c, integ.state()[kDistance], acc.data(), c.speed_mps.front(), integ.state()[kSpeed], r);
   return r;
 }
 

@@ -9,14 +9,14 @@
 
 namespace rollsim::selection {
 
-/// The car's headline figure: battery energy per distance for an electric car, fuel per distance otherwise.
+/// The car's headline figure: fuel per distance for a car that burns fuel, battery energy per distance otherwise.
 struct EnergyFigure {
   double value = 0.0;     ///< kWh/10 km or l/100 km
   std::string unit;       ///< "kwh_per_10km" or "l_per_100km"
   double range_km = 0.0;  ///< electric only, 0 otherwise
 };
 
-/// "kwh_per_10km" for an electric car, "l_per_100km" otherwise.
+/// "l_per_100km" for a car whose powertrain burns fuel, "kwh_per_10km" otherwise.
 std::string energy_unit(const Vehicle& vehicle);
 /// "kWh/10 km" / "l/100 km" for tables.
 std::string energy_unit_label(const std::string& unit);

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -69,7 +70,7 @@ struct EnergyBreakdown {
   double clutch_loss_j = 0.0;
 
   double wheel_residual_j() const;       ///< traction minus all its uses; ~0 when the balance closes
-  double powertrain_residual_j(bool electric) const;  ///< source energy minus all its uses
+  double powertrain_residual_j() const;  ///< source energy (battery terminals + fuel) minus all its uses
 };
 
 struct Shortfall {
@@ -89,26 +90,37 @@ struct TracePoint {
   int gear;
 };
 
+/// What a run took from a battery, when the powertrain has one.
+struct BatteryFigures {
+  double usable_j = 0.0;     ///< usable capacity
+  double initial_soc = 1.0;  ///< fraction of usable capacity
+  double final_soc = 1.0;
+};
+
+/// What a run burned, when the powertrain has a fuel converter.
+struct FuelFigures {
+  double volume_m3 = 0.0;
+  double co2_kg = 0.0;
+};
+
 struct SimulationResult {
   std::string vehicle;
   std::string road_load;
   std::string cycle;
   std::string mode;  ///< "forward" or "replay"
-  bool electric = false;
   double duration_s = 0.0;
   double distance_m = 0.0;
   EnergyBreakdown energy;
-  double fuel_volume_m3 = 0.0;
-  double co2_kg = 0.0;
-  double usable_battery_j = 0.0;
-  double initial_soc = 1.0;
-  double final_soc = 1.0;
+  std::optional<BatteryFigures> battery;  ///< set when the powertrain has a battery
+  std::optional<FuelFigures> fuel;        ///< set when it burns fuel
   double max_speed_error_mps = 0.0;
   double max_speed_error_time_s = 0.0;
   OdeStats solver;
   std::vector<Shortfall> shortfalls;
   std::vector<TracePoint> trace;
 
+  /// Energy taken from the sources [J]: battery terminals plus fuel (lower heating value).
+  double source_energy_j() const;
   /// Battery-terminal energy per distance in kWh/10 km (the platform study's unit).
   double aec_kwh_per_10km() const;
   double fuel_l_per_100km() const;
