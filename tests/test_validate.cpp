@@ -117,6 +117,12 @@ TEST(ConventionalPowertrain, ConverterSlipsAtLaunchAndLocksUpAtSpeed) {
   // Overrun above the cut-off speed burns nothing; standing still it idles.
   EXPECT_EQ(at.deliver(-500.0, 20.0, 0, 0.33).fuel_power_w, 0.0);
   EXPECT_GT(at.deliver(0.0, 0.0, 0, 0.33).fuel_power_w, 0.0);
+  // Standing in Drive the stalled converter absorbs (w_idle / K)^2 at idle speed; a declutched manual does not.
+  const PowerFlow stand = at.deliver(0.0, 0.0, 0, 0.33);
+  const auto& p = at.params();
+  const double q = p.engine.idle_speed_radps / p.transmission.converter.k_factor_radps_per_sqrt_nm;
+  EXPECT_NEAR(stand.clutch_loss_w, q * q * p.engine.idle_speed_radps, 1e-9);
+  EXPECT_EQ(ConventionalPowertrain(car(TransmissionKind::clutch)).deliver(0.0, 0.0, 0, 0.33).clutch_loss_w, 0.0);
 }
 
 // A powertrain with both capabilities (the shape of a hybrid): results carry both figures and one balance holds.

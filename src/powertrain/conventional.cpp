@@ -170,6 +170,12 @@ PowerFlow ConventionalPowertrain::deliver(double wheel_force_n, double speed_mps
         out.machine_speed_radps = op.engine_speed_radps;
         return out;
       }
+    } else if (p_.transmission.kind != TransmissionKind::clutch) {
+      // Standing in Drive: the converter's pump turns at idle against a stalled turbine and absorbs its capacity
+      // (ω_idle / K)^2, all of it heat, while the brakes hold the car.
+      const double q = e.idle_speed_radps / p_.transmission.converter.k_factor_radps_per_sqrt_nm;
+      engine_nm = q * q;
+      out.clutch_loss_w = engine_nm * e.idle_speed_radps;
     }
   }
   out.machine_speed_radps = engine_radps;
