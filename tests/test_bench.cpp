@@ -1,7 +1,7 @@
 // Discovery benchmark, CI subset: the null's false-discovery rate, the warm-up's detection, the time-reversed null.
 #include <gtest/gtest.h>
 
-#include "rollsim/diagnose/bench.hpp"
+#include "rollsim/discovery/scorecard.hpp"
 
 namespace rollsim {
 namespace {

@@ -8,6 +8,7 @@
 
 #include "rollsim/cycle/drive_cycle.hpp"
 #include "rollsim/diagnose/diagnose.hpp"
+#include "rollsim/discovery/generate.hpp"
 #include "rollsim/sim/simulation.hpp"
 
 namespace rollsim {
@@ -240,7 +241,6 @@ TEST(DiagnoseLimits, LocatesSocRecordingsByWindow) {
   EXPECT_GT(first, late + 500.0);
 }
 
-#include "rollsim/diagnose/generate.hpp"
 
 // The fuel and SOC channels of the generator: the artefacts are in the channel's own units (a non-negative flow
 // on its meter's quantum; SOC on the BMS's 0.1 % steps), and the concealed truths add energy where they should.

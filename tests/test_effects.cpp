@@ -34,7 +34,7 @@ TEST(EffectCatalogue, NeutralParametersLeaveEnergyUnchanged) {
     const double base = source_j(run(v, nullptr));
     for (const auto& info : effect_catalogue()) {
       const double e = source_j(run(v, make_effect(info.id, {}, context(v))));
-      EXPECT_NEAR(e, base, 1e-9 * base) << file << " " << info.id;
+      EXPECT_NEAR(e, base, 1e-9 * base) << file << " " << info.name;
     }
   }
 }
@@ -161,8 +161,8 @@ TEST(EffectCatalogue, EnergyBalancesCloseWithEveryEffectOn) {
       for (bool forward : {false, true}) {
         const SimulationResult r = run(v, make_effect(info.id, p, ctx), forward);
         const SimulationResult& b = forward ? base_forward : base_replay;
-        EXPECT_NEAR(r.energy.wheel_residual_j(), b.energy.wheel_residual_j(), 2e-3 * r.energy.traction_j) << file << " " << info.id << " fwd " << forward;
-        EXPECT_NEAR(r.energy.powertrain_residual_j(), b.energy.powertrain_residual_j(), 2e-3 * source_j(r)) << file << " " << info.id;
+        EXPECT_NEAR(r.energy.wheel_residual_j(), b.energy.wheel_residual_j(), 2e-3 * r.energy.traction_j) << file << " " << info.name << " fwd " << forward;
+        EXPECT_NEAR(r.energy.powertrain_residual_j(), b.energy.powertrain_residual_j(), 2e-3 * source_j(r)) << file << " " << info.name;
       }
     }
   }

@@ -8,7 +8,7 @@
 
 #include "commands.hpp"
 #include "rollsim/common/yaml_reader.hpp"
-#include "rollsim/diagnose/bench.hpp"
+#include "rollsim/discovery/scorecard.hpp"
 #include "rollsim/diagnose/diagnose.hpp"
 #include "rollsim/recording/recording.hpp"
 

@@ -169,13 +169,24 @@ void run_tyre(const TyreOptions& o) {
   const LoadChoice load = choose_load(o, spec);
 
   std::vector<double> speeds_kmh;
-  for (const auto& s : o.speeds_kmh) speeds_kmh.push_back(parse_number(s, "--speed-kmh", Range::closed(0.0, 500.0)));
+  for (const auto& given : o.speeds_kmh) {
+    // Split here rather than by CLI11, which drops empty items: "1,,2" is a typo, not two speeds.
+    std::size_t start = 0;
+    while (true) {
+      const std::size_t comma = given.find(',', start);
+      const std::string item = given.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+      if (item.empty()) throw InputError("--speed-kmh '" + given + "'", "an empty value between commas; give e.g. 50,80,120");
+      speeds_kmh.push_back(parse_number(item, "--speed-kmh", Range::closed(0.0, 500.0)));
+      if (comma == std::string::npos) break;
+      start = comma + 1;
+    }
+  }
   if (speeds_kmh.empty()) speeds_kmh.push_back(80.0);
   // Explaining needs a rolling tyre: at standstill RRC is 0 and has no elasticity.
   if (o.explain) {
     for (std::size_t i = 0; i < speeds_kmh.size(); ++i) {
       if (!(speeds_kmh[i] > 0.0)) {
-        throw InputError("--speed-kmh " + o.speeds_kmh[i], "0 is not allowed with --explain: must be > 0");
+        throw InputError("--speed-kmh " + format_value(speeds_kmh[i]), "0 is not allowed with --explain: must be > 0");
       }
     }
   }
@@ -266,7 +277,6 @@ void register_tyre_command(CLI::App& app) {
       ->type_name("PCT");
   sub->add_option("--speed-kmh", opts->speeds_kmh, "Speed(s) [km/h]: several values, repeated or comma-separated "
                                                     "(default 80)")
-      ->delimiter(',')
       ->type_name("KMH");
   sub->add_flag("--json", opts->json, "One JSON object per operating point per line");
   sub->add_flag("--explain", opts->explain, "Elasticities of RRC and RR power and the mechanism behind each");

@@ -87,24 +87,25 @@ std::vector<std::string> write_diagnosis_report(const std::string& dir, const Di
            << (w.measured_j - w.calibrated_j) / dur << " " << (w.measured_j - w.fitted_j) / dur << "\n";
     }
   }
-  const std::string dat = "'" + report::gnuplot_escape((work / "windows.dat").string()) + "'";
-  const std::string after = report::gnuplot_escape(d.findings.empty() ? "after (no findings: same as before)" : "after the findings' effects");
+  using report::gnuplot_string;
+  const std::string dat = gnuplot_string((work / "windows.dat").string());
+  const std::string after = gnuplot_string(d.findings.empty() ? "after (no findings: same as before)" : "after the findings' effects");
   // Window residuals before and after, as points against one signature variable (a column of windows.dat).
   auto residual_against = [&](const std::string& file, const std::string& what, const std::string& xlabel, int column) {
     std::ostringstream script;
-    script << "set xlabel '" << xlabel << "'\nset ylabel 'residual mean power [W]'\nplot " << dat << " u " << column
-           << ":11 w p pt 7 ps 0.6 t 'before', " << dat << " u " << column << ":12 w p pt 6 ps 0.6 t '" << after
-           << "', 0 w l lc 'black' notitle\n";
+    script << "set xlabel " << gnuplot_string(xlabel) << "\nset ylabel 'residual mean power [W]'\nplot " << dat << " u " << column
+           << ":11 w p pt 7 ps 0.6 t 'before', " << dat << " u " << column << ":12 w p pt 6 ps 0.6 t " << after
+           << ", 0 w l lc 'black' notitle\n";
     return Figure{file, "Window residual against " + what, script.str()};
   };
   std::vector<Figure> figs{
       {"energy.svg", "Measured against simulated mean power per window (" + d.channel + " channel)",
        "set xlabel 'time, recordings one after another [min]'\nset ylabel 'mean power per window [W]'\nplot " + dat +
            " u 1:2 w lp pt 7 ps 0.5 lw 2 t 'measured', " + dat + " u 1:3 w l lw 1 dt 2 t 'simulated (nominal)', " + dat +
-           " u 1:4 w l lw 2 t 'calibrated', " + dat + " u 1:5 w l lw 2 t '" + after + "'\n"},
+           " u 1:4 w l lw 2 t 'calibrated', " + dat + " u 1:5 w l lw 2 t " + after + "\n"},
       {"cumulative.svg", "Cumulative residual (measured minus model) over time",
        "set xlabel 'time, recordings one after another [min]'\nset ylabel 'cumulative residual energy [kJ]'\nplot " + dat +
-           " u 1:6 w l lw 2 t 'before (calibrated)', " + dat + " u 1:7 w l lw 2 t '" + after + "'\n"},
+           " u 1:6 w l lw 2 t 'before (calibrated)', " + dat + " u 1:7 w l lw 2 t " + after + "\n"},
       residual_against("residual_speed.svg", "mean speed", "mean speed in the window [km/h]", 8),
       residual_against("residual_accel.svg", "mean positive acceleration", "mean of max(0, a) in the window [m/s^2]", 9),
       residual_against("residual_time.svg", "time since the start of its recording", "time since the start of the recording [min]", 10),
@@ -114,8 +115,8 @@ std::vector<std::string> write_diagnosis_report(const std::string& dir, const Di
     const fs::path out = work / f.file;
     {
       std::ofstream gp(work / "plot.gp");
-      gp << "set terminal svg size 800,450 dynamic font 'Sans,11'\nset output '" << report::gnuplot_escape(out.string()) << "'\n"
-         << "set title '" << report::gnuplot_escape(f.caption) << "'\nset grid\nset key outside bottom center horizontal\n" << f.script;
+      gp << report::gnuplot_terminal("svg size 800,450 dynamic font 'Sans,11'") << "set output " << gnuplot_string(out.string()) << "\n"
+         << "set title " << gnuplot_string(f.caption) << "\nset grid\nset key outside bottom center horizontal\n" << f.script;
     }
     if (const std::string err = report::run_gnuplot_script(gnuplot, (work / "plot.gp").string()); !err.empty()) {
       fs::remove_all(work, ec);

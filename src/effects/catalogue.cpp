@@ -1,4 +1,4 @@
-// The effect modules: each a small physical model with its parameters in SI.
+// The effect modules: each a small physical model with typed parameters in SI, and the registry of them.
 #include "rollsim/effects/catalogue.hpp"
 
 #include <algorithm>
@@ -14,6 +14,46 @@ namespace {
 constexpr double kG = units::kStandardGravity_mps2;
 constexpr double kRefSpeed_mps = 100.0 / 3.6;  // rr_speed's coefficient is the RRC change at 100 km/h
 
+// Typed parameters of each module; their names, units, neutral values and bounds are declared once, in the
+// module's registry row below, beside the member each one fills.
+struct TyreWarmupParams {
+  double cold_rrc_excess, heat_capacity_j_per_k, convection_w_per_k, convection_growth_s_per_m, warm_excess_k,
+      initial_excess_k;
+};
+struct AuxLoadParams {
+  double power_w, duty_cycle, period_s;
+};
+struct WindParams {
+  double headwind_mps;
+};
+struct MassParams {
+  double extra_mass_kg;
+};
+struct RrSpeedParams {
+  double rrc_change_at_100kmh;
+};
+struct AmbientRrcParams {
+  double rrc_change_per_k, ambient_temp_c, reference_temp_c;
+};
+struct RotationalInertiaParams {
+  double extra_rotating_mass_kg;
+};
+struct BatteryResistanceParams {
+  double extra_resistance_ohm, pack_voltage_v;
+};
+struct TyreSlipParams {
+  double slip_per_kn;
+};
+struct RegenLimitParams {
+  double friction_share_above_limit, regen_limit_w;
+};
+struct EngineWarmupParams {
+  double cold_fuel_excess, heat_capacity_j_per_k, idle_heat_w, heat_per_wheel_work, heat_loss_w_per_k, warm_excess_k;
+};
+struct RoadGradeParams {
+  double grade_offset, profile_wavelength_m;
+};
+
 // Tyre warm-up, lumped over the four tyres. Hidden state: tyre temperature above ambient, T [K].
 //   C dT/dt = eta_heat * P_rr - h(v) T,  h(v) = h0 (1 + g v)  (forced convection grows with speed)
 //   RRC factor = 1 + excess * max(0, 1 - T / T_warm)          (linear in temperature below the warm point)
@@ -21,9 +61,9 @@ constexpr double kRefSpeed_mps = 100.0 / 3.6;  // rr_speed's coefficient is the 
 // and the tens-of-minutes time constant C/h are of the literature (see docs/diagnose.md).
 class TyreWarmup final : public Effect {
  public:
-  explicit TyreWarmup(const EffectParameters& p)
-      : excess_(p.at("cold_rrc_excess")), c_(p.at("heat_capacity_j_per_k")), h0_(p.at("convection_w_per_k")),
-        g_(p.at("convection_growth_s_per_m")), warm_(p.at("warm_excess_k")), initial_(p.at("initial_excess_k")) {}
+  TyreWarmup(const TyreWarmupParams& p, const EffectContext&)
+      : excess_(p.cold_rrc_excess), c_(p.heat_capacity_j_per_k), h0_(p.convection_w_per_k),
+        g_(p.convection_growth_s_per_m), warm_(p.warm_excess_k), initial_(p.initial_excess_k) {}
   std::string id() const override { return "tyre_warmup"; }
   int num_states() const override { return 1; }
   void initial_states(double* x) const override { x[0] = initial_; }
@@ -41,20 +81,26 @@ class TyreWarmup final : public Effect {
 };
 
 // Constant electrical consumer (HVAC, electronics) not in the vehicle file's aux power.
+// Duty-cycled (an A/C compressor or heater cycling on and off every few minutes): on for the first duty_cycle x
+// period_s of each period, at power_w / duty_cycle, so power_w is always the mean; period 0 is a constant load.
 class AuxLoad final : public Effect {
  public:
-  explicit AuxLoad(const EffectParameters& p) : p_(p.at("power_w")) {}
+  AuxLoad(const AuxLoadParams& p, const EffectContext&) : p_(p.power_w), duty_(p.duty_cycle), period_(p.period_s) {}
   std::string id() const override { return "aux_load"; }
-  double extra_electric_power_w(const EffectInputs&, const double*) const override { return p_; }
+  double extra_electric_power_w(const EffectInputs& in, const double*) const override {
+    if (period_ <= 0.0 || duty_ >= 1.0) return p_;
+    const double phase = std::fmod(std::max(0.0, in.time_s), period_) / period_;
+    return phase < duty_ ? p_ / duty_ : 0.0;
+  }
 
  private:
-  double p_;
+  double p_, duty_, period_;
 };
 
 // Constant headwind u (negative: tailwind): the aero force is 0.5 rho CdA (v + u)^2 instead of 0.5 rho CdA v^2.
 class Wind final : public Effect {
  public:
-  Wind(const EffectParameters& p, const EffectContext& c) : u_(p.at("headwind_mps")), k_(0.5 * c.rho_cda_kg_per_m) {}
+  Wind(const WindParams& p, const EffectContext& c) : u_(p.headwind_mps), k_(0.5 * c.rho_cda_kg_per_m) {}
   std::string id() const override { return "wind"; }
   double extra_resistance_n(const EffectInputs& in, const double*) const override {
     const double v = std::max(in.speed_mps, 0.0);
@@ -70,7 +116,7 @@ class Wind final : public Effect {
 // Mass (payload) error dm: inertia, grade and the rolling share, dm (a + g sin theta + g RRC).
 class Mass final : public Effect {
  public:
-  Mass(const EffectParameters& p, const EffectContext& c) : dm_(p.at("extra_mass_kg")), m_(c.mass_kg) {}
+  Mass(const MassParams& p, const EffectContext& c) : dm_(p.extra_mass_kg), m_(c.mass_kg) {}
   std::string id() const override { return "mass"; }
   double extra_resistance_n(const EffectInputs& in, const double*) const override {
     const double rolling_per_kg = m_ > 0.0 ? in.base_rolling_force_n / m_ : 0.0;
@@ -84,7 +130,7 @@ class Mass final : public Effect {
 // Speed dependence of rolling resistance the tyre model lacks (pressure, wrong tyre): factor 1 + k (v/v100)^2.
 class RrSpeed final : public Effect {
  public:
-  explicit RrSpeed(const EffectParameters& p) : k_(p.at("rrc_change_at_100kmh")) {}
+  RrSpeed(const RrSpeedParams& p, const EffectContext&) : k_(p.rrc_change_at_100kmh) {}
   std::string id() const override { return "rr_speed"; }
   double rolling_resistance_factor(const EffectInputs& in, const double*) const override {
     const double r = std::max(in.speed_mps, 0.0) / kRefSpeed_mps;
@@ -98,8 +144,8 @@ class RrSpeed final : public Effect {
 // RRC against ambient temperature: factor 1 + c (T_ref - T_amb) (UN R117 / ISO 28580: c about 0.008 /K).
 class AmbientRrc final : public Effect {
  public:
-  explicit AmbientRrc(const EffectParameters& p)
-      : c_(p.at("rrc_change_per_k")), t_(p.at("ambient_temp_c")), ref_(p.at("reference_temp_c")) {}
+  AmbientRrc(const AmbientRrcParams& p, const EffectContext&)
+      : c_(p.rrc_change_per_k), t_(p.ambient_temp_c), ref_(p.reference_temp_c) {}
   std::string id() const override { return "ambient_rrc"; }
   double rolling_resistance_factor(const EffectInputs&, const double*) const override {
     return std::max(0.0, 1.0 + c_ * (ref_ - t_));
@@ -115,7 +161,7 @@ class AmbientRrc final : public Effect {
 // comes back in a deceleration only as far as regen recovers it, so friction braking makes it a net loss.
 class RotationalInertia final : public Effect {
  public:
-  explicit RotationalInertia(const EffectParameters& p) : dm_(p.at("extra_rotating_mass_kg")) {}
+  RotationalInertia(const RotationalInertiaParams& p, const EffectContext&) : dm_(p.extra_rotating_mass_kg) {}
   std::string id() const override { return "rotational_inertia"; }
   double extra_resistance_n(const EffectInputs& in, const double*) const override { return dm_ * in.accel_mps2; }
 
@@ -128,7 +174,7 @@ class RotationalInertia final : public Effect {
 // terminal power.
 class BatteryResistance final : public Effect {
  public:
-  explicit BatteryResistance(const EffectParameters& p) : dr_(p.at("extra_resistance_ohm")), v_(p.at("pack_voltage_v")) {}
+  BatteryResistance(const BatteryResistanceParams& p, const EffectContext&) : dr_(p.extra_resistance_ohm), v_(p.pack_voltage_v) {}
   std::string id() const override { return "battery_resistance"; }
   double battery_loss_w(const EffectInputs&, double terminal_power_w, const double*) const override {
     const double i = terminal_power_w / v_;
@@ -143,7 +189,7 @@ class BatteryResistance final : public Effect {
 // and in braking. The parameter is the compliance 1 / C_x of the car's tyres together, in slip per kN.
 class TyreSlip final : public Effect {
  public:
-  explicit TyreSlip(const EffectParameters& p) : per_n_(p.at("slip_per_kn") / 1000.0) {}
+  TyreSlip(const TyreSlipParams& p, const EffectContext&) : per_n_(p.slip_per_kn / 1000.0) {}
   std::string id() const override { return "tyre_slip"; }
   double wheel_loss_w(const EffectInputs& in, const double*) const override {
     const double f = in.wheel_force_demand_n, v = std::max(in.speed_mps, 0.0);
@@ -160,7 +206,7 @@ class TyreSlip final : public Effect {
 // booked as wheel loss, not friction braking).
 class RegenLimit final : public Effect {
  public:
-  explicit RegenLimit(const EffectParameters& p) : share_(p.at("friction_share_above_limit")), lim_(p.at("regen_limit_w")) {}
+  RegenLimit(const RegenLimitParams& p, const EffectContext&) : share_(p.friction_share_above_limit), lim_(p.regen_limit_w) {}
   std::string id() const override { return "regen_limit"; }
   double wheel_loss_w(const EffectInputs& in, const double*) const override {
     const double f = in.wheel_force_demand_n, v = std::max(in.speed_mps, 0.0);
@@ -178,9 +224,9 @@ class RegenLimit final : public Effect {
 // loss grows with its work). Neutral on an electric car: there is no fuel power to scale.
 class EngineWarmup final : public Effect {
  public:
-  explicit EngineWarmup(const EffectParameters& p)
-      : k_(p.at("cold_fuel_excess")), c_(p.at("heat_capacity_j_per_k")), idle_(p.at("idle_heat_w")),
-        q_(p.at("heat_per_wheel_work")), h_(p.at("heat_loss_w_per_k")), warm_(p.at("warm_excess_k")) {}
+  EngineWarmup(const EngineWarmupParams& p, const EffectContext&)
+      : k_(p.cold_fuel_excess), c_(p.heat_capacity_j_per_k), idle_(p.idle_heat_w),
+        q_(p.heat_per_wheel_work), h_(p.heat_loss_w_per_k), warm_(p.warm_excess_k) {}
   std::string id() const override { return "engine_warmup"; }
   int num_states() const override { return 1; }
   void state_derivatives(const EffectInputs& in, const double* x, double* xdot) const override {
@@ -201,8 +247,8 @@ class EngineWarmup final : public Effect {
 // separates them (grade changes sign, RRC does not).
 class RoadGrade final : public Effect {
  public:
-  RoadGrade(const EffectParameters& p, const EffectContext& c)
-      : g0_(p.at("grade_offset")), wavelength_(p.at("profile_wavelength_m")), m_(c.mass_kg) {}
+  RoadGrade(const RoadGradeParams& p, const EffectContext& c)
+      : g0_(p.grade_offset), wavelength_(p.profile_wavelength_m), m_(c.mass_kg) {}
   std::string id() const override { return "road_grade"; }
   double extra_resistance_n(const EffectInputs& in, const double*) const override {
     if (std::max(in.speed_mps, 0.0) <= 0.0) return 0.0;  // standing still: the brakes hold the car
@@ -215,45 +261,111 @@ class RoadGrade final : public Effect {
   double g0_, wavelength_, m_;
 };
 
+// One parameter: the member it fills and its metadata.
+template <class P>
+struct Field {
+  double P::*member;
+  EffectParameterInfo info;
+};
+
+// A registry row: metadata, and a factory filling the typed parameters from a complete, checked set.
+template <class E, class P>
+EffectInfo row(EffectId id, std::string name, std::string description, std::string opposite, std::vector<Field<P>> fields) {
+  EffectInfo e{id, std::move(name), std::move(description), {}, std::move(opposite), {}};
+  for (const auto& f : fields) e.parameters.push_back(f.info);
+  e.make = [fields](const EffectParameters& given, const EffectContext& c) -> std::shared_ptr<const Effect> {
+    P p{};
+    for (const auto& f : fields) p.*f.member = given.at(f.info.name);
+    return std::make_shared<E>(p, c);
+  };
+  return e;
+}
+
+// Amplitude bounds carry the physical sign (a warm-up makes the start costlier, a load draws power, a payload adds
+// mass); a fit that needs the other sign is described by `opposite`, never reported as this effect.
+std::vector<EffectInfo> build_catalogue() {
+  using I = EffectId;
+  std::vector<EffectInfo> c;
+  c.push_back(row<TyreWarmup, TyreWarmupParams>(
+      I::tyre_warmup, "tyre_warmup",
+      "tyre thermal state: RRC falls as rolling loss heats the tyres (heat balance with speed-dependent convection)",
+      "rolling resistance rising over the trip (the opposite of a tyre warm-up)",
+      {{&TyreWarmupParams::cold_rrc_excess, {"cold_rrc_excess", "1", 0.0, 0.2, 0.0, 1.0, true}},
+       {&TyreWarmupParams::heat_capacity_j_per_k, {"heat_capacity_j_per_k", "J/K", 50000.0, 50000.0, 5000.0, 500000.0, false}},
+       {&TyreWarmupParams::convection_w_per_k, {"convection_w_per_k", "W/K", 20.0, 20.0, 1.0, 500.0, false}},
+       {&TyreWarmupParams::convection_growth_s_per_m, {"convection_growth_s_per_m", "s/m", 0.1, 0.1, 0.0, 1.0, false}},
+       {&TyreWarmupParams::warm_excess_k, {"warm_excess_k", "K", 30.0, 30.0, 1.0, 100.0, false}},
+       {&TyreWarmupParams::initial_excess_k, {"initial_excess_k", "K", 0.0, 0.0, 0.0, 100.0, false}}}));
+  c.push_back(row<AuxLoad, AuxLoadParams>(
+      I::aux_load, "aux_load",
+      "extra electrical load (HVAC, electronics): constant, or duty-cycled on and off with its mean power_w",
+      "less constant power drawn than the vehicle file's auxiliaries",
+      {{&AuxLoadParams::power_w, {"power_w", "W", 0.0, 400.0, 0.0, 8000.0, true}},
+       {&AuxLoadParams::duty_cycle, {"duty_cycle", "1", 1.0, 1.0, 0.05, 1.0, false}},
+       {&AuxLoadParams::period_s, {"period_s", "s", 0.0, 0.0, 0.0, 3600.0, false}}}));
+  c.push_back(row<Wind, WindParams>(I::wind, "wind", "constant headwind (negative: tailwind)", "",
+                                    {{&WindParams::headwind_mps, {"headwind_mps", "m/s", 0.0, 3.0, -20.0, 20.0, true}}}));
+  c.push_back(row<Mass, MassParams>(I::mass, "mass", "mass or payload missing from the file: inertia, grade and rolling share",
+                                    "less mass than the vehicle file's test mass (inertia, grade and rolling share all lighter)",
+                                    {{&MassParams::extra_mass_kg, {"extra_mass_kg", "kg", 0.0, 150.0, 0.0, 1000.0, true}}}));
+  c.push_back(row<RrSpeed, RrSpeedParams>(
+      I::rr_speed, "rr_speed", "speed-dependent rolling resistance: RRC x (1 + k (v / 100 km/h)^2)",
+      "rolling resistance falling with speed against the tyre model's",
+      {{&RrSpeedParams::rrc_change_at_100kmh, {"rrc_change_at_100kmh", "1", 0.0, 0.2, 0.0, 3.0, true}}}));
+  c.push_back(row<AmbientRrc, AmbientRrcParams>(
+      I::ambient_rrc, "ambient_rrc", "RRC against ambient temperature: RRC x (1 + c (T_ref - T_amb))",
+      "RRC falling in the cold across the trips (against tyre physics)",
+      {{&AmbientRrcParams::rrc_change_per_k, {"rrc_change_per_k", "1/K", 0.0, 0.008, 0.0, 0.05, true}},
+       {&AmbientRrcParams::ambient_temp_c, {"ambient_temp_c", "degC", 20.0, 20.0, -40.0, 50.0, false}},
+       {&AmbientRrcParams::reference_temp_c, {"reference_temp_c", "degC", 20.0, 20.0, -40.0, 50.0, false}}}));
+  c.push_back(row<RotationalInertia, RotationalInertiaParams>(
+      I::rotational_inertia, "rotational_inertia",
+      "rotating parts' equivalent mass missing from the file: force dm_rot a, acceleration only",
+      "less force on acceleration than the file's rotating masses imply",
+      {{&RotationalInertiaParams::extra_rotating_mass_kg, {"extra_rotating_mass_kg", "kg", 0.0, 80.0, 0.0, 500.0, true}}}));
+  c.push_back(row<BatteryResistance, BatteryResistanceParams>(
+      I::battery_resistance, "battery_resistance",
+      "extra battery internal resistance: loss dR (P / V)^2 inside the cells (SOC only)",
+      "less loss in the cells than the model's internal resistance",
+      {{&BatteryResistanceParams::extra_resistance_ohm, {"extra_resistance_ohm", "ohm", 0.0, 0.05, 0.0, 2.0, true}},
+       {&BatteryResistanceParams::pack_voltage_v, {"pack_voltage_v", "V", 360.0, 360.0, 12.0, 1000.0, false}}}));
+  c.push_back(row<TyreSlip, TyreSlipParams>(I::tyre_slip, "tyre_slip", "longitudinal tyre slip, linear range: loss F_x^2 v / C_x",
+                                            "less loss in hard traction and braking than the model's",
+                                            {{&TyreSlipParams::slip_per_kn, {"slip_per_kn", "1/kN", 0.0, 0.005, 0.0, 0.1, true}}}));
+  c.push_back(row<RegenLimit, RegenLimitParams>(
+      I::regen_limit, "regen_limit",
+      "lower regen limit (brake blending): a share of braking power above the limit goes to friction",
+      "more braking energy recovered than the file's regen limit allows",
+      {{&RegenLimitParams::friction_share_above_limit, {"friction_share_above_limit", "1", 0.0, 1.0, 0.0, 1.0, true}},
+       {&RegenLimitParams::regen_limit_w, {"regen_limit_w", "W", 10000.0, 10000.0, 0.0, 200000.0, false}}}));
+  c.push_back(row<EngineWarmup, EngineWarmupParams>(
+      I::engine_warmup, "engine_warmup",
+      "cold engine: fuel power x (1 + k max(0, 1 - T_oil / T_warm)), oil heated by the engine's losses",
+      "fuel rate rising over the trip (the opposite of an engine warm-up)",
+      {{&EngineWarmupParams::cold_fuel_excess, {"cold_fuel_excess", "1", 0.0, 0.2, 0.0, 2.0, true}},
+       {&EngineWarmupParams::heat_capacity_j_per_k, {"heat_capacity_j_per_k", "J/K", 100000.0, 100000.0, 5000.0, 2000000.0, false}},
+       {&EngineWarmupParams::idle_heat_w, {"idle_heat_w", "W", 2000.0, 2000.0, 0.0, 50000.0, false}},
+       {&EngineWarmupParams::heat_per_wheel_work, {"heat_per_wheel_work", "1", 0.6, 0.6, 0.0, 5.0, false}},
+       {&EngineWarmupParams::heat_loss_w_per_k, {"heat_loss_w_per_k", "W/K", 40.0, 40.0, 1.0, 2000.0, false}},
+       {&EngineWarmupParams::warm_excess_k, {"warm_excess_k", "K", 60.0, 60.0, 1.0, 150.0, false}}}));
+  c.push_back(row<RoadGrade, RoadGradeParams>(
+      I::road_grade, "road_grade",
+      "missing grade: constant offset or a cosine elevation-profile error along distance, force m g sin(theta)", "",
+      {{&RoadGradeParams::grade_offset, {"grade_offset", "1", 0.0, 0.005, -0.2, 0.2, true}},
+       {&RoadGradeParams::profile_wavelength_m, {"profile_wavelength_m", "m", 0.0, 0.0, 0.0, 1e6, false}}}));
+  return c;
+}
+
 }  // namespace
 
+const EffectParameterInfo& EffectInfo::amplitude() const {
+  for (const auto& p : parameters)
+    if (p.amplitude) return p;
+  throw InputError("effect '" + name + "'", "has no amplitude parameter");
+}
+
 const std::vector<EffectInfo>& effect_catalogue() {
-  static const std::vector<EffectInfo> kCatalogue{
-      {"tyre_warmup",
-       "tyre thermal state: RRC falls as rolling loss heats the tyres (heat balance with speed-dependent convection)",
-       {{"cold_rrc_excess", "1", 0.0, 0.2, -0.5, 1.0, true},
-        {"heat_capacity_j_per_k", "J/K", 50000.0, 50000.0, 5000.0, 500000.0, false},
-        {"convection_w_per_k", "W/K", 20.0, 20.0, 1.0, 500.0, false},
-        {"convection_growth_s_per_m", "s/m", 0.1, 0.1, 0.0, 1.0, false},
-        {"warm_excess_k", "K", 30.0, 30.0, 1.0, 100.0, false},
-        {"initial_excess_k", "K", 0.0, 0.0, 0.0, 100.0, false}}},
-      {"aux_load", "constant extra electrical load (HVAC, electronics)", {{"power_w", "W", 0.0, 400.0, -2000.0, 8000.0, true}}},
-      {"wind", "constant headwind (negative: tailwind)", {{"headwind_mps", "m/s", 0.0, 3.0, -20.0, 20.0, true}}},
-      {"mass", "mass or payload error: inertia, grade and rolling share", {{"extra_mass_kg", "kg", 0.0, 150.0, -500.0, 1000.0, true}}},
-      {"rr_speed", "speed-dependent rolling resistance: RRC x (1 + k (v / 100 km/h)^2)",
-       {{"rrc_change_at_100kmh", "1", 0.0, 0.2, -0.9, 3.0, true}}},
-      {"ambient_rrc", "RRC against ambient temperature: RRC x (1 + c (T_ref - T_amb))",
-       {{"rrc_change_per_k", "1/K", 0.0, 0.008, -0.05, 0.05, true},
-        {"ambient_temp_c", "degC", 20.0, 20.0, -40.0, 50.0, false},
-        {"reference_temp_c", "degC", 20.0, 20.0, -40.0, 50.0, false}}},
-      {"rotational_inertia", "rotating parts' equivalent mass missing from the file: force dm_rot a, acceleration only",
-       {{"extra_rotating_mass_kg", "kg", 0.0, 80.0, -300.0, 500.0, true}}},
-      {"battery_resistance", "extra battery internal resistance: loss dR (P / V)^2 inside the cells (SOC only)",
-       {{"extra_resistance_ohm", "ohm", 0.0, 0.05, -0.5, 2.0, true}, {"pack_voltage_v", "V", 360.0, 360.0, 12.0, 1000.0, false}}},
-      {"tyre_slip", "longitudinal tyre slip, linear range: loss F_x^2 v / C_x",
-       {{"slip_per_kn", "1/kN", 0.0, 0.005, 0.0, 0.1, true}}},
-      {"regen_limit", "lower regen limit (brake blending): a share of braking power above the limit goes to friction",
-       {{"friction_share_above_limit", "1", 0.0, 1.0, 0.0, 1.0, true}, {"regen_limit_w", "W", 10000.0, 10000.0, 0.0, 200000.0, false}}},
-      {"engine_warmup", "cold engine: fuel power x (1 + k max(0, 1 - T_oil / T_warm)), oil heated by the engine's losses",
-       {{"cold_fuel_excess", "1", 0.0, 0.2, -0.5, 2.0, true},
-        {"heat_capacity_j_per_k", "J/K", 100000.0, 100000.0, 5000.0, 2000000.0, false},
-        {"idle_heat_w", "W", 2000.0, 2000.0, 0.0, 50000.0, false},
-        {"heat_per_wheel_work", "1", 0.6, 0.6, 0.0, 5.0, false},
-        {"heat_loss_w_per_k", "W/K", 40.0, 40.0, 1.0, 2000.0, false},
-        {"warm_excess_k", "K", 60.0, 60.0, 1.0, 150.0, false}}},
-      {"road_grade", "missing grade: constant offset or a cosine elevation-profile error along distance, force m g sin(theta)",
-       {{"grade_offset", "1", 0.0, 0.005, -0.2, 0.2, true}, {"profile_wavelength_m", "m", 0.0, 0.0, 0.0, 1e6, false}}},
-  };
+  static const std::vector<EffectInfo> kCatalogue = build_catalogue();
   return kCatalogue;
 }
 
@@ -264,59 +376,55 @@ const std::vector<std::string>& effects_not_implemented() {
   return kMissing;
 }
 
-const EffectInfo& effect_info(const std::string& id) {
+const EffectInfo& effect_info(EffectId id) { return effect_catalogue().at(static_cast<std::size_t>(id)); }
+
+const std::string& to_string(EffectId id) { return effect_info(id).name; }
+
+const EffectInfo& effect_info(const std::string& name) {
   for (const auto& e : effect_catalogue())
-    if (e.id == id) return e;
+    if (e.name == name) return e;
   for (const auto& m : effects_not_implemented())
-    if (m == id) throw InputError("effect '" + id + "'", "is in the catalogue but not implemented yet");
-  throw InputError("effect '" + id + "'", "is not a catalogue effect");
+    if (m == name) throw InputError("effect '" + name + "'", "is in the catalogue but not implemented yet");
+  throw InputError("effect '" + name + "'", "is not a catalogue effect");
 }
 
-std::shared_ptr<const Effect> make_effect(const std::string& id, const EffectParameters& given,
-                                          const EffectContext& context) {
+std::shared_ptr<const Effect> make_effect(EffectId id, const EffectParameters& given, const EffectContext& context) {
   const EffectInfo& info = effect_info(id);
   EffectParameters p;
   for (const auto& pi : info.parameters) p[pi.name] = pi.neutral;
   for (const auto& [name, value] : given) {
-    auto it = std::find_if(info.parameters.begin(), info.parameters.end(), [&](const auto& pi) { return pi.name == name; });
-    if (it == info.parameters.end()) throw InputError("effect '" + id + "'", "has no parameter '" + name + "'");
+    auto it = std::find_if(info.parameters.begin(), info.parameters.end(), [&name = name](const auto& pi) { return pi.name == name; });
+    if (it == info.parameters.end()) throw InputError("effect '" + info.name + "'", "has no parameter '" + name + "'");
     if (!(value >= it->min && value <= it->max))
-      throw InputError("effect '" + id + "' parameter '" + name + "'",
+      throw InputError("effect '" + info.name + "' parameter '" + name + "'",
                        format_value(value) + " is not allowed: must be in [" + format_value(it->min) + ", " +
                            format_value(it->max) + "] " + it->unit);
     p[name] = value;
   }
-  if (id == "tyre_warmup") return std::make_shared<TyreWarmup>(p);
-  if (id == "aux_load") return std::make_shared<AuxLoad>(p);
-  if (id == "wind") return std::make_shared<Wind>(p, context);
-  if (id == "mass") return std::make_shared<Mass>(p, context);
-  if (id == "rr_speed") return std::make_shared<RrSpeed>(p);
-  if (id == "ambient_rrc") return std::make_shared<AmbientRrc>(p);
-  if (id == "rotational_inertia") return std::make_shared<RotationalInertia>(p);
-  if (id == "battery_resistance") return std::make_shared<BatteryResistance>(p);
-  if (id == "tyre_slip") return std::make_shared<TyreSlip>(p);
-  if (id == "regen_limit") return std::make_shared<RegenLimit>(p);
-  if (id == "engine_warmup") return std::make_shared<EngineWarmup>(p);
-  if (id == "road_grade") return std::make_shared<RoadGrade>(p, context);
-  throw InputError("effect '" + id + "'", "has no module");  // unreachable while the catalogue and this list agree
+  return info.make(p, context);
+}
+
+std::shared_ptr<const Effect> make_effect(const std::string& name, const EffectParameters& params, const EffectContext& context) {
+  return make_effect(effect_info(name).id, params, context);
 }
 
 std::vector<std::shared_ptr<const Effect>> load_effects(YamlMap effects, const EffectContext& context) {
   std::vector<std::shared_ptr<const Effect>> out;
   for (const auto& kv : effects.node()) {
-    const std::string id = kv.first.as<std::string>();
+    const std::string name = kv.first.as<std::string>();
+    const EffectInfo* info = nullptr;
     try {
-      effect_info(id);
+      info = &effect_info(name);
     } catch (const InputError& e) {
-      throw InputError(effects.where(id), e.problem());
+      throw InputError(effects.where(name), e.problem());
     }
-    YamlMap m = effects.map(id);
+    YamlMap m = effects.map(name);
     EffectParameters p;
-    for (const auto& pi : effect_info(id).parameters) {
+    for (const auto& pi : info->parameters) {
       if (auto v = m.optional_number(pi.name, Range::closed(pi.min, pi.max))) p[pi.name] = *v;
     }
     m.finish();
-    out.push_back(make_effect(id, p, context));
+    out.push_back(make_effect(info->id, p, context));
   }
   effects.finish();
   return out;

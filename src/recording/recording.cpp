@@ -185,7 +185,7 @@ ColumnMapping merge_mapping(ColumnMapping base, const ColumnMapping& overrides) 
 }
 
 Recording load_recording(const std::string& path, const ColumnMapping& mapping) {
-  const CsvTable table = read_csv(path);
+  const CsvTable table = read_csv(path, ',', kMaxRecordingSamples, "samples");
   const std::string found = "found columns: " + table.columns_list();
   const std::size_t n = table.rows.size();
 

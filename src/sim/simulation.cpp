@@ -492,6 +492,7 @@ SimulationResult simulate_forward(const VehicleModel& m, const DriveCycle& c, co
   std::size_t record_hint = 0;
   Shortfall open{};
   bool in_shortfall = false;
+  double standstill_brake_j = 0.0;  // kinetic energy braked away where a standstill segment starts
   auto record = [&](double t, const std::vector<double>& y) {
     const double target = c.speed_mps_at(t, record_hint);
     const double err = target - y[kSpeed];
@@ -553,7 +554,10 @@ SimulationResult simulate_forward(const VehicleModel& m, const DriveCycle& c, co
     } else if (t >= t_stop && t < t_end) {
       std::vector<double> y = integ.state();
       if (sys.standstill_segment(t)) {
-        y[kSpeed] = 0.0;  // stopped and braked: the driver releases the pedal
+        // Stopped and braked: the driver holds the car on its brakes. Whatever speed is left (the integration's
+        // error, or a car the trace left running) is braked away by friction, and booked so the balance closes.
+        standstill_brake_j += 0.5 * m.inertial_mass_kg() * y[kSpeed] * y[kSpeed];
+        y[kSpeed] = 0.0;
         y[kDriverIntegral] = 0.0;
       }
       // The demand jumps at a kink of the trace: choose the gear for the segment that starts here.
@@ -567,8 +571,9 @@ SimulationResult simulate_forward(const VehicleModel& m, const DriveCycle& c, co
   }
   if (in_shortfall) r.shortfalls.push_back(open);
   r.solver = integ.stats();
-  finish_result(m, c, integ.state()[kDistance], all_accumulators(integ.quadratures()).data(), c.speed_mps.front(),
-                integ.state()[kSpeed], r);
+  auto acc = all_accumulators(integ.quadratures());
+  acc[kFriction] += standstill_brake_j;
+  finish_result(m, c, integ.state()[kDistance], acc.data(), c.speed_mps.front(), integ.state()[kSpeed], r);
   return r;
 }
 

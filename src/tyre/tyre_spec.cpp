@@ -164,6 +164,7 @@ TyreSize parse_tyre_size(const std::string& designation, const std::string& wher
   c.skip_spaces();
   const std::string rim = c.number();
   if (rim.empty()) return fail("missing rim diameter in inches");
+  if (rim.size() > 5) return fail("rim diameter " + rim.substr(0, 8) + "... in is outside 8..30 in");
 
   out.section_width_m = std::stod(width) * units::kMPerMm;
   out.aspect_ratio = std::stod(aspect) / 100.0;

@@ -77,6 +77,7 @@ ElectricPowertrainParams read_electric(YamlMap& pt) {
     p.motor.max_torque_nm = m.number("max_torque_nm", Range::positive());
     p.motor.max_power_w = m.number("max_power_kw", Range::positive()) * 1e3;
     p.motor.max_speed_radps = m.number("max_speed_rpm", Range::positive()) * kRadPerSPerRpm;
+    p.motor.speed_limit_band_fraction = m.number_or("speed_limit_band_pct", 3.0, Range::closed(0.0, 50.0)) / 100.0;
     p.motor.losses.copper_w_per_nm2 = m.number("copper_loss_w_per_nm2", Range::non_negative());
     p.motor.losses.iron_w_s_per_rad = m.number("iron_loss_w_per_radps", Range::non_negative());
     p.motor.losses.windage_w_s3_per_rad3 = m.number_or("windage_loss_w_per_radps3", 0.0, Range::non_negative());
@@ -213,6 +214,7 @@ Vehicle load_vehicle_file(const std::string& path) {
   // A vehicle may name its logger's columns; the recording module reads these blocks (rollsim diagnose).
   root.accept("recording_columns");
   root.accept("recording_scale");
+  root.accept("calibration_priors");  // read by the diagnosis (calibration_priors_from_yaml)
   root.finish();
 
   check_tyre_loads(v, path);

@@ -5,11 +5,33 @@
 #include <vector>
 
 #include "rollsim/cycle/drive_cycle.hpp"
+#include "rollsim/common/yaml_reader.hpp"
 #include "rollsim/effects/catalogue.hpp"
 #include "rollsim/recording/recording.hpp"
 #include "rollsim/vehicle/vehicle.hpp"
 
 namespace rollsim {
+
+/// The measured energy channel a recording carries (the first present, in this order).
+enum class ChannelKind { battery_power, battery_voltage_x_current, fuel_rate, soc };
+std::string to_string(ChannelKind k);
+
+/// Physical priors of the calibration, per channel kind (docs/diagnose.md, "Calibration with priors"). The channel
+/// scale is bounded (a hard box about 1): a battery's terminal voltage and current, or a dynamometer's direct fuel
+/// meter, are calibrated to a few per cent; a state of charge carries the usable capacity's uncertainty. RRC level
+/// and aero C carry Gaussian penalties at their published uncertainty. Settable in a vehicle file's
+/// `calibration_priors:` block (calibration_priors_from_yaml).
+struct CalibrationPriors {
+  double terminal_scale_bound = 0.05;  ///< battery power, or voltage x current: scale within 1 +- this
+  double fuel_scale_bound = 0.05;      ///< direct fuel flow
+  double soc_scale_bound = 0.10;       ///< state of charge: usable capacity +- 10 %
+  double rrc_level_sd = 0.15;          ///< RRC level: tyre label class width, pressure, road surface
+  double drag_sd = 0.15;               ///< aero C: coast-down repeatability, CdA from published figures
+  double scale_bound(ChannelKind k) const;
+};
+/// Reads a vehicle file's optional `calibration_priors:` block (keys as the fields above, fractions), marking it
+/// read on `file`; errors name the file and key.
+CalibrationPriors calibration_priors_from_yaml(YamlMap& file);
 
 /// Fixed in advance (not tuned per recording), so that the null case's false-discovery rate is what it is.
 struct DiagnoseOptions {
@@ -19,7 +41,15 @@ struct DiagnoseOptions {
   double bic_threshold = 10.0;     ///< "very strong" evidence on the Kass-Raftery scale
   double collinear_corr = 0.9;     ///< |corr| of calibration-cleaned signatures above which effects are confounded
   int max_effects = 2;
-  double calibration_prior_fraction = 0.15;  ///< prior sd of the RRC-level and aero-C calibration changes
+  CalibrationPriors priors;
+  /// Adequacy against the recording's own noise: the noise floor comes from windows of this length (their
+  /// successive differences), and the residual is tested against it aggregated at each of the scales below.
+  double noise_window_s = 10.0;
+  std::vector<double> adequacy_scales_s{30.0, 60.0, 120.0, 300.0};
+  double adequacy_z = 3.3;          ///< one-sided, per scale (about 0.05 % each)
+  double adequacy_min_ratio = 2.0;  ///< and at least this variance ratio over the floor
+  /// A standing residual counts as an auxiliary load's evidence at this BIC-equivalent (z^2 - ln n_eff).
+  double standing_bic_threshold = 10.0;
   /// SOC channels: windows are lengthened until the SOC quantisation error of a window's energy (sd q / sqrt 6
   /// for two quantised readings) is at most this fraction of the mean window energy.
   double soc_quantisation_fraction = 0.02;
@@ -110,11 +140,22 @@ struct Diagnosis {
   int windows = 0;
   double effective_windows = 0.0;
   double lag1_autocorrelation = 0.0;
-  int lag_samples = 0;                     ///< calibration: measured channel lag behind the model, samples
+  int lag_samples = 0;                     ///< calibration: the lag rounded to whole samples
+  double lag_s = 0.0, lag_ci_low_s = 0.0, lag_ci_high_s = 0.0;  ///< continuous lag and its 95 % profile interval
   double raw_trip_energy_error_pct = 0.0;  ///< uncalibrated model against measured, whole data
   double channel_scale = 1.0;              ///< calibration: measured / simulated
   double rrc_level_change = 0.0;           ///< calibration: fractional RRC change
   double drag_change = 0.0;                ///< calibration: fractional aero (C term) change
+  /// The channel scale's prior (a box) and what the data alone wanted; outside, the scale is held at the bound and
+  /// the energy it would have absorbed is left for the effects (and reported in a finding).
+  double channel_scale_prior_low = 0.0, channel_scale_prior_high = 0.0;
+  double channel_scale_free = 1.0;
+  bool channel_scale_outside_prior = false;
+  double scale_absorbed_energy_pct = 0.0;  ///< of the measured energy
+  /// Adequacy: the calibrated residual's variance over the noise floor at the worst scale, and that scale.
+  double noise_floor_j = 0.0;              ///< sd of one noise window's energy (successive differences)
+  double residual_to_noise_ratio = 0.0, residual_to_noise_z = 0.0, adequacy_scale_s = 0.0;
+  double final_residual_to_noise_ratio = 0.0, final_residual_to_noise_z = 0.0;  ///< after the findings
   double heldout_rmse_calibrated_j = 0.0;
   double heldout_energy_error_pct_calibrated = 0.0;
   std::vector<Finding> findings;
@@ -141,21 +182,5 @@ std::string diagnosis_text(const Diagnosis& d);
 
 /// The vehicle file at `vehicle_path` with an `effects:` block holding the findings' fitted effects.
 std::string fitted_vehicle_yaml(const std::string& vehicle_path, const Diagnosis& d);
-
-/// Synthetic recording with a concealed effect, for the proof. The truth uses its own models (a two-node tyre
-/// thermal network with an exponential RRC law), never the catalogue's modules.
-struct SyntheticOptions {
-  std::string cycle = "wltc";
-  int repeats = 2;
-  double tyre_cold_excess = 0.0;   ///< truth's RRC excess of a cold tyre (0: null recording)
-  double rrc_level_jitter = 0.03;  ///< truth's RRC level, uniform +- (calibration, not a discovery)
-  double scale_jitter = 0.02;      ///< measured channel scale, uniform +-
-  double noise_w = 400.0;          ///< white sensor noise, standard deviation
-  double quantum_w = 100.0;        ///< logger quantisation
-  double lag_s = 1.0;              ///< channel lag
-  bool time_reversed = false;      ///< the truth's warm-up decay placed at the end of the trip (a null)
-  unsigned seed = 1;
-};
-Recording generate_recording(const Vehicle& vehicle, const SyntheticOptions& opt);
 
 }  // namespace rollsim

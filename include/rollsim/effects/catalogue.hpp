@@ -1,6 +1,7 @@
 // Catalogue of physical effects beyond the base model (tyre warm-up, auxiliary load, wind, ...), each a sim Effect.
 #pragma once
 
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -11,13 +12,29 @@
 
 namespace rollsim {
 
+/// The implemented effects. Adding one: its module and its one registry row in catalogue.cpp.
+enum class EffectId {
+  tyre_warmup,
+  aux_load,
+  wind,
+  mass,
+  rr_speed,
+  ambient_rrc,
+  rotational_inertia,
+  battery_resistance,
+  tyre_slip,
+  regen_limit,
+  engine_warmup,
+  road_grade,
+};
+
 /// What an effect needs to know about the car it is fitted to (set from the vehicle description).
 struct EffectContext {
   double mass_kg = 0.0;            ///< test mass (the mass effect's rolling share is scaled from it)
   double rho_cda_kg_per_m = 0.0;   ///< air density x drag area (2 x coast-down C for coast-down vehicles)
 };
 
-/// One parameter of a catalogue effect, with its unit, neutral value and allowed bounds.
+/// One parameter of a catalogue effect, with its unit, neutral value and allowed (physical) bounds.
 struct EffectParameterInfo {
   std::string name;        ///< YAML key, e.g. "cold_rrc_excess"
   std::string unit;        ///< "1", "W", "m/s", "kg", "J/K", ...
@@ -28,23 +45,34 @@ struct EffectParameterInfo {
   bool amplitude = false;  ///< the effect's size (fitted linearly); otherwise a shape parameter
 };
 
+using EffectParameters = std::map<std::string, double>;
+using EffectFactory = std::function<std::shared_ptr<const Effect>(const EffectParameters&, const EffectContext&)>;
+
+/// One registry row: metadata and factory together.
 struct EffectInfo {
-  std::string id;
+  EffectId id{};
+  std::string name;         ///< identifier in files and reports, e.g. "tyre_warmup"
   std::string description;
   std::vector<EffectParameterInfo> parameters;
+  /// What a signature of this effect's shape with the physically impossible sign describes (the amplitude's
+  /// bounds carry the sign: a warm-up makes the start costlier, a load draws power, a payload adds mass).
+  std::string opposite_sign;
+  EffectFactory make;       ///< from a complete, checked parameter set
+  const EffectParameterInfo& amplitude() const;
 };
 
-/// The implemented effects, in a stable order.
+/// The implemented effects, in a stable order (the enum's).
 const std::vector<EffectInfo>& effect_catalogue();
 /// Catalogue identifiers the issue lists that have no module yet (documented in docs/diagnose.md).
 const std::vector<std::string>& effects_not_implemented();
-const EffectInfo& effect_info(const std::string& id);  ///< throws InputError for an unknown id
-
-using EffectParameters = std::map<std::string, double>;
+const EffectInfo& effect_info(EffectId id);
+const EffectInfo& effect_info(const std::string& name);  ///< throws InputError for an unknown name
+const std::string& to_string(EffectId id);
 
 /// Builds one effect; missing parameters take their neutral (or default) value; throws InputError on an unknown
 /// id or parameter, or a value out of bounds.
-std::shared_ptr<const Effect> make_effect(const std::string& id, const EffectParameters& params,
+std::shared_ptr<const Effect> make_effect(EffectId id, const EffectParameters& params, const EffectContext& context);
+std::shared_ptr<const Effect> make_effect(const std::string& name, const EffectParameters& params,
                                           const EffectContext& context);
 
 /// Reads a vehicle file's `effects:` block ({id: {param: value}}), strictly.

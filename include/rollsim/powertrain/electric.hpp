@@ -20,6 +20,11 @@ struct ElectricMotorParams {
   double max_torque_nm = 0.0;
   double max_power_w = 0.0;        ///< continuous-peak mechanical power, both directions
   double max_speed_radps = 0.0;
+  /// Speed limiter: over the top band of speed, [1 - band, 1] x max_speed, the controller derates the torque
+  /// limit linearly to zero at max_speed (a governor's taper). The force the motor can give is then continuous
+  /// in speed: a car at its top speed settles where force meets road load, instead of switching between full
+  /// force and none at max_speed, which no error-controlled integrator can step over.
+  double speed_limit_band_fraction = 0.03;
   MotorLossParams losses;
 };
 
@@ -68,6 +73,8 @@ class ElectricPowertrain final : public Powertrain {
 
  private:
   double motor_loss_w(double torque_nm, double speed_radps) const;
+  /// The speed limiter's factor on the torque limit at this motor speed: 1 below the band, 0 at max speed.
+  double speed_limit_factor(double speed_radps) const;
   ElectricPowertrainParams p_;
 };
 

@@ -1,5 +1,5 @@
 // Synthetic recordings with concealed effects: each truth is a richer model than the catalogue's, on its own code.
-#include "rollsim/diagnose/generate.hpp"
+#include "rollsim/discovery/generate.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +8,6 @@
 #include "rollsim/common/error.hpp"
 #include "rollsim/common/units.hpp"
 #include "rollsim/cycle/drive_cycle.hpp"
-#include "rollsim/diagnose/diagnose.hpp"
 #include "rollsim/sim/simulation.hpp"
 
 namespace rollsim {

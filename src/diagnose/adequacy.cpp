@@ -1,0 +1,189 @@
+// Diagnosis stage 7: adequacy against the recording's own noise. The noise floor comes from short windows'
+// successive differences (a slowly varying model error cancels in them, noise does not); the residual, aggregated
+// over longer blocks, is compared with the floor scaled to each block's duration (white at the short scale). Noise
+// correlated over a few samples (lag jitter, a SOC quantum) telescopes in longer blocks, so the test is conservative.
+#include <algorithm>
+#include <cmath>
+
+#include "pipeline.hpp"
+
+namespace rollsim::diag {
+namespace {
+
+struct Block {
+  std::size_t rec = 0;
+  double start_s = 0.0, end_s = 0.0, residual_j = 0.0, distance_start_m = 0.0, distance_end_m = 0.0;
+};
+
+// Consecutive windows of each recording summed into blocks of at least `scale_s` (a last one of half kept).
+std::vector<Block> blocks_of(const Observations& o, const std::vector<Recording>& recs, const Eigen::VectorXd& resid,
+                             double scale_s) {
+  std::vector<Block> out;
+  std::vector<std::vector<double>> dist(recs.size());
+  for (std::size_t r = 0; r < recs.size(); ++r) {
+    dist[r].assign(recs[r].time_s.size(), 0.0);
+    for (std::size_t i = 1; i < dist[r].size(); ++i)
+      dist[r][i] = dist[r][i - 1] + 0.5 * (recs[r].speed_mps[i] + recs[r].speed_mps[i - 1]) * (recs[r].time_s[i] - recs[r].time_s[i - 1]);
+  }
+  Block cur;
+  bool open = false;
+  auto close = [&] {
+    if (open && cur.end_s - cur.start_s >= 0.5 * scale_s) out.push_back(cur);
+    open = false;
+  };
+  for (Eigen::Index w = 0; w < o.n(); ++w) {
+    const Window& win = o.windows[static_cast<std::size_t>(w)];
+    const Recording& r = recs[win.rec];
+    if (open && cur.rec != win.rec) close();
+    if (!open) {
+      cur = {win.rec, r.time_s[win.begin] - r.time_s.front(), 0.0, 0.0, dist[win.rec][win.begin], 0.0};
+      open = true;
+    }
+    cur.end_s = r.time_s[win.end] - r.time_s.front();
+    cur.distance_end_m = dist[win.rec][win.end];
+    cur.residual_j += resid[w];
+    if (cur.end_s - cur.start_s >= scale_s - 1e-9) close();
+  }
+  close();
+  return out;
+}
+
+}  // namespace
+
+NoiseFloor noise_floor(const Observations& short_obs, const Eigen::VectorXd& resid) {
+  NoiseFloor f;
+  double sum = 0.0, seconds = 0.0;
+  int pairs = 0;
+  for (Eigen::Index k = 1; k < short_obs.n(); ++k) {
+    const Window& a = short_obs.windows[static_cast<std::size_t>(k - 1)];
+    const Window& b = short_obs.windows[static_cast<std::size_t>(k)];
+    if (a.rec != b.rec) continue;
+    const double d = resid[k] - resid[k - 1];
+    sum += 0.5 * d * d;
+    double t = 0.0;
+    for (std::size_t i = a.begin; i < b.end; ++i) t += short_obs.dt_s[a.rec][i];
+    seconds += 0.5 * t;
+    ++pairs;
+  }
+  if (pairs == 0 || !(seconds > 0.0)) return f;
+  f.variance_per_s = sum / seconds;  // variance of a window's noise energy, per second of window (white)
+  f.pairs = pairs;
+  f.window_s = short_obs.window_s;
+  return f;
+}
+
+Adequacy test_adequacy(const Observations& o, const std::vector<Recording>& recs, const Eigen::VectorXd& resid,
+                       const NoiseFloor& nf, const DiagnoseOptions& opt) {
+  Adequacy best;
+  if (!(nf.variance_per_s > 0.0)) return best;
+  for (double scale : opt.adequacy_scales_s) {
+    const std::vector<Block> blocks = blocks_of(o, recs, resid, std::max(scale, o.window_s));
+    if (blocks.size() < 4) continue;
+    double ss = 0.0, expected = 0.0;
+    for (const auto& b : blocks) {
+      ss += b.residual_j * b.residual_j;
+      expected += nf.variance_per_s * (b.end_s - b.start_s);
+    }
+    const double ratio = ss / expected;
+    // ln ratio under noise alone: chi^2 over the blocks, and the floor's own estimate (successive differences, about
+    // 2/3 efficient): variance 2 / blocks + 3 / pairs.
+    const double z = std::log(ratio) / std::sqrt(2.0 / static_cast<double>(blocks.size()) + 3.0 / nf.pairs);
+    if (z <= best.z) continue;
+    best.z = z;
+    best.ratio = ratio;
+    best.scale_s = std::max(scale, o.window_s);
+    best.inadequate = z >= opt.adequacy_z && ratio >= opt.adequacy_min_ratio;
+    // Where: the blocks beyond three noise sds.
+    best.flagged = 0;
+    best.blocks = static_cast<int>(blocks.size());
+    best.flagged_j = 0.0;
+    best.first_s = 1e300, best.last_s = 0.0, best.first_m = 1e300, best.last_m = 0.0;
+    double moving_s = 0.0, moving_m = 0.0;
+    for (const auto& b : blocks) {
+      if (std::abs(b.residual_j) <= 3.0 * std::sqrt(nf.variance_per_s * (b.end_s - b.start_s))) continue;
+      ++best.flagged;
+      best.flagged_j += b.residual_j;
+      best.first_s = std::min(best.first_s, b.start_s);
+      best.last_s = std::max(best.last_s, b.end_s);
+      best.first_m = std::min(best.first_m, b.distance_start_m);
+      best.last_m = std::max(best.last_m, b.distance_end_m);
+      moving_s += b.end_s - b.start_s;
+      moving_m += b.distance_end_m - b.distance_start_m;
+    }
+    best.flagged_mean_speed_mps = moving_s > 0.0 ? moving_m / moving_s : 0.0;
+  }
+  return best;
+}
+
+// The residual left above the noise floor, in words: how far above, where, and how much energy.
+Finding adequacy_finding(const Adequacy& a, const NoiseFloor& nf, const Observations& o, const std::vector<RegimeResidual>& located) {
+  Finding f;
+  f.effect = "unexplained";
+  f.delta_bic = 0.0;
+  const double total_j = std::max(1e-9, std::abs(o.measured_j.sum()));
+  f.description = "the residual is " + fixed(a.ratio, 1) + " times the recording's own noise floor (variance, over " +
+                  fixed(a.scale_s, 0) + " s blocks; floor " + fixed(std::sqrt(nf.variance_per_s * nf.window_s) / 1e3, 2) +
+                  " kJ per " + fixed(nf.window_s, 0) + " s, z " + fixed(a.z, 1) + "), and no catalogue effect explains it";
+  if (a.flagged > 0)
+    f.description += ": " + std::to_string(a.flagged) + " of " + std::to_string(a.blocks) + " blocks beyond 3 noise sd, between " +
+                     fixed(a.first_s / 60.0, 0) + " and " + fixed(a.last_s / 60.0, 0) + " min since the start (" +
+                     fixed(a.first_m / 1e3, 1) + "-" + fixed(a.last_m / 1e3, 1) + " km), at a mean " +
+                     fixed(a.flagged_mean_speed_mps * 3.6, 0) + " km/h, net " + fixed(a.flagged_j / 1e3, 0) + " kJ (" +
+                     fixed(100.0 * a.flagged_j / total_j, 1) + " % of the measured energy)";
+  // The regime whose mean residual is furthest from zero, in units of its interval.
+  const RegimeResidual* worst = nullptr;
+  double worst_z = 2.0;
+  for (const auto& l : located) {
+    const double half = 0.5 * (l.ci_high_w - l.ci_low_w);
+    const double z = half > 0.0 ? std::abs(l.mean_w) / (half / 1.96) : 0.0;
+    if (z > worst_z) worst_z = z, worst = &l;
+  }
+  if (worst)
+    f.description += "; most in regime '" + worst->regime + "': " + fixed(worst->mean_w, 0) + " W [" + fixed(worst->ci_low_w, 0) +
+                     ", " + fixed(worst->ci_high_w, 0) + "]";
+  f.parameters.push_back({"residual_to_noise_variance_ratio", "1", a.ratio, a.ratio, a.ratio});
+  f.parameters.push_back({"flagged_energy_j", "J", a.flagged_j, a.flagged_j, a.flagged_j});
+  return f;
+}
+
+}  // namespace rollsim::diag
+
+namespace rollsim::diag {
+
+// The calibrated model's residual on short windows, and the floor from it.
+NoiseFloor calibrated_noise_floor(const Observations& o, const std::vector<Recording>& recs, const Signatures& s,
+                                  const Calibration& cal, double lag_samples, const DiagnoseOptions& opt) {
+  const Observations shortw = rewindow(o, recs, std::min(opt.noise_window_s, o.window_s));
+  if (shortw.n() < 4) return {};
+  const Eigen::VectorXd& k = cal.model.fit.coef;
+  const Eigen::VectorXd b = window_energies(s.base.power_w, shortw, lag_samples);
+  const Eigen::VectorXd sim = k[0] * b + k[1] * (window_energies(s.rrc.power_w, shortw, lag_samples) - b) +
+                              k[2] * (window_energies(s.drag.power_w, shortw, lag_samples) - b);
+  return noise_floor(shortw, shortw.measured_j - sim);
+}
+
+}  // namespace rollsim::diag
+
+namespace rollsim::diag {
+
+// The model's residual with its calibration (scale, RRC level, aero C) free per recording: across trips these
+// scatter (tyre pressure, the day's weather, a logger's gain) without any physics missing, so the adequacy test
+// must not take that scatter for a missing effect. The effects found stay shared.
+Eigen::VectorXd per_recording_residual(const Model& m, const Observations& o, std::size_t recordings) {
+  if (recordings < 2) return *m.y - m.x * m.fit.coef;
+  const auto nr = static_cast<Eigen::Index>(recordings), n = o.n(), rest = m.x.cols() - 3;
+  Eigen::MatrixXd x = Eigen::MatrixXd::Zero(n, 3 * nr + rest);
+  for (Eigen::Index w = 0; w < n; ++w) {
+    const auto r = static_cast<Eigen::Index>(o.windows[static_cast<std::size_t>(w)].rec);
+    for (Eigen::Index c = 0; c < 3; ++c) x(w, c * nr + r) = m.x(w, c);
+  }
+  x.rightCols(rest) = m.x.rightCols(rest);
+  Prior p;
+  for (Eigen::Index r = 0; r < nr; ++r) {
+    p.rows.push_back({nr + r, m.prior.rows[0].weight, 0.0});
+    p.rows.push_back({2 * nr + r, m.prior.rows[1].weight, 0.0});
+  }
+  return *m.y - x * least_squares(x, *m.y, p).coef;
+}
+
+}  // namespace rollsim::diag

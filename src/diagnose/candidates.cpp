@@ -1,0 +1,186 @@
+// Diagnosis stage 4: candidate signatures: each catalogue effect's (and the unexplained basis') change in window
+// energy per unit size, from the full simulator with the effect on.
+#include <algorithm>
+#include <cmath>
+
+#include "pipeline.hpp"
+
+namespace rollsim::diag {
+namespace {
+
+// Calibration signature of the aero (C) term: a force k * 0.5 rho CdA v^2 (k = fractional change).
+class DragScale final : public Effect {
+ public:
+  DragScale(double k, double rho_cda) : k_(k), half_rho_cda_(0.5 * rho_cda) {}
+  std::string id() const override { return "calibration_drag"; }
+  double extra_resistance_n(const EffectInputs& in, const double*) const override {
+    const double v = std::max(in.speed_mps, 0.0);
+    return k_ * half_rho_cda_ * v * v;
+  }
+
+ private:
+  double k_, half_rho_cda_;
+};
+
+// Calibration signature of the RRC level: a constant factor on rolling resistance.
+class RrcLevel final : public Effect {
+ public:
+  explicit RrcLevel(double k) : k_(k) {}
+  std::string id() const override { return "calibration_rrc"; }
+  double rolling_resistance_factor(const EffectInputs&, const double*) const override { return 1.0 + k_; }
+
+ private:
+  double k_;
+};
+
+// Basis of the unexplained-residual description (not a catalogue effect): a force of one shape, per unit
+// amplitude, optionally decaying from the start of the trip. Run through the simulator so that the powertrain's
+// efficiency, regen and fuel cut weigh it as they would weigh a real force.
+class SignatureForce final : public Effect {
+ public:
+  SignatureForce(ForceShape shape, double decay_s) : shape_(shape), decay_s_(decay_s) {}
+  std::string id() const override { return "signature_force"; }
+  double extra_resistance_n(const EffectInputs& in, const double*) const override {
+    constexpr double kV100 = 100.0 / 3.6;
+    const double v = std::max(in.speed_mps, 0.0);
+    double f = 0.0;
+    switch (shape_) {
+      case ForceShape::constant: f = v > 0.1 ? 1.0 : 0.0; break;  // 1 N while moving
+      case ForceShape::speed: f = v / kV100; break;               // 1 N at 100 km/h
+      case ForceShape::speed_squared: f = (v / kV100) * (v / kV100); break;
+      case ForceShape::positive_accel: f = std::max(in.accel_mps2, 0.0); break;  // 1 kg x a
+    }
+    return decay_s_ > 0.0 ? f * std::exp(-in.time_s / decay_s_) : f;
+  }
+
+ private:
+  ForceShape shape_;
+  double decay_s_;
+};
+
+// Shapes tested for each effect: hidden-state effects one per time constant (refined by a profile once found).
+std::vector<EffectParameters> shapes_of(const EffectInfo& info) {
+  if (info.id == EffectId::tyre_warmup)
+    return {{{"heat_capacity_j_per_k", 20000.0}}, {{"heat_capacity_j_per_k", 50000.0}}, {{"heat_capacity_j_per_k", 120000.0}}};
+  if (info.id == EffectId::engine_warmup) return {{{"heat_capacity_j_per_k", 100000.0}}};
+  return {{}};
+}
+
+}  // namespace
+
+std::shared_ptr<const Effect> signature_force(ForceShape shape, double decay_s) {
+  return std::make_shared<SignatureForce>(shape, decay_s);
+}
+
+std::shared_ptr<const Effect> drag_scale(double k, double rho_cda) { return std::make_shared<DragScale>(k, rho_cda); }
+
+Eigen::VectorXd power_signature(const Observations& o, const std::vector<DriveCycle>& cycles, double decay_s) {
+  Eigen::VectorXd sig(o.n());
+  for (Eigen::Index w = 0; w < o.n(); ++w) {
+    const auto& win = o.windows[static_cast<std::size_t>(w)];
+    double e = 0.0;
+    for (std::size_t i = win.begin; i < win.end; ++i)
+      e += (decay_s > 0.0 ? std::exp(-cycles[win.rec].time_s[i] / decay_s) : 1.0) * o.dt_s[win.rec][i];
+    sig[w] = e;
+  }
+  return sig;
+}
+
+// Ambient temperature on RRC moves the RRC level from trip to trip, never within one: within one trip it is the
+// RRC level (a calibration quantity). It is a candidate only across recordings whose recorded ambients differ.
+AmbientSetting ambient_setting(const std::vector<Recording>& recordings, const DiagnoseOptions& opt, std::vector<std::string>& notes) {
+  AmbientSetting a;
+  if (recordings.size() < 2) {
+    notes.push_back("ambient_rrc not tested: one recording (within one trip it is the RRC level, a calibration quantity)");
+    return a;
+  }
+  if (!std::all_of(recordings.begin(), recordings.end(), [](const Recording& r) { return r.ambient_temp_k.has_value(); })) {
+    notes.push_back("ambient_rrc not tested: not every recording has an ambient_temp_c column");
+    return a;
+  }
+  for (const auto& r : recordings) {
+    double sum = 0.0;
+    for (double t : *r.ambient_temp_k) sum += t;
+    a.ambient_k.push_back(sum / static_cast<double>(std::max<std::size_t>(1, r.ambient_temp_k->size())));
+  }
+  const auto [lo, hi] = std::minmax_element(a.ambient_k.begin(), a.ambient_k.end());
+  a.testable = *hi - *lo >= opt.ambient_min_spread_k;
+  notes.push_back(a.testable ? "ambient_rrc tested across " + std::to_string(recordings.size()) + " recordings at " +
+                                   fixed(*lo - 273.15, 1) + " to " + fixed(*hi - 273.15, 1) + " degC (one shared RRC level)"
+                             : "ambient_rrc not tested: recorded ambients span " + fixed(*hi - *lo, 1) + " K, under " +
+                                   fixed(opt.ambient_min_spread_k, 1) + " K (the recordings are at the same ambient)");
+  // Reference: the recordings' mean ambient, so that the ambient signature is nearly orthogonal to the shared RRC
+  // level (whose prior would otherwise push a level offset into the unpenalised ambient coefficient).
+  for (double t : a.ambient_k) a.reference_k += t / static_cast<double>(a.ambient_k.size());
+  return a;
+}
+
+Signatures compute_signatures(const Replayer& rp, const Observations& o, const Variant& base, double lag_samples,
+                              const AmbientSetting& amb, const EffectContext& ctx, const DiagnoseOptions& opt) {
+  Signatures s;
+  s.base = base;
+  std::vector<EffectList> extras{{std::make_shared<RrcLevel>(0.1)}, {std::make_shared<DragScale>(0.1, ctx.rho_cda_kg_per_m)}};
+  std::vector<double> nominal_of_run;
+  for (const auto& info : effect_catalogue()) {
+    const EffectParameterInfo& amp = info.amplitude();
+    if (info.id == EffectId::ambient_rrc) {
+      if (!amb.testable) continue;
+      Candidate c;
+      c.id = info.id;
+      c.label = info.name;
+      c.shape = {{"reference_temp_c", amb.reference_k - 273.15}, {"ambient_temp_c", amb.reference_k - 273.15}};
+      c.amplitude = &amp;
+      c.across_trips = true;
+      s.candidates.push_back(std::move(c));
+      continue;
+    }
+    for (const auto& shape : shapes_of(info)) {
+      Candidate c;
+      c.id = info.id;
+      c.shape = shape;
+      c.amplitude = &amp;
+      c.label = info.name;
+      for (const auto& [k, v] : shape) c.label += " (" + k + " " + num(v) + ")";
+      EffectParameters p = shape;
+      p[amp.name] = amp.nominal;
+      extras.push_back({make_effect(info.id, p, ctx)});
+      s.candidates.push_back(std::move(c));
+    }
+  }
+  std::vector<double> decays{0.0};
+  decays.insert(decays.end(), opt.unexplained_decay_s.begin(), opt.unexplained_decay_s.end());
+  for (double tau : decays) {
+    for (ForceShape fs : {ForceShape::constant, ForceShape::speed, ForceShape::speed_squared, ForceShape::positive_accel}) {
+      s.basis.push_back({BasisShape::force, fs, tau, {}});
+      extras.push_back({signature_force(fs, tau)});
+    }
+    s.basis.push_back({BasisShape::power, ForceShape::constant, tau, {}});  // computed directly, no simulation
+  }
+  std::vector<Variant> vars = rp.run(extras, o, lag_samples);
+  s.rrc = std::move(vars[0]);
+  s.drag = std::move(vars[1]);
+  std::size_t k = 2;
+  std::vector<Candidate> kept;
+  for (auto& c : s.candidates) {
+    if (c.across_trips) {
+      // RRC factor 1 + c (T_ref - T_r) on recording r: per unit c, (T_ref - T_r) times the RRC-level signature
+      // (the variant is +10 % RRC; rolling energy is linear in the RRC factor to first order).
+      c.signature.resize(o.n());
+      for (Eigen::Index w = 0; w < o.n(); ++w)
+        c.signature[w] = (amb.reference_k - amb.ambient_k[o.windows[static_cast<std::size_t>(w)].rec]) *
+                         (s.rrc.window_j[w] - base.window_j[w]) / 0.1;
+      kept.push_back(std::move(c));
+      continue;
+    }
+    c.signature = (vars[k++].window_j - base.window_j) / c.amplitude->nominal;
+    if (c.signature.norm() > 0.0) kept.push_back(std::move(c));
+  }
+  s.candidates = std::move(kept);
+  for (auto& b : s.basis) {
+    b.signature = b.kind == BasisShape::force ? Eigen::VectorXd(vars[k++].window_j - base.window_j)
+                                              : power_signature(o, rp.cycles, b.decay_s);
+  }
+  return s;
+}
+
+}  // namespace rollsim::diag

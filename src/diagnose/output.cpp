@@ -1,0 +1,187 @@
+// Diagnosis output: the JSON and text reports, and the vehicle file with the fitted effects.
+#include <fstream>
+#include <sstream>
+
+#include "pipeline.hpp"
+#include "rollsim/common/error.hpp"
+
+namespace rollsim {
+
+namespace diag {
+
+std::string num(double v) {
+  std::ostringstream os;
+  os.precision(6);
+  os << v;
+  return os.str();
+}
+
+std::string fixed(double v, int digits) {
+  std::ostringstream os;
+  os.setf(std::ios::fixed);
+  os.precision(digits);
+  os << v;
+  return os.str();
+}
+
+}  // namespace diag
+
+using diag::num;
+
+namespace {
+std::string json_escape(const std::string& s) {
+  std::string o;
+  for (char c : s) {
+    if (c == '"' || c == '\\') o += '\\';
+    if (c == '\n') { o += "\\n"; continue; }
+    o += c;
+  }
+  return o;
+}
+}  // namespace
+
+std::string diagnosis_json(const Diagnosis& d) {
+  std::ostringstream os;
+  os << "{\n  \"verdict\": \"" << d.verdict << "\",\n  \"channel\": \"" << d.channel << "\",\n";
+  os << "  \"windows\": " << d.windows << ",\n  \"effective_windows\": " << num(d.effective_windows) << ",\n";
+  os << "  \"calibration\": {\"channel_scale\": " << num(d.channel_scale) << ", \"rrc_level_change\": " << num(d.rrc_level_change)
+     << ", \"drag_change\": " << num(d.drag_change) << ", \"channel_scale_prior\": {\"low\": " << num(d.channel_scale_prior_low)
+     << ", \"high\": " << num(d.channel_scale_prior_high) << "}, \"channel_scale_free\": " << num(d.channel_scale_free)
+     << ", \"channel_scale_outside_prior\": " << (d.channel_scale_outside_prior ? "true" : "false")
+     << ", \"scale_absorbed_energy_pct\": " << num(d.scale_absorbed_energy_pct) << "},\n";
+  os << "  \"adequacy\": {\"noise_floor_j\": " << num(d.noise_floor_j) << ", \"residual_to_noise_ratio\": "
+     << num(d.residual_to_noise_ratio) << ", \"z\": " << num(d.residual_to_noise_z) << ", \"scale_s\": " << num(d.adequacy_scale_s)
+     << ", \"after_findings_ratio\": " << num(d.final_residual_to_noise_ratio) << ", \"after_findings_z\": "
+     << num(d.final_residual_to_noise_z) << "},\n";
+  os << "  \"lag_samples\": " << d.lag_samples << ",\n";
+  os << "  \"lag_s\": {\"value\": " << num(d.lag_s) << ", \"ci_low\": " << num(d.lag_ci_low_s) << ", \"ci_high\": " << num(d.lag_ci_high_s) << "},\n";
+  os << "  \"window_s\": " << num(d.window_s) << ",\n  \"notes\": [";
+  for (std::size_t i = 0; i < d.notes.size(); ++i) os << (i ? ", " : "") << "\"" << json_escape(d.notes[i]) << "\"";
+  os << "],\n";
+  os << "  \"raw_trip_energy_error_pct\": " << num(d.raw_trip_energy_error_pct) << ",\n";
+  os << "  \"heldout_rmse_calibrated\": " << num(d.heldout_rmse_calibrated_j) << ",\n";
+  os << "  \"heldout_energy_error_pct_calibrated\": " << num(d.heldout_energy_error_pct_calibrated) << ",\n";
+  os << "  \"findings\": [";
+  for (std::size_t i = 0; i < d.findings.size(); ++i) {
+    const auto& f = d.findings[i];
+    os << (i ? "," : "") << "\n    {\"effect\": \"" << f.effect << "\", ";
+    if (!f.description.empty()) os << "\"description\": \"" << json_escape(f.description) << "\", ";
+    os << "\"parameters\": {";
+    for (std::size_t k = 0; k < f.parameters.size(); ++k) {
+      const auto& p = f.parameters[k];
+      os << (k ? ", " : "") << "\"" << p.name << "\": {\"value\": " << num(p.value) << ", \"ci_low\": " << num(p.ci_low)
+         << ", \"ci_high\": " << num(p.ci_high) << ", \"unit\": \"" << p.unit << "\"";
+      if (p.profiled)
+        os << ", \"interval\": \"profile\", \"ci_low_open\": " << (p.ci_low_open ? "true" : "false")
+           << ", \"ci_high_open\": " << (p.ci_high_open ? "true" : "false");
+      os << "}";
+    }
+    os << "}, \"confounded_with\": [";
+    for (std::size_t k = 0; k < f.confounded_with.size(); ++k) os << (k ? ", " : "") << "\"" << f.confounded_with[k] << "\"";
+    os << "], \"separating_tests\": [";
+    for (std::size_t k = 0; k < f.separating_tests.size(); ++k)
+      os << (k ? ", " : "") << "\"" << json_escape(f.separating_tests[k]) << "\"";
+    os << "], \"delta_bic\": " << num(f.delta_bic) << ", \"heldout_rmse_before\": " << num(f.heldout_rmse_before_j)
+       << ", \"heldout_rmse_after\": " << num(f.heldout_rmse_after_j)
+       << ", \"heldout_energy_error_pct_before\": " << num(f.heldout_energy_error_pct_before)
+       << ", \"heldout_energy_error_pct_after\": " << num(f.heldout_energy_error_pct_after)
+       << ", \"heldout_lag1_autocorrelation_before\": " << num(f.heldout_lag1_autocorrelation_before)
+       << ", \"heldout_lag1_autocorrelation_after\": " << num(f.heldout_lag1_autocorrelation_after) << "}";
+  }
+  os << (d.findings.empty() ? "" : "\n  ") << "],\n  \"located\": [";
+  for (std::size_t i = 0; i < d.located.size(); ++i) {
+    const auto& l = d.located[i];
+    os << (i ? "," : "") << "\n    {\"regime\": \"" << l.regime << "\", \"samples\": " << l.samples << ", \"mean_residual_w\": "
+       << num(l.mean_w) << ", \"ci_low_w\": " << num(l.ci_low_w) << ", \"ci_high_w\": " << num(l.ci_high_w) << "}";
+  }
+  os << (d.located.empty() ? "" : "\n  ") << "],\n  \"detection_limits\": [";
+  for (std::size_t i = 0; i < d.detection_limits.size(); ++i) {
+    const auto& l = d.detection_limits[i];
+    os << (i ? "," : "") << "\n    {\"effect\": \"" << l.effect << "\", \"parameter\": \"" << l.parameter
+       << "\", \"smallest_detectable\": " << num(l.smallest_detectable) << ", \"unit\": \"" << l.unit
+       << "\", \"within_bounds\": " << (l.within_bounds ? "true" : "false") << "}";
+  }
+  os << (d.detection_limits.empty() ? "" : "\n  ") << "]\n}\n";
+  return os.str();
+}
+
+std::string diagnosis_text(const Diagnosis& d) {
+  std::ostringstream os;
+  os.setf(std::ios::fixed);
+  os.precision(3);
+  os << "channel " << d.channel << ", " << d.windows << " windows (effective " << d.effective_windows
+     << ", lag-1 autocorrelation " << d.lag1_autocorrelation << ")\n";
+  for (const auto& note : d.notes) os << note << "\n";
+  os << "channel lag: " << d.lag_s << " s [" << d.lag_ci_low_s << ", " << d.lag_ci_high_s << "] (interpolated channel)\n";
+  os << "uncalibrated trip energy error: " << d.raw_trip_energy_error_pct << " %\n";
+  os << "calibration: channel scale " << d.channel_scale << " (prior [" << d.channel_scale_prior_low << ", "
+     << d.channel_scale_prior_high << "]), RRC level " << 100 * d.rrc_level_change << " %, aero C " << 100 * d.drag_change << " %\n";
+  if (d.channel_scale_outside_prior)
+    os << "  the data alone wanted a channel scale of " << d.channel_scale_free << ", outside its prior: held at the bound, it leaves "
+       << d.scale_absorbed_energy_pct << " % of the measured energy for the effects to explain\n";
+  os << "noise floor: " << d.noise_floor_j / 1e3 << " kJ per noise window; calibrated residual " << d.residual_to_noise_ratio
+     << " x the floor (z " << d.residual_to_noise_z << ", " << d.adequacy_scale_s << " s blocks), after the findings "
+     << d.final_residual_to_noise_ratio << " x (z " << d.final_residual_to_noise_z << ")\n";
+  os << "held-out, calibrated: RMSE " << d.heldout_rmse_calibrated_j / 1e3 << " kJ per window, trip energy error "
+     << d.heldout_energy_error_pct_calibrated << " %\n";
+  os << "verdict: " << d.verdict << "\n";
+  for (const auto& f : d.findings) {
+    os << "  " << f.effect << " (delta BIC " << f.delta_bic << ")";
+    if (!f.confounded_with.empty()) {
+      os << " confounded with";
+      for (const auto& c : f.confounded_with) os << " " << c;
+    }
+    os << "\n";
+    if (!f.description.empty()) os << "    " << f.description << "\n";
+    for (const auto& t : f.separating_tests) os << "    to separate from " << t << "\n";
+    for (const auto& p : f.parameters) {
+      os << "    " << p.name << " = " << p.value;
+      if (p.profiled)
+        os << " [" << (p.ci_low_open ? "< " : "") << p.ci_low << ", " << (p.ci_high_open ? "> " : "") << p.ci_high
+           << "] " << p.unit << " (profile likelihood, 95 %" << (p.ci_low_open || p.ci_high_open ? "; open at the grid's end" : "")
+           << ")\n";
+      else if (p.ci_low == p.value && p.ci_high == p.value)
+        os << " " << p.unit << " (fixed)\n";
+      else
+        os << " [" << p.ci_low << ", " << p.ci_high << "] " << p.unit << "\n";
+    }
+    os << "    held-out RMSE " << f.heldout_rmse_before_j / 1e3 << " -> " << f.heldout_rmse_after_j / 1e3
+       << " kJ/window, trip energy error " << f.heldout_energy_error_pct_before << " -> " << f.heldout_energy_error_pct_after
+       << " %, residual lag-1 autocorrelation " << f.heldout_lag1_autocorrelation_before << " -> "
+       << f.heldout_lag1_autocorrelation_after << " (0: white)\n";
+  }
+  if (!d.detection_limits.empty()) {
+    os << "not found; smallest size of each effect's catalogue shape this data would have shown (a lower bound:\n"
+       << "real effects differ from the shape; the discovery benchmark measures 1-3 times these):\n";
+    for (const auto& l : d.detection_limits) {
+      os << "  " << l.effect << ": " << l.parameter << " " << l.smallest_detectable << " " << l.unit
+         << (l.within_bounds ? "" : " (beyond its physical bounds: not detectable here)") << "\n";
+    }
+  }
+  os << "located (measured - calibrated model, mean power, 95 %):\n";
+  os.precision(0);
+  for (const auto& l : d.located)
+    os << "  " << l.regime << ": " << l.mean_w << " W [" << l.ci_low_w << ", " << l.ci_high_w << "] (" << l.samples << " samples)\n";
+  return os.str();
+}
+
+std::string fitted_vehicle_yaml(const std::string& vehicle_path, const Diagnosis& d) {
+  std::ifstream in(vehicle_path);
+  if (!in) throw InputError(vehicle_path, "cannot read");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  std::string text = ss.str();
+  // Only files without an effects block are rewritten: merging two blocks would silently drop one.
+  std::istringstream lines(text);
+  for (std::string line; std::getline(lines, line);)
+    if (line.rfind("effects:", 0) == 0) throw InputError(vehicle_path, "already has an effects: block; remove it to write a fitted one");
+  std::vector<std::pair<std::string, EffectParameters>> eff;
+  for (const auto& f : d.findings)
+    if (f.effect != "unexplained") eff.emplace_back(f.effect, f.fitted);  // described, not a module
+  if (!text.empty() && text.back() != '\n') text += '\n';
+  text += "# effects fitted by rollsim diagnose (verdict: " + d.verdict + ")\n";
+  if (eff.empty()) return text;
+  return text + effects_yaml(eff);
+}
+
+}  // namespace rollsim

@@ -1,0 +1,292 @@
+// The diagnosis pipeline's stages and the plain results they pass on (internal to src/diagnose/).
+#pragma once
+
+#include <Eigen/Dense>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "rollsim/diagnose/diagnose.hpp"
+#include "rollsim/sim/effect.hpp"
+
+namespace rollsim::diag {
+
+using EffectList = std::vector<std::shared_ptr<const Effect>>;
+
+// ---- windows (windows.cpp) -------------------------------------------------------------------------------------
+
+struct Window {
+  std::size_t rec = 0, begin = 0, end = 0;  // sample range [begin, end]
+};
+
+/// The measurement cut into energy windows: what every later stage compares against.
+struct Observations {
+  ChannelKind channel = ChannelKind::soc;
+  double window_s = 0.0;
+  std::vector<Window> windows;
+  std::vector<std::vector<double>> dt_s;        // per recording, per segment
+  std::vector<std::vector<double>> measured_w;  // per recording, per sample (empty for SOC)
+  Eigen::VectorXd measured_j;                   // per window
+  std::vector<int> fold_of;                     // held-out fold of each window
+  double soc_capacity_j = 0.0;
+  Eigen::Index n() const { return measured_j.size(); }
+};
+
+/// Measured channel power per sample [W] (empty for SOC, which is differenced per window), and its kind.
+std::vector<double> measured_power_w(const Vehicle& v, const Recording& r, ChannelKind& kind);
+
+/// Windows of `window_s` (SOC: lengthened until its quantum is small), their measured energies and held-out folds.
+Observations build_windows(const Vehicle& vehicle, const std::vector<Recording>& recordings, double window_s,
+                           const DiagnoseOptions& opt, std::vector<std::string>& notes);
+/// Windows of `window_s` over the same samples, measured energies only (the noise floor's short windows).
+Observations rewindow(const Observations& o, const std::vector<Recording>& recordings, double window_s);
+
+// ---- replay (replay.cpp) ---------------------------------------------------------------------------------------
+
+/// Simulated channel power of one model variant: per recording, per sample, and per window (lag applied).
+struct Variant {
+  std::vector<std::vector<double>> power_w;
+  Eigen::VectorXd window_j;
+};
+
+/// Replays model variants (the base model plus extra effects) on the recordings' traces, in parallel.
+struct Replayer {
+  const Vehicle& vehicle;
+  const std::vector<DriveCycle>& cycles;
+  EffectList per_recording;  // known per-recording physics (air density at the recorded ambient), or empty
+  bool cells = false;        // SOC: the cells' internal loss counts
+  unsigned threads = 0;
+  std::vector<std::vector<double>> power(const EffectList& extra) const;
+  std::vector<Variant> run(const std::vector<EffectList>& extras, const Observations& o, double lag_samples) const;
+};
+
+/// Window energies of per-sample powers, shifted by a (fractional) channel lag, interpolated linearly.
+Eigen::VectorXd window_energies(const std::vector<std::vector<double>>& power_w, const Observations& o, double lag_samples);
+
+/// Channel lag (calibration): the continuous shift of the simulated power, 0-10 samples, that best matches the
+/// measured one (interpolated channel), with its profile interval.
+struct LagEstimate {
+  double samples = 0.0, low = 0.0, high = 0.0;
+  double seconds = 0.0, low_s = 0.0, high_s = 0.0;
+};
+LagEstimate estimate_lag(const std::vector<std::vector<double>>& sim_w, const Observations& o);
+
+// ---- least squares with priors (fit.cpp) -----------------------------------------------------------------------
+
+/// Priors of the calibration columns: Gaussian penalties (rows pulling a coefficient towards `target`) and a hard
+/// box on the channel scale (column 0).
+struct Prior {
+  struct Row {
+    Eigen::Index column;
+    double weight, target;
+  };
+  std::vector<Row> rows;
+  double scale_low = -1e300, scale_high = 1e300;
+};
+
+struct Fit {
+  Eigen::VectorXd coef;
+  Eigen::MatrixXd cov;
+  double rss = 0.0;
+};
+Fit least_squares(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, const Prior& prior = {});
+
+double lag1_autocorrelation(const Eigen::VectorXd& r);
+double rmse(const Eigen::VectorXd& a, const Eigen::VectorXd& b);
+double energy_error_pct(const Eigen::VectorXd& pred, const Eigen::VectorXd& meas);
+Eigen::MatrixXd hcat(const Eigen::MatrixXd& a, const Eigen::VectorXd& b);
+/// Part of `s` not explained by the columns of `basis` (least squares).
+Eigen::VectorXd cleaned(const Eigen::MatrixXd& basis, const Eigen::VectorXd& s);
+
+/// The current model of the window energies: design, its fit, and what every test of one more column needs.
+struct Model {
+  Eigen::MatrixXd x;
+  Fit fit;
+  Eigen::VectorXd heldout;  // out-of-fold prediction
+  const Eigen::VectorXd* y = nullptr;
+  const std::vector<int>* fold_of = nullptr;
+  Prior prior;
+  double n_eff = 0.0, inflate = 1.0;
+};
+
+/// The model with one more column: its fit, Delta BIC on the effective n, and out-of-fold prediction.
+struct Scored {
+  Fit fit;
+  double dbic = -1e300;
+  Eigen::VectorXd heldout;
+  double amplitude() const { return fit.coef[fit.coef.size() - 1] / fit.coef[0]; }  // per channel scale 1
+  double amplitude_se(double inflate) const;
+};
+Eigen::VectorXd heldout_prediction(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, const std::vector<int>& fold_of,
+                                   const Prior& prior);
+double delta_bic(const Model& m, double rss_with);
+Scored score_column(const Model& m, const Eigen::VectorXd& signature);
+/// True when the candidate fits better out of fold than the model without it.
+/// Fills the candidate's out-of-fold prediction (the costly part, done only for candidates that pass).
+void add_heldout(const Model& m, const Eigen::VectorXd& signature, Scored& s);
+bool improves_heldout(const Model& m, const Scored& s);
+Model extended(const Model& m, const Eigen::VectorXd& signature, const Scored& s);
+/// Held-out metrics of a finding, from the model before and after it.
+void set_heldout_metrics(Finding& f, const Model& before, const Eigen::VectorXd& after_pred);
+
+// ---- calibration with priors (calibration.cpp) -----------------------------------------------------------------
+
+struct Calibration {
+  Model model;                // measured = s sim + a S_rrc + b S_drag, priors applied
+  double free_scale = 1.0;    // the scale the data alone would take
+  double prior_scale_sd = 0.0;
+  bool scale_at_bound = false;
+  double absorbed_j = 0.0;    // energy the free scale would have absorbed beyond the bounded one
+};
+Calibration calibrate(const Observations& o, const Variant& base, const Variant& rrc, const Variant& drag,
+                      const CalibrationPriors& priors);
+
+// ---- candidate signatures (candidates.cpp) ---------------------------------------------------------------------
+
+/// A catalogue effect with its shape parameters fixed (hidden-state effects: one per time constant).
+struct Candidate {
+  EffectId id{};
+  std::string label;
+  EffectParameters shape;
+  const EffectParameterInfo* amplitude = nullptr;
+  Eigen::VectorXd signature;  // window energy per unit amplitude
+  bool across_trips = false;  // ambient_rrc: a per-recording level from the RRC-level variant (no own run)
+  double min() const { return amplitude->min; }
+  double max() const { return amplitude->max; }
+};
+
+/// The force (or power) shapes that describe a residual no catalogue effect explains.
+enum class ForceShape { constant, speed, speed_squared, positive_accel };
+struct BasisShape {
+  enum Kind { force, power } kind = force;
+  ForceShape shape = ForceShape::constant;
+  double decay_s = 0.0;  // 0: no decay
+  Eigen::VectorXd signature;
+};
+std::shared_ptr<const Effect> signature_force(ForceShape shape, double decay_s);
+/// A force k x 0.5 rho CdA v^2 (the aero calibration's signature; air density per recording).
+std::shared_ptr<const Effect> drag_scale(double k, double rho_cda);
+/// 1 W at the measured channel, optionally decaying from each recording's start, per window.
+Eigen::VectorXd power_signature(const Observations& o, const std::vector<DriveCycle>& cycles, double decay_s);
+
+struct AmbientSetting {
+  bool testable = false;
+  std::vector<double> ambient_k;  // per recording
+  double reference_k = 0.0;
+};
+AmbientSetting ambient_setting(const std::vector<Recording>& recordings, const DiagnoseOptions& opt,
+                               std::vector<std::string>& notes);
+
+struct Signatures {
+  Variant base, rrc, drag;
+  std::vector<Candidate> candidates;
+  std::vector<BasisShape> basis;
+};
+/// Every variant (calibration, catalogue candidates, unexplained basis) in one parallel batch.
+Signatures compute_signatures(const Replayer& rp, const Observations& o, const Variant& base, double lag_samples,
+                              const AmbientSetting& amb, const EffectContext& ctx, const DiagnoseOptions& opt);
+
+// ---- selection (selection.cpp, profile.cpp) --------------------------------------------------------------------
+
+/// low, low 2^(1/k), ... up to high (and `also`, the value already chosen, merged in), ascending.
+std::vector<double> log_grid(double low, double high, int per_octave, double also);
+
+/// A time constant's log grid and a way to get the signature at any point of it.
+struct TimeProfile {
+  std::string parameter;
+  double selected = 0.0;
+  std::vector<double> grid;
+  std::function<std::vector<Eigen::VectorXd>(const std::vector<double>&)> signatures;  // at these grid values
+};
+/// Profiles the criterion over the grid; adopts the grid's best (returned signature and score) if it also fits
+/// better out of fold; the interval always holds the value kept.
+struct ProfileResult {
+  ProfileInterval interval;
+  std::string parameter;
+  Eigen::VectorXd signature;
+  Scored score;
+};
+ProfileResult profile_time_constant(const Model& m, const TimeProfile& tp, const Eigen::VectorXd& selected_signature,
+                                    const Scored& selected_score, double amp_min, double amp_max);
+
+struct SelectionContext {
+  const Replayer& replayer;
+  const Observations& obs;
+  const Variant& base;
+  double lag_samples;
+  const EffectContext& ctx;
+  const AmbientSetting& ambient;
+  const std::vector<Recording>& recordings;
+  const DiagnoseOptions& opt;
+  /// Regime evidence: the calibrated model's mean residual power when standing, its standard error (AR(1)) and
+  /// effective number of samples; available only for per-sample channels.
+  struct Standing {
+    bool available = false;
+    double mean_w = 0.0, se_w = 0.0, n_eff = 0.0;
+  } standing;
+};
+
+/// Forward selection of catalogue effects; the model grows by each finding.
+std::vector<Finding> select_effects(const SelectionContext& sc, const std::vector<Candidate>& cands, Model& m,
+                                    std::vector<EffectId>& chosen);
+std::vector<DetectionLimit> detection_limits(const std::vector<Candidate>& cands, const std::vector<EffectId>& chosen,
+                                             const Model& m, const DiagnoseOptions& opt);
+
+// ---- unexplained residual (unexplained.cpp) --------------------------------------------------------------------
+
+std::optional<Finding> describe_unexplained(const SelectionContext& sc, const std::vector<DriveCycle>& cycles,
+                                            const std::vector<BasisShape>& basis, Model& m);
+
+// ---- location (locate.cpp) -------------------------------------------------------------------------------------
+
+
+std::vector<DiagnosisWindow> window_series(const Observations& o, const std::vector<Recording>& recordings,
+                                           const Eigen::VectorXd& base_j, const Eigen::VectorXd& calibrated_j,
+                                           const Eigen::VectorXd& fitted_j);
+
+// ---- small text helpers (output.cpp) ---------------------------------------------------------------------------
+std::string num(double v);
+std::string fixed(double v, int digits);
+
+}  // namespace rollsim::diag
+
+namespace rollsim::diag {
+
+// ---- adequacy against the noise floor (adequacy.cpp) -----------------------------------------------------------
+
+struct NoiseFloor {
+  double variance_per_s = 0.0;  // of a window's noise energy [J^2], per second of window
+  int pairs = 0;
+  double window_s = 0.0;
+};
+/// From the calibrated residual of short windows (`short_obs`): half the mean squared successive difference.
+NoiseFloor noise_floor(const Observations& short_obs, const Eigen::VectorXd& resid);
+
+struct Adequacy {
+  double ratio = 0.0, z = -1e300, scale_s = 0.0;  // at the scale of largest z
+  bool inadequate = false;
+  int blocks = 0, flagged = 0;
+  double flagged_j = 0.0, first_s = 0.0, last_s = 0.0, first_m = 0.0, last_m = 0.0, flagged_mean_speed_mps = 0.0;
+};
+Adequacy test_adequacy(const Observations& o, const std::vector<Recording>& recs, const Eigen::VectorXd& resid,
+                       const NoiseFloor& nf, const DiagnoseOptions& opt);
+/// Mean residual of the calibrated model by regime; per-sample channels also give the standing residual's evidence.
+std::vector<RegimeResidual> locate_regimes(const Observations& o, const std::vector<Recording>& recordings,
+                                           const std::vector<DriveCycle>& cycles, const Signatures& s,
+                                           const Eigen::VectorXd& cal_coef, double lag_samples,
+                                           SelectionContext::Standing* standing);
+Finding adequacy_finding(const Adequacy& a, const NoiseFloor& nf, const Observations& o,
+                         const std::vector<RegimeResidual>& located);
+
+}  // namespace rollsim::diag
+
+namespace rollsim::diag {
+NoiseFloor calibrated_noise_floor(const Observations& o, const std::vector<Recording>& recs, const Signatures& s,
+                                  const Calibration& cal, double lag_samples, const DiagnoseOptions& opt);
+std::string calibration_outside_prior_text(const Calibration& c, const Observations& o, const std::vector<Candidate>& cands);
+}  // namespace rollsim::diag
+namespace rollsim::diag {
+Eigen::VectorXd per_recording_residual(const Model& m, const Observations& o, std::size_t recordings);
+}  // namespace rollsim::diag

@@ -1,0 +1,148 @@
+// Diagnosis stage 2: replays of model variants on the recordings' traces, and the channel lag.
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <mutex>
+#include <thread>
+
+#include "pipeline.hpp"
+#include "rollsim/sim/simulation.hpp"
+
+namespace rollsim::diag {
+namespace {
+
+// The simulated counterpart of the measured channel: fuel power, battery terminal power, or, for a state of charge
+// (which counts what leaves the cells), terminal power plus the cells' internal loss.
+double sim_power_w(const TracePoint& t, bool electric, double fuel_j_per_m3, bool cells) {
+  if (!electric) return t.fuel_rate_m3_per_s * fuel_j_per_m3;
+  return cells ? t.battery_power_w + t.battery_loss_w : t.battery_power_w;
+}
+
+// p(i - lag) with a fractional lag, linear between samples, held at the first sample before the start.
+double shifted(const std::vector<double>& p, std::size_t i, double lag) {
+  const double pos = static_cast<double>(i) - lag;
+  if (pos <= 0.0) return p.front();
+  const auto k = static_cast<std::size_t>(pos);
+  const double f = pos - static_cast<double>(k);
+  return k + 1 < p.size() ? (1.0 - f) * p[k] + f * p[k + 1] : p.back();
+}
+
+double lag_sse(const std::vector<std::vector<double>>& sim_w, const Observations& o, double lag) {
+  double sse = 0.0;
+  for (std::size_t ri = 0; ri < sim_w.size(); ++ri)
+    for (std::size_t i = 10; i < sim_w[ri].size(); ++i) {  // the same samples for every lag searched
+      const double e = o.measured_w[ri][i] - shifted(sim_w[ri], i, lag);
+      sse += e * e;
+    }
+  return sse;
+}
+
+}  // namespace
+
+std::vector<std::vector<double>> Replayer::power(const EffectList& extra) const {
+  VehicleModel model = VehicleModel::assemble(vehicle);
+  for (const auto& e : extra) model.effects.push_back(e);
+  const bool electric = vehicle.is_electric();
+  double fuel_j_per_m3 = 0.0;
+  if (const auto* cp = std::get_if<CombustionPowertrainParams>(&vehicle.powertrain))
+    fuel_j_per_m3 = cp->fuel.density_kg_per_m3 * cp->fuel.lower_heating_value_j_per_kg;
+  SimulationOptions so;
+  so.record_trace = true;
+  std::vector<std::vector<double>> out;
+  for (std::size_t ci = 0; ci < cycles.size(); ++ci) {
+    const bool own = ci < per_recording.size() && per_recording[ci];
+    if (own) model.effects.push_back(per_recording[ci]);
+    const SimulationResult r = simulate_replay(model, cycles[ci], so);
+    if (own) model.effects.pop_back();
+    std::vector<double> p(r.trace.size());
+    for (std::size_t i = 0; i < p.size(); ++i) p[i] = sim_power_w(r.trace[i], electric, fuel_j_per_m3, cells);
+    out.push_back(std::move(p));
+  }
+  return out;
+}
+
+// Independent replays, so they run in parallel (each thread assembles its own model).
+std::vector<Variant> Replayer::run(const std::vector<EffectList>& extras, const Observations& o, double lag_samples) const {
+  std::vector<Variant> out(extras.size());
+  std::atomic<std::size_t> next{0};
+  std::exception_ptr failure;
+  std::mutex failure_mutex;
+  auto work = [&] {
+    for (std::size_t k = next++; k < extras.size(); k = next++) {
+      try {
+        out[k].power_w = power(extras[k]);
+        out[k].window_j = window_energies(out[k].power_w, o, lag_samples);
+      } catch (...) {
+        const std::lock_guard<std::mutex> lock(failure_mutex);
+        if (!failure) failure = std::current_exception();
+      }
+    }
+  };
+  const unsigned n = std::max(1u, std::min<unsigned>(threads ? threads : std::thread::hardware_concurrency(),
+                                                     static_cast<unsigned>(extras.size())));
+  std::vector<std::thread> pool;
+  for (unsigned t = 1; t < n; ++t) pool.emplace_back(work);
+  work();
+  for (auto& t : pool) t.join();
+  if (failure) std::rethrow_exception(failure);
+  return out;
+}
+
+Eigen::VectorXd window_energies(const std::vector<std::vector<double>>& power_w, const Observations& o, double lag_samples) {
+  Eigen::VectorXd e(o.n());
+  for (std::size_t w = 0; w < o.windows.size(); ++w) {
+    const auto& win = o.windows[w];
+    double sum = 0.0;
+    for (std::size_t i = win.begin; i < win.end; ++i) sum += shifted(power_w[win.rec], i, lag_samples) * o.dt_s[win.rec][i];
+    e[static_cast<Eigen::Index>(w)] = sum;
+  }
+  return e;
+}
+
+// Whole samples 0-10 first, then 0.05-sample steps about the best; the interval is where the per-sample criterion
+// n_eff ln(SSE / SSE_min) stays under 3.84, n_eff from the residual's lag-1 autocorrelation (AR(1)).
+LagEstimate estimate_lag(const std::vector<std::vector<double>>& sim_w, const Observations& o) {
+  LagEstimate l;
+  if (o.channel == ChannelKind::soc) return l;
+  int best_whole = 0;
+  double best = 1e300;
+  for (int lag = 0; lag <= 10; ++lag) {
+    const double sse = lag_sse(sim_w, o, lag);
+    if (sse < best) best = sse, best_whole = lag;
+  }
+  std::vector<double> grid, sse;
+  for (double lag = std::max(0.0, best_whole - 1.0); lag <= std::min(10.0, best_whole + 1.0) + 1e-9; lag += 0.05) {
+    grid.push_back(lag);
+    sse.push_back(lag_sse(sim_w, o, lag));
+  }
+  const std::size_t k = static_cast<std::size_t>(std::min_element(sse.begin(), sse.end()) - sse.begin());
+  l.samples = grid[k];
+  // The residual's autocorrelation at the best lag sets how much independent information the samples carry.
+  double num = 0.0, den = 0.0, count = 0.0;
+  for (std::size_t ri = 0; ri < sim_w.size(); ++ri) {
+    double prev = 0.0;
+    for (std::size_t i = 10; i < sim_w[ri].size(); ++i) {
+      const double e = o.measured_w[ri][i] - shifted(sim_w[ri], i, l.samples);
+      den += e * e;
+      if (i > 10) num += e * prev;
+      prev = e;
+      count += 1.0;
+    }
+  }
+  const double rho = std::clamp(den > 0.0 ? num / den : 0.0, 0.0, 0.999);
+  const double n_eff = std::max(2.0, count * (1.0 - rho) / (1.0 + rho));
+  std::size_t lo = k, hi = k;
+  while (lo > 0 && n_eff * std::log(sse[lo - 1] / sse[k]) < 3.84) --lo;
+  while (hi + 1 < grid.size() && n_eff * std::log(sse[hi + 1] / sse[k]) < 3.84) ++hi;
+  l.low = grid[lo];
+  l.high = grid[hi];
+  std::vector<double> dts(o.dt_s.front());
+  std::nth_element(dts.begin(), dts.begin() + static_cast<std::ptrdiff_t>(dts.size() / 2), dts.end());
+  const double dt = dts.empty() ? 1.0 : dts[dts.size() / 2];
+  l.seconds = l.samples * dt;
+  l.low_s = l.low * dt;
+  l.high_s = l.high * dt;
+  return l;
+}
+
+}  // namespace rollsim::diag

@@ -1,0 +1,296 @@
+// Diagnosis stage 5: forward selection of catalogue effects by BIC and held-out fit, within their physical signs.
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <tuple>
+
+#include "pipeline.hpp"
+
+namespace rollsim {
+
+std::string separating_test(const std::string& a, const std::string& b) {
+  // Each pair's confusion (docs/diagnose.md) and the experiment that breaks it: a variable that moves one
+  // signature and not the other.
+  static const std::vector<std::tuple<std::string, std::string, std::string>> kTests{
+      {"mass", "rotational_inertia", "drive a route with grade, or weigh the car: mass also loads the grade and the tyres, inertia only acceleration"},
+      {"mass", "rr_speed", "weigh the car, or compare an uphill and a downhill run at the same speed"},
+      {"mass", "road_grade", "drive the route in both directions: a grade changes sign, a mass error does not"},
+      {"aux_load", "rr_speed", "log a long standstill with the car switched on: an auxiliary load draws power at zero speed, rolling resistance does not"},
+      {"aux_load", "tyre_warmup", "log a standstill early and late in the trip: an auxiliary load draws at standstill, a tyre warms only while rolling"},
+      {"wind", "rr_speed", "drive the same road in both directions: a headwind reverses, rolling resistance does not"},
+      {"wind", "mass", "drive the same road in both directions, or at two steady speeds: wind grows with speed squared, mass with acceleration"},
+      {"tyre_warmup", "engine_warmup", "idle the cold car for ten minutes before driving: an engine warms idling, a tyre only rolling"},
+      {"tyre_warmup", "ambient_rrc", "repeat the trip with a warm start: a warm-up decays within the trip, an ambient effect stays"},
+      {"battery_resistance", "tyre_slip", "compare hard accelerations at low and high speed: battery loss follows current squared, slip loss also grows with speed"},
+      {"regen_limit", "rotational_inertia", "brake at different strengths from the same speed: a regen limit shows only above its power, inertia in every braking"},
+      {"road_grade", "rr_speed", "drive the route in both directions, or record elevation: grade reverses with direction"},
+  };
+  for (const auto& [x, y, text] : kTests) {
+    if ((a == x && b == y) || (a == y && b == x)) return text;
+  }
+  return "vary the conditions that move one signature and not the other (speed, acceleration, grade, time since start, "
+         "direction of travel) in a second recording";
+}
+
+namespace diag {
+namespace {
+
+// Time-constant parameters profiled when their effect is found, and their grid ranges.
+struct TimeParameter {
+  EffectId effect;
+  const char* parameter;
+  double low, high;
+};
+constexpr TimeParameter kTimeParameters[] = {
+    {EffectId::tyre_warmup, "heat_capacity_j_per_k", 10000.0, 320000.0},   // tau ~ C / h: ~3-60 min at 20-50 W/K
+    {EffectId::engine_warmup, "heat_capacity_j_per_k", 25000.0, 800000.0},  // oil, block and coolant of small to large engines
+};
+
+// ambient_rrc's evidence lives in a few per-trip RRC levels, not in the windows: a trip's RRC level also moves with
+// tyre pressure and road surface (and its aero force with the weather), so windows alone would take any such
+// trip-to-trip scatter for an ambient law. The trips' own RRC levels (the model with the shared RRC column split per
+// recording) are regressed on ambient by generalised least squares with their covariance plus that scatter (fixed
+// in advance); returns c [1/K], its standard error and the trips' Delta BIC (chi^2 - ln trips).
+struct TripLevel {
+  double c = 0.0, se = 0.0, dbic = -1e300;
+};
+TripLevel trip_level_ambient(const SelectionContext& sc, const Model& m) {
+  TripLevel t;
+  const Observations& o = sc.obs;
+  const Eigen::Index n = o.n();
+  const auto nr = static_cast<Eigen::Index>(sc.recordings.size());
+  const Eigen::MatrixXd& xm = m.x;
+  Eigen::MatrixXd xt = Eigen::MatrixXd::Zero(n, xm.cols() - 1 + nr);
+  xt.col(0) = xm.col(0);
+  for (Eigen::Index w = 0; w < n; ++w) xt(w, 1 + static_cast<Eigen::Index>(o.windows[static_cast<std::size_t>(w)].rec)) = xm(w, 1);
+  xt.rightCols(xm.cols() - 2) = xm.rightCols(xm.cols() - 2);
+  Prior pt = m.prior;
+  pt.rows.clear();
+  for (Eigen::Index r = 0; r < nr; ++r) pt.rows.push_back({1 + r, m.prior.rows[0].weight, 0.0});
+  pt.rows.push_back({1 + nr, m.prior.rows[1].weight, 0.0});
+  const Fit f = least_squares(xt, o.measured_j, pt);
+  const double s = f.coef[0];
+  if (!(std::abs(s) > 0.0)) return t;
+  const double opt_scatter = sc.opt.trip_rrc_scatter * std::abs(s) / 0.1;  // coefficients are per 10 % RRC
+  Eigen::MatrixXd v = f.cov.block(1, 1, nr, nr) * (m.inflate * m.inflate);
+  v.diagonal().array() += opt_scatter * opt_scatter;
+  // The day's unrecorded barometric pressure moves the trip's aero force; projected onto that trip's RRC level
+  // (least squares of the aero signature on the RRC signature over the trip's windows), it is more scatter.
+  for (Eigen::Index r = 0; r < nr; ++r) {
+    double sa = 0.0, ss = 0.0;
+    for (Eigen::Index w = 0; w < n; ++w) {
+      if (static_cast<Eigen::Index>(o.windows[static_cast<std::size_t>(w)].rec) != r) continue;
+      sa += xm(w, 2) * xm(w, 1);
+      ss += xm(w, 1) * xm(w, 1);
+    }
+    const double air_coef = ss > 0.0 ? sc.opt.trip_air_density_scatter * std::abs(s) / 0.1 * sa / ss : 0.0;
+    v(r, r) += air_coef * air_coef;
+  }
+  Eigen::MatrixXd design(nr, 2);
+  Eigen::VectorXd a(nr);
+  for (Eigen::Index r = 0; r < nr; ++r) {
+    design(r, 0) = 1.0;
+    design(r, 1) = sc.ambient.reference_k - sc.ambient.ambient_k[static_cast<std::size_t>(r)];
+    a[r] = f.coef[1 + r];
+  }
+  const Eigen::MatrixXd vinv = v.inverse();
+  const Eigen::MatrixXd cov = (design.transpose() * vinv * design).inverse();
+  const Eigen::VectorXd beta = cov * design.transpose() * vinv * a;
+  t.c = 0.1 * beta[1] / s;
+  t.se = 0.1 * std::sqrt(std::max(0.0, cov(1, 1))) / std::abs(s);
+  t.dbic = beta[1] * beta[1] / std::max(1e-300, cov(1, 1)) - std::log(static_cast<double>(nr));
+  return t;
+}
+
+struct Passing {
+  std::size_t idx;
+  Scored score;
+  double se_amplitude = 0.0;  // ambient_rrc: the trip-level standard error (else 0: the fit's own)
+  bool wrong_sign = false;    // the fit needs the physically impossible sign
+  bool standing = false;      // passed on the standing residual's evidence (aux_load)
+};
+
+// A standing residual is an auxiliary load's signature: at standstill nothing but consumers draws power.
+double standing_bic(const SelectionContext& sc) {
+  const auto& st = sc.standing;
+  if (!st.available || !(st.se_w > 0.0) || st.n_eff < 2.0) return -1e300;
+  const double z = st.mean_w / st.se_w;
+  return z > 0.0 ? z * z - std::log(st.n_eff) : -1e300;
+}
+
+// Every untried candidate that passes: BIC threshold (or, for aux_load, the standing evidence), amplitude within
+// its bounds (or of the impossible sign: kept apart, never named), and a better held-out fit.
+std::vector<Passing> passing_candidates(const SelectionContext& sc, const std::vector<Candidate>& cands, const Model& m,
+                                        const std::vector<EffectId>& chosen) {
+  std::vector<Passing> out;
+  for (std::size_t k = 0; k < cands.size(); ++k) {
+    const Candidate& c = cands[k];
+    if (std::find(chosen.begin(), chosen.end(), c.id) != chosen.end()) continue;
+    Passing p{k, score_column(m, c.signature)};
+    const double amp = p.score.amplitude();
+    p.wrong_sign = c.min() >= 0.0 && amp < 0.0;
+    p.standing = c.id == EffectId::aux_load && !p.wrong_sign && standing_bic(sc) >= sc.opt.standing_bic_threshold;
+    if (p.score.dbic < sc.opt.bic_threshold && !p.standing) continue;
+    if (!p.wrong_sign && (amp < c.min() || amp > c.max())) continue;
+    if (c.across_trips) {
+      // It must also pass the same threshold on the trips' RRC levels, against trip-to-trip scatter.
+      const TripLevel t = trip_level_ambient(sc, m);
+      if (t.dbic < sc.opt.bic_threshold) continue;
+      p.se_amplitude = t.se;
+    }
+    add_heldout(m, c.signature, p.score);
+    if (!improves_heldout(m, p.score)) continue;
+    out.push_back(std::move(p));
+  }
+  std::sort(out.begin(), out.end(), [](const Passing& a, const Passing& b) { return a.score.dbic > b.score.dbic; });
+  return out;
+}
+
+std::optional<ProfileResult> refine(const SelectionContext& sc, Candidate& c, const Model& m, Passing& best) {
+  for (const auto& tp : kTimeParameters) {
+    if (c.id != tp.effect || !c.shape.count(tp.parameter)) continue;
+    TimeProfile prof;
+    prof.parameter = tp.parameter;
+    prof.selected = c.shape.at(tp.parameter);
+    prof.grid = log_grid(tp.low, tp.high, sc.opt.profile_points_per_octave, prof.selected);
+    prof.signatures = [&](const std::vector<double>& values) {
+      std::vector<EffectList> runs;
+      for (double g : values) {
+        EffectParameters p = c.shape;
+        p[tp.parameter] = g;
+        p[c.amplitude->name] = c.amplitude->nominal;
+        runs.push_back({make_effect(c.id, p, sc.ctx)});
+      }
+      std::vector<Eigen::VectorXd> sigs;
+      for (const auto& v : sc.replayer.run(runs, sc.obs, sc.lag_samples))
+        sigs.push_back((v.window_j - sc.base.window_j) / c.amplitude->nominal);
+      return sigs;
+    };
+    ProfileResult r = profile_time_constant(m, prof, c.signature, best.score, c.min(), c.max());
+    r.parameter = tp.parameter;
+    c.signature = r.signature;
+    c.shape[tp.parameter] = r.interval.value;
+    best.score = r.score;
+    return r;
+  }
+  return std::nullopt;
+}
+
+Finding catalogue_finding(const SelectionContext& sc, const Candidate& c, const Passing& best,
+                          const std::optional<ProfileResult>& prof, double inflate) {
+  const EffectInfo& info = effect_info(c.id);
+  Finding f;
+  f.effect = info.name;
+  f.delta_bic = best.score.dbic;
+  const double value = best.score.amplitude();
+  // ambient_rrc: the wider of the windows' and the trips' intervals (a few trips carry its information).
+  const double se = std::max(best.score.amplitude_se(inflate), best.se_amplitude);
+  f.parameters.push_back({c.amplitude->name, c.amplitude->unit, value, value - 1.96 * se, value + 1.96 * se});
+  f.fitted = c.shape;
+  f.fitted[c.amplitude->name] = value;
+  if (c.across_trips) {
+    const auto [lo, hi] = std::minmax_element(sc.ambient.ambient_k.begin(), sc.ambient.ambient_k.end());
+    f.description = "RRC level follows ambient temperature across the recordings (" + fixed(*lo - 273.15, 1) + " to " +
+                    fixed(*hi - 273.15, 1) + " degC): " + fixed(100.0 * value, 2) + " % per K colder, referred to " +
+                    fixed(sc.ambient.reference_k - 273.15, 1) + " degC; the written vehicle is neutral at that reference, set "
+                    "ambient_temp_c per trip";
+  }
+  if (best.standing)
+    f.description = "the calibrated model's residual when standing, " + fixed(sc.standing.mean_w, 0) + " W [" +
+                    fixed(sc.standing.mean_w - 1.96 * sc.standing.se_w, 0) + ", " +
+                    fixed(sc.standing.mean_w + 1.96 * sc.standing.se_w, 0) +
+                    "], is an auxiliary load's signature (nothing else draws power at standstill); constant or duty-cycled, "
+                    "the windows see its mean";
+  for (const auto& [k, v] : c.shape) {
+    for (const auto& pi : info.parameters) {
+      if (pi.name != k) continue;
+      if (prof && k == prof->parameter)
+        f.parameters.push_back({k, pi.unit, v, prof->interval.low, prof->interval.high, true, prof->interval.low_open,
+                                prof->interval.high_open});
+      else
+        f.parameters.push_back({k, pi.unit, v, v, v});  // fixed, not fitted
+    }
+  }
+  return f;
+}
+
+// A catalogue shape fitted with the impossible sign: described by its shape, never named as the effect.
+Finding wrong_sign_finding(const Candidate& c, const Passing& p, double inflate) {
+  const EffectInfo& info = effect_info(c.id);
+  Finding f;
+  f.effect = "unexplained";
+  const double value = p.score.amplitude(), se = p.score.amplitude_se(inflate);
+  f.description = info.opposite_sign + ": the residual has " + info.name + "'s shape with the impossible sign (" +
+                  c.amplitude->name + " " + fixed(value, 3) + " " + c.amplitude->unit + "), so it is not " + info.name;
+  f.delta_bic = p.score.dbic;
+  f.parameters.push_back({"opposite_" + c.amplitude->name, c.amplitude->unit, value, value - 1.96 * se, value + 1.96 * se});
+  return f;
+}
+
+void add_confounders(Finding& f, const Candidate& c, const std::vector<Candidate>& cands, const std::vector<Passing>& passing,
+                     const Model& m, double collinear_corr) {
+  const Eigen::VectorXd sb = cleaned(m.x, c.signature);
+  for (std::size_t q = 1; q < passing.size(); ++q) {
+    const Candidate& o = cands[passing[q].idx];
+    if (o.id == c.id || passing[q].wrong_sign) continue;
+    const Eigen::VectorXd so = cleaned(m.x, o.signature);
+    const double corr = sb.dot(so) / std::max(1e-300, sb.norm() * so.norm());
+    const std::string& name = to_string(o.id);
+    if (std::abs(corr) > collinear_corr && std::find(f.confounded_with.begin(), f.confounded_with.end(), name) == f.confounded_with.end()) {
+      f.confounded_with.push_back(name);
+      f.separating_tests.push_back(name + ": " + separating_test(to_string(c.id), name));
+    }
+  }
+}
+
+}  // namespace
+
+// Adds the candidate with the largest BIC gain while one passes; confounded if another candidate's cleaned
+// signature is nearly collinear and also passes.
+std::vector<Finding> select_effects(const SelectionContext& sc, const std::vector<Candidate>& cands, Model& m,
+                                    std::vector<EffectId>& chosen) {
+  std::vector<Finding> out;
+  for (int round = 0; round < sc.opt.max_effects; ++round) {
+    const std::vector<Passing> passing = passing_candidates(sc, cands, m, chosen);
+    if (passing.empty()) break;
+    Passing best = passing.front();
+    Candidate c = cands[best.idx];
+    Finding f;
+    if (best.wrong_sign) {
+      f = wrong_sign_finding(c, best, m.inflate);
+    } else {
+      const std::optional<ProfileResult> prof = refine(sc, c, m, best);
+      f = catalogue_finding(sc, c, best, prof, m.inflate);
+      add_confounders(f, c, cands, passing, m, sc.opt.collinear_corr);
+    }
+    set_heldout_metrics(f, m, best.score.heldout);
+    m = extended(m, c.signature, best.score);
+    chosen.push_back(c.id);
+    out.push_back(std::move(f));
+  }
+  return out;
+}
+
+// For each catalogue effect not found, the amplitude whose signature, cleaned of calibration and of the effects
+// found, would have cut the residual enough to pass the same BIC threshold: n_eff ln(1 + c^2 |s|^2 / RSS) - ln n_eff
+// = threshold.
+std::vector<DetectionLimit> detection_limits(const std::vector<Candidate>& cands, const std::vector<EffectId>& chosen,
+                                             const Model& m, const DiagnoseOptions& opt) {
+  const double factor = std::exp((opt.bic_threshold + std::log(m.n_eff)) / m.n_eff) - 1.0;
+  std::map<EffectId, DetectionLimit> best;
+  for (const auto& c : cands) {
+    if (std::find(chosen.begin(), chosen.end(), c.id) != chosen.end()) continue;
+    const double norm = cleaned(m.x, c.signature).norm();
+    if (!(norm > 0.0)) continue;
+    const double amp = std::sqrt(m.fit.rss * factor) / norm / std::max(1e-12, std::abs(m.fit.coef[0]));
+    const bool within = amp <= std::max(std::abs(c.min()), std::abs(c.max()));
+    auto [it, inserted] = best.try_emplace(c.id, DetectionLimit{to_string(c.id), c.amplitude->name, c.amplitude->unit, amp, within});
+    if (!inserted && amp < it->second.smallest_detectable) it->second = {to_string(c.id), c.amplitude->name, c.amplitude->unit, amp, within};
+  }
+  std::vector<DetectionLimit> out;
+  for (auto& [id, lim] : best) out.push_back(lim);
+  return out;
+}
+
+}  // namespace diag
+}  // namespace rollsim

@@ -1,0 +1,129 @@
+// Diagnosis stage 1: the measured channel cut into energy windows, with held-out folds.
+#include <algorithm>
+#include <cmath>
+
+#include "pipeline.hpp"
+#include "rollsim/common/error.hpp"
+
+namespace rollsim::diag {
+namespace {
+
+// Median of the non-zero steps of a quantised signal (its quantum), 0 if it never changes.
+double quantum_of(const std::vector<double>& x) {
+  std::vector<double> steps;
+  for (std::size_t i = 1; i < x.size(); ++i)
+    if (x[i] != x[i - 1]) steps.push_back(std::abs(x[i] - x[i - 1]));
+  if (steps.empty()) return 0.0;
+  std::nth_element(steps.begin(), steps.begin() + static_cast<std::ptrdiff_t>(steps.size() / 2), steps.end());
+  return steps[steps.size() / 2];
+}
+
+// SOC: windows lengthened until the quantisation error (sd q / sqrt 6 of two quantised readings) is at most a
+// fixed fraction of the mean window energy.
+double soc_window_s(const std::vector<Recording>& recordings, double capacity_j, double window_s, const DiagnoseOptions& opt,
+                    std::vector<std::string>& notes) {
+  double q = 0.0, drop_j = 0.0, duration = 0.0;
+  for (const auto& r : recordings) {
+    q = std::max(q, quantum_of(*r.soc_fraction));
+    drop_j += (r.soc_fraction->front() - r.soc_fraction->back()) * capacity_j;
+    duration += r.duration_s();
+  }
+  const double mean_power_w = drop_j / std::max(1.0, duration);
+  if (q > 0.0 && mean_power_w > 0.0) {
+    const double needed = q * capacity_j / std::sqrt(6.0) / (opt.soc_quantisation_fraction * mean_power_w);
+    window_s = std::max(window_s, std::ceil(needed / 10.0) * 10.0);
+  }
+  notes.push_back("SOC quantum " + fixed(100.0 * q, 3) + " % (" + fixed(q * capacity_j / 1e3, 1) + " kJ), mean power " +
+                  fixed(mean_power_w, 0) + " W: windows of " + fixed(window_s, 0) + " s");
+  return window_s;
+}
+
+// Cuts every recording into windows of `window_s` (a last one of at least half a window kept) and measures them.
+void cut_windows(Observations& o, const std::vector<Recording>& recordings) {
+  o.windows.clear();
+  std::vector<double> meas;
+  for (std::size_t ri = 0; ri < recordings.size(); ++ri) {
+    const Recording& r = recordings[ri];
+    std::size_t begin = 0;
+    for (std::size_t i = 1; i < r.time_s.size(); ++i) {
+      if (r.time_s[i] - r.time_s[begin] < o.window_s && i + 1 != r.time_s.size()) continue;
+      if (r.time_s[i] - r.time_s[begin] >= 0.5 * o.window_s) {
+        o.windows.push_back({ri, begin, i});
+        double e = 0.0;
+        if (o.channel == ChannelKind::soc) {
+          if (o.soc_capacity_j <= 0.0) throw InputError(r.source, "SOC recorded but the vehicle has no battery");
+          e = ((*r.soc_fraction)[begin] - (*r.soc_fraction)[i]) * o.soc_capacity_j;
+        } else {
+          for (std::size_t k = begin; k < i; ++k) e += o.measured_w[ri][k] * o.dt_s[ri][k];
+        }
+        meas.push_back(e);
+      }
+      begin = i;
+    }
+  }
+  o.measured_j = Eigen::Map<Eigen::VectorXd>(meas.data(), static_cast<Eigen::Index>(meas.size()));
+}
+
+}  // namespace
+
+std::vector<double> measured_power_w(const Vehicle& v, const Recording& r, ChannelKind& kind) {
+  if (r.battery_power_w) {
+    kind = ChannelKind::battery_power;
+    return *r.battery_power_w;
+  }
+  if (r.battery_voltage_v && r.battery_current_a) {
+    kind = ChannelKind::battery_voltage_x_current;
+    std::vector<double> p(r.time_s.size());
+    for (std::size_t i = 0; i < p.size(); ++i) p[i] = (*r.battery_voltage_v)[i] * (*r.battery_current_a)[i];
+    return p;
+  }
+  if (r.fuel_rate_m3ps) {
+    const auto* cp = std::get_if<CombustionPowertrainParams>(&v.powertrain);
+    if (!cp) throw InputError(r.source, "fuel rate recorded but the vehicle is electric");
+    kind = ChannelKind::fuel_rate;
+    std::vector<double> p(r.time_s.size());
+    const double j_per_m3 = cp->fuel.density_kg_per_m3 * cp->fuel.lower_heating_value_j_per_kg;
+    for (std::size_t i = 0; i < p.size(); ++i) p[i] = (*r.fuel_rate_m3ps)[i] * j_per_m3;
+    return p;
+  }
+  kind = ChannelKind::soc;
+  return {};
+}
+
+Observations build_windows(const Vehicle& vehicle, const std::vector<Recording>& recordings, double window_s,
+                           const DiagnoseOptions& opt, std::vector<std::string>& notes) {
+  Observations o;
+  if (const auto* ep = std::get_if<ElectricPowertrainParams>(&vehicle.powertrain)) o.soc_capacity_j = ep->battery.usable_capacity_j;
+  for (std::size_t ri = 0; ri < recordings.size(); ++ri) {
+    const Recording& r = recordings[ri];
+    ChannelKind kind{};
+    o.measured_w.push_back(measured_power_w(vehicle, r, kind));
+    if (ri > 0 && kind != o.channel) throw InputError(r.source, "all recordings must carry the same energy channel");
+    o.channel = kind;
+    std::vector<double> dt(r.time_s.size() - 1);
+    for (std::size_t i = 0; i + 1 < r.time_s.size(); ++i) dt[i] = r.time_s[i + 1] - r.time_s[i];
+    o.dt_s.push_back(std::move(dt));
+  }
+  if (o.channel == ChannelKind::soc && o.soc_capacity_j > 0.0)
+    window_s = soc_window_s(recordings, o.soc_capacity_j, window_s, opt, notes);
+  o.window_s = window_s;
+  cut_windows(o, recordings);
+  const Eigen::Index n = o.n();
+  if (n < 8) throw InputError("--recording", "too short to diagnose: " + std::to_string(n) + " windows of " + num(window_s) + " s, need 8");
+  // Held-out folds: whole recordings when several are given (the honest test of a model), else alternating blocks.
+  o.fold_of.resize(static_cast<std::size_t>(n));
+  for (Eigen::Index w = 0; w < n; ++w)
+    o.fold_of[static_cast<std::size_t>(w)] = recordings.size() > 1 ? static_cast<int>(o.windows[static_cast<std::size_t>(w)].rec)
+                                                                    : static_cast<int>((w / opt.block_windows) % 2);
+  return o;
+}
+
+Observations rewindow(const Observations& o, const std::vector<Recording>& recordings, double window_s) {
+  Observations s = o;
+  s.window_s = window_s;
+  cut_windows(s, recordings);
+  s.fold_of.assign(static_cast<std::size_t>(s.n()), 0);
+  return s;
+}
+
+}  // namespace rollsim::diag
