@@ -1,6 +1,7 @@
 // `rollsim simulate`: a car over one or more drive cycles with one or more tyre sets; CLI glue only.
 #include <CLI/CLI.hpp>
 
+#include <cmath>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -100,11 +101,12 @@ void run_simulate(const SimulateOptions& o) {
     const auto& r = runs[i].result;
     const auto& ref = runs[i - i % tyre_sets.size()].result;
     const double value = report::headline_value(r), ref_value = report::headline_value(ref);
-    t.add_row({r.cycle, runs[i].tyre_label, fixed(value, 3), fixed(100.0 * (value / ref_value - 1.0), 2),
+    // A run that did not move has no per-distance figure (and no rolling energy to compare): "-", not inf or NaN.
+    auto shown = [](double x, int digits) { return std::isfinite(x) ? fixed(x, digits) : std::string("-"); };
+    t.add_row({r.cycle, runs[i].tyre_label, shown(value, 3), shown(100.0 * (value / ref_value - 1.0), 2),
                fixed(units::j_to_kwh(r.energy.rolling_j), 4),
-               fixed(100.0 * (r.energy.rolling_j / ref.energy.rolling_j - 1.0), 2),
-               r.fuel ? fixed(r.co2_g_per_km(), 1) : fixed(r.range_km(), 1),
-               fixed(units::mps_to_kmh(r.max_speed_error_mps), 2)});
+               shown(100.0 * (r.energy.rolling_j / ref.energy.rolling_j - 1.0), 2),
+               shown(r.fuel ? r.co2_g_per_km() : r.range_km(), 1), fixed(units::mps_to_kmh(r.max_speed_error_mps), 2)});
   }
   std::cout << base.name << " (" << (o.replay ? "replay" : "forward") << " simulation)\n" << t.render();
   std::cout << "diff %: against the first tyre on the same cycle\n";

@@ -157,6 +157,10 @@ std::string explanation_text(const TyreExplanation& x) {
 void run_tyre(const TyreOptions& o) {
   const TyreSpec spec = build_tyre(o);
   const LoadChoice load = choose_load(o, spec);
+  if (o.explain && spec.state.model != TyreModelKind::Thesis) {
+    throw InputError("--explain", "explains the thesis model's mechanisms; " + spec.source +
+                                      " uses the hysteresis model (model: kind: hysteresis)");
+  }
 
   std::vector<double> speeds_kmh;
   for (const auto& given : o.speeds_kmh) {
@@ -202,6 +206,7 @@ void run_tyre(const TyreOptions& o) {
       const auto& r = results[i];
       JsonObject j;
       j.add("tyre", spec.name).add("source", spec.source);
+      j.add("model", spec.state.model == TyreModelKind::Thesis ? "thesis" : "hysteresis");
       if (spec.size) j.add("size", spec.size->designation);
       j.add("outer_radius_m", spec.state.geometry.outer_radius_m)
           .add("section_width_m", spec.state.geometry.section_width_m)
@@ -270,7 +275,11 @@ void register_tyre_command(CLI::App& app) {
       ->type_name("KMH");
   sub->add_flag("--json", opts->json, "One JSON object per operating point per line");
   sub->add_flag("--explain", opts->explain, "Elasticities of RRC and RR power and the mechanism behind each");
-  sub->callback([opts] { run_tyre(*opts); });
+  register_tyre_fit_command(*sub);
+  sub->callback([opts, sub] {
+    if (sub->got_subcommand("fit")) return;  // `rollsim tyre fit` runs its own callback
+    run_tyre(*opts);
+  });
 }
 
 }  // namespace rollsim::cli
