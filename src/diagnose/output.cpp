@@ -3,6 +3,7 @@
 #include <sstream>
 
 #include "pipeline.hpp"
+#include "rollsim/common/json.hpp"
 #include "rollsim/common/error.hpp"
 
 namespace rollsim {
@@ -16,29 +17,9 @@ std::string num(double v) {
   return os.str();
 }
 
-std::string fixed(double v, int digits) {
-  std::ostringstream os;
-  os.setf(std::ios::fixed);
-  os.precision(digits);
-  os << v;
-  return os.str();
-}
-
 }  // namespace diag
 
 using diag::num;
-
-namespace {
-std::string json_escape(const std::string& s) {
-  std::string o;
-  for (char c : s) {
-    if (c == '"' || c == '\\') o += '\\';
-    if (c == '\n') { o += "\\n"; continue; }
-    o += c;
-  }
-  return o;
-}
-}  // namespace
 
 std::string diagnosis_json(const Diagnosis& d) {
   std::ostringstream os;
@@ -56,7 +37,7 @@ std::string diagnosis_json(const Diagnosis& d) {
   os << "  \"lag_samples\": " << d.lag_samples << ",\n";
   os << "  \"lag_s\": {\"value\": " << num(d.lag_s) << ", \"ci_low\": " << num(d.lag_ci_low_s) << ", \"ci_high\": " << num(d.lag_ci_high_s) << "},\n";
   os << "  \"window_s\": " << num(d.window_s) << ",\n  \"notes\": [";
-  for (std::size_t i = 0; i < d.notes.size(); ++i) os << (i ? ", " : "") << "\"" << json_escape(d.notes[i]) << "\"";
+  for (std::size_t i = 0; i < d.notes.size(); ++i) os << (i ? ", " : "") << json_string(d.notes[i]);
   os << "],\n";
   os << "  \"raw_trip_energy_error_pct\": " << num(d.raw_trip_energy_error_pct) << ",\n";
   os << "  \"heldout_rmse_calibrated\": " << num(d.heldout_rmse_calibrated_j) << ",\n";
@@ -65,7 +46,7 @@ std::string diagnosis_json(const Diagnosis& d) {
   for (std::size_t i = 0; i < d.findings.size(); ++i) {
     const auto& f = d.findings[i];
     os << (i ? "," : "") << "\n    {\"effect\": \"" << f.effect << "\", ";
-    if (!f.description.empty()) os << "\"description\": \"" << json_escape(f.description) << "\", ";
+    if (!f.description.empty()) os << "\"description\": " << json_string(f.description) << ", ";
     os << "\"parameters\": {";
     for (std::size_t k = 0; k < f.parameters.size(); ++k) {
       const auto& p = f.parameters[k];
@@ -80,7 +61,7 @@ std::string diagnosis_json(const Diagnosis& d) {
     for (std::size_t k = 0; k < f.confounded_with.size(); ++k) os << (k ? ", " : "") << "\"" << f.confounded_with[k] << "\"";
     os << "], \"separating_tests\": [";
     for (std::size_t k = 0; k < f.separating_tests.size(); ++k)
-      os << (k ? ", " : "") << "\"" << json_escape(f.separating_tests[k]) << "\"";
+      os << (k ? ", " : "") << json_string(f.separating_tests[k]);
     os << "], \"delta_bic\": " << num(f.delta_bic) << ", \"heldout_rmse_before\": " << num(f.heldout_rmse_before_j)
        << ", \"heldout_rmse_after\": " << num(f.heldout_rmse_after_j)
        << ", \"heldout_energy_error_pct_before\": " << num(f.heldout_energy_error_pct_before)

@@ -6,6 +6,7 @@
 #include <thread>
 
 #include "pipeline.hpp"
+#include "rollsim/common/parallel.hpp"
 #include "rollsim/sim/simulation.hpp"
 
 namespace rollsim::diag {
@@ -65,11 +66,10 @@ std::vector<std::vector<double>> Replayer::power(const EffectList& extra) const 
 // Independent replays, so they run in parallel (each thread assembles its own model).
 std::vector<Variant> Replayer::run(const std::vector<EffectList>& extras, const Observations& o, double lag_samples) const {
   std::vector<Variant> out(extras.size());
-  std::atomic<std::size_t> next{0};
   std::exception_ptr failure;
   std::mutex failure_mutex;
-  auto work = [&] {
-    for (std::size_t k = next++; k < extras.size(); k = next++) {
+  auto work = [&](std::size_t k) {
+    {
       try {
         out[k].power_w = power(extras[k]);
         out[k].window_j = window_energies(out[k].power_w, o, lag_samples);
@@ -79,12 +79,7 @@ std::vector<Variant> Replayer::run(const std::vector<EffectList>& extras, const 
       }
     }
   };
-  const unsigned n = std::max(1u, std::min<unsigned>(threads ? threads : std::thread::hardware_concurrency(),
-                                                     static_cast<unsigned>(extras.size())));
-  std::vector<std::thread> pool;
-  for (unsigned t = 1; t < n; ++t) pool.emplace_back(work);
-  work();
-  for (auto& t : pool) t.join();
+  parallel_for(extras.size(), threads, work);
   if (failure) std::rethrow_exception(failure);
   return out;
 }

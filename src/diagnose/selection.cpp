@@ -5,6 +5,7 @@
 #include <tuple>
 
 #include "pipeline.hpp"
+#include "rollsim/common/units.hpp"
 
 namespace rollsim {
 
@@ -190,9 +191,9 @@ Finding catalogue_finding(const SelectionContext& sc, const Candidate& c, const 
   f.fitted[c.amplitude->name] = value;
   if (c.across_trips) {
     const auto [lo, hi] = std::minmax_element(sc.ambient.ambient_k.begin(), sc.ambient.ambient_k.end());
-    f.description = "RRC level follows ambient temperature across the recordings (" + fixed(*lo - 273.15, 1) + " to " +
-                    fixed(*hi - 273.15, 1) + " degC): " + fixed(100.0 * value, 2) + " % per K colder, referred to " +
-                    fixed(sc.ambient.reference_k - 273.15, 1) + " degC; the written vehicle is neutral at that reference, set "
+    f.description = "RRC level follows ambient temperature across the recordings (" + fixed(*lo - units::kKelvinOffset, 1) + " to " +
+                    fixed(*hi - units::kKelvinOffset, 1) + " degC): " + fixed(100.0 * value, 2) + " % per K colder, referred to " +
+                    fixed(sc.ambient.reference_k - units::kKelvinOffset, 1) + " degC; the written vehicle is neutral at that reference, set "
                     "ambient_temp_c per trip";
   }
   if (best.standing)

@@ -1,4 +1,5 @@
 // Discovery benchmark: concealed-effect cases, blind diagnosis, parameter-only and sparse-regression baselines.
+#include "rollsim/common/parallel.hpp"
 #include "rollsim/discovery/scorecard.hpp"
 
 #include <algorithm>
@@ -272,11 +273,11 @@ BenchResult run_discovery_bench(const Vehicle& vehicle, const BenchOptions& opt)
   for (std::size_t c = 0; c < cases.size(); ++c)
     for (int s = 0; s < cases[c].seeds; ++s) tasks.push_back({c, s});
   std::vector<Outcome> out(tasks.size());
-  std::atomic<std::size_t> next{0}, done{0};
+  std::atomic<std::size_t> done{0};
   std::mutex io;
   const unsigned threads = opt.threads > 0 ? opt.threads : std::max(1u, std::thread::hardware_concurrency());
-  auto worker = [&] {
-    for (std::size_t k; (k = next.fetch_add(1)) < tasks.size();) {
+  auto worker = [&](std::size_t k) {
+    {
       const Case& c = cases[tasks[k].c];
       SyntheticCase s = c.synth;
       s.seed = c.seed0 + static_cast<unsigned>(tasks[k].s);
@@ -308,9 +309,7 @@ BenchResult run_discovery_bench(const Vehicle& vehicle, const BenchOptions& opt)
       }
     }
   };
-  std::vector<std::thread> pool;
-  for (unsigned i = 0; i < threads; ++i) pool.emplace_back(worker);
-  for (auto& th : pool) th.join();
+  parallel_for(tasks.size(), threads, worker);
 
   BenchResult res;
   res.threads = threads;
