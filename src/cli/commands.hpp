@@ -15,5 +15,6 @@ void register_compare_command(CLI::App& app);
 void register_sweep_command(CLI::App& app);
 void register_sensitivity_command(CLI::App& app);
 void register_regress_command(CLI::App& app);
+void register_validate_command(CLI::App& app);
 
 }  // namespace rollsim::cli
