@@ -125,8 +125,9 @@ class WeakBrakes final : public Powertrain {
   double max_wheel_force_n(int g, double v, double r) const override { return inner_->max_wheel_force_n(g, v, r); }
   std::vector<double> shift_speeds_mps(int g) const override { return inner_->shift_speeds_mps(g); }
   std::vector<double> regime_speeds_mps() const override { return inner_->regime_speeds_mps(); }
-  double usable_battery_energy_j() const override { return inner_->usable_battery_energy_j(); }
-  bool is_electric() const override { return inner_->is_electric(); }
+  const BatteryParams* battery() const override { return inner_->battery(); }
+  const FuelParams* fuel() const override { return inner_->fuel(); }
+  void add_electric_load(double w, PowerFlow& flow) const override { inner_->add_electric_load(w, flow); }
 
  private:
   std::shared_ptr<const Powertrain> inner_;
