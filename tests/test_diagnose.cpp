@@ -92,7 +92,7 @@ double measured_over_simulated(const Vehicle& v, const Recording& r, double t0, 
     if (r.time_s[i] < t0 || r.time_s[i] >= t1) continue;
     const double dt = r.time_s[i + 1] - r.time_s[i];
     em += (*r.battery_power_w)[i] * dt;
-    es += s.trace[i].battery_power_w * dt;
+    es += s.trace[i].segment_battery_power_w * dt;  // the segment's mean, as simulate integrates it
   }
   return em / es;
 }

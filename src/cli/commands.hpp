@@ -8,6 +8,7 @@ namespace rollsim::cli {
 void register_commands(CLI::App& app);
 void register_simulate_command(CLI::App& app);
 void register_tyre_command(CLI::App& app);
+void register_tyre_fit_command(CLI::App& tyre);
 void register_diagnose_command(CLI::App& app);
 void register_diagnose_bench_command(CLI::App& app);
 void register_compare_command(CLI::App& app);

@@ -47,7 +47,7 @@ SparseDesign sparse_design(const Vehicle& vehicle, const Recording& rec, double 
   for (std::size_t i = 0; i + 1 < rec.time_s.size() && i < sim.trace.size(); ++i) {
     const double dt = rec.time_s[i + 1] - rec.time_s[i], v = rec.speed_mps[i];
     const double a = (rec.speed_mps[i + 1] - v) / dt;
-    const double sim_w = fuel_j_per_m3 > 0.0 ? sim.trace[i].fuel_rate_m3_per_s * fuel_j_per_m3 : sim.trace[i].battery_power_w;
+    const double sim_w = fuel_j_per_m3 > 0.0 ? sim.trace[i].segment_fuel_rate_m3_per_s * fuel_j_per_m3 : sim.trace[i].segment_battery_power_w;
     const std::array<double, kTerms> phi{sim_w, 1.0, v, v * v, v * v * v, a, a * v};
     for (int k = 0; k < kTerms; ++k) acc[k] += phi[k] * dt;
     // SOC is a state: a window's energy is its drop times the capacity, not an integral of samples.

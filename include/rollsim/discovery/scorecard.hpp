@@ -21,6 +21,8 @@ struct BenchOptions {
   /// The combustion car of the fuel-channel cases (engine warm-up, fuel null), a shipped name or a path; not
   /// loaded in the quick subset, which has no fuel case.
   std::string combustion_vehicle = "ice";
+  /// Only the rows whose label contains one of these (empty: every row), e.g. {"real logger"}.
+  std::vector<std::string> only;
 };
 
 /// How one method fared on one case, over its seeds.
@@ -32,6 +34,35 @@ struct Score {
   int n() const { return named + confounded + missed + mistaken; }
 };
 
+/// One finding as the scorecard reads it: its effect (or "unexplained"), the ids it is confounded with, its size (the
+/// first parameter: the catalogue amplitude).
+struct FindingSummary {
+  std::string effect;
+  std::vector<std::string> confounded_with;
+  double size = 0.0;
+};
+
+/// What a row asks of a diagnosis. `group` as BenchRow's; `sign` +1 where the truth's physics has a sign (the
+/// expected effect with a negative size is then a mistake); `never_called` for the "reversed" rows, the effect a
+/// null of that kind must never be called (tyre_warmup for an RRC rising over the trip).
+struct RowRule {
+  std::string group;
+  std::vector<std::string> expected;
+  int sign = 0;
+  std::string never_called;
+};
+
+enum class Tally { named, confounded, missed, mistaken };
+
+/// How rollsim's column scores one diagnosis. Effect rows ("single", "pair", "trips"): by the first finding, named
+/// when it is an expected id alone, confounded when an expected id is among its confounded set, missed when there is
+/// none or it is "unexplained", mistaken otherwise, and mistaken too when it names an expected id with a size of the
+/// wrong sign. "two": named when both expected ids are among all findings, confounded when one is. "null": any
+/// finding is mistaken (a false discovery). "reversed": any finding of `never_called`, of either sign, is mistaken.
+/// `wrong_sign` (optional) is set when the tally is a mistake for the sign alone, or a never_called finding of
+/// negative size.
+Tally score_findings(const RowRule& rule, const std::vector<FindingSummary>& findings, bool* wrong_sign = nullptr);
+
 struct BenchRow {
   std::string group;       ///< "single", "pair", "two", "trips" (several recordings), "null", "reversed"
   std::string label;       ///< e.g. "aux_compressor 300 W (mean)"
@@ -41,6 +72,9 @@ struct BenchRow {
   std::vector<Score> sparse_by_threshold;  ///< per sparse_thresholds() entry
   Score sparse_bic;                        ///< at the threshold BIC picks per recording
   int rollsim_unexplained = 0;  ///< seeds whose first finding was an unexplained signature
+  /// Seeds counted mistaken for a size of the wrong sign (effect rows), or a never_called finding of negative size
+  /// ("reversed" rows; the rest of that row's mistakes had a positive size).
+  int rollsim_wrong_sign = 0;
 };
 
 /// The sparse baseline at one threshold, pooled over the scorecard: null rows, and effect rows (single, pair, two).

@@ -47,7 +47,8 @@ struct ColumnMapping {
 /// The canonical column names, in the order above.
 const std::vector<std::string>& canonical_recording_columns();
 
-/// Adds one `--column CANONICAL=SOURCE` option to `mapping`; throws InputError naming the option.
+/// Adds one `--column CANONICAL=SOURCE` option to `mapping`; `--column CANONICAL=` (nothing after '=') drops the
+/// column (a preset's mapping included; time_s and speed_kmh cannot be dropped). Throws InputError naming the option.
 void parse_column_option(const std::string& text, ColumnMapping& mapping);
 /// Adds one `--scale CANONICAL=FACTOR` option (finite, non-zero) to `mapping`; throws InputError naming it.
 void parse_scale_option(const std::string& text, ColumnMapping& mapping);
@@ -83,7 +84,9 @@ inline constexpr std::size_t kMaxRecordingSamples = 1000000;
 /// and column for: a missing column (found columns listed, --column suggested), text in a number column,
 /// infinite or out-of-range values, time repeating or going backwards, NaN runs longer than
 /// kMaxBridgedRun_s, a recording shorter than kMinRecordingDuration_s, no energy channel, more than
-/// kMaxRecordingSamples rows (checked while reading, before anything else is allocated).
+/// kMaxRecordingSamples rows (checked while reading, before anything else is allocated). GPS latitude and longitude,
+/// which the diagnosis does not need, never throw: bad cells are read as missing and a column too broken to bridge is
+/// dropped, each with a "warning:" in repairs. A canonical column mapped to "" is not read.
 Recording load_recording(const std::string& path, const ColumnMapping& mapping);
 
 }  // namespace rollsim
