@@ -104,6 +104,12 @@ TEST_F(Hardening, ErrorsDeepInParsingNameFileAndPlace) {
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_TRUE(has(r.err, dir_.string() + ": is a folder")) << r.err;
 
+  // Found by fuzz_tyre in the duplicate-key walk: an alias inside its own anchor is an endless tree.
+  const std::string loop = write("loop.yaml", "a: &x [1, *x, *x]\nsize: \"175/70 R14 84T\"\n");
+  r = run_rollsim("tyre '" + loop + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, loop + ": line 1: nested more than 64 levels")) << r.err;
+
   // A list item's key is written item.key.
   const std::string neg = write("neg.yaml", "cases:\n  - {name: a, vehicle: ev, tyre: nominal, cycle: nedc, unit: kwh_per_10km, "
                                              "expected: -1, tolerance_pct: 1}\n");
@@ -118,6 +124,9 @@ TEST_F(Hardening, MessagesSayWhatIsWrong) {
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_TRUE(has(r.err, "is a folder")) << r.err;
   r = run_rollsim("simulate --vehicle ev --tyre '" + dir_.string() + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, "is a folder")) << r.err;
+  r = run_rollsim("simulate --vehicle ev --cycle '" + dir_.string() + "'");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_TRUE(has(r.err, "is a folder")) << r.err;
 
@@ -175,6 +184,62 @@ TEST_F(Hardening, OversizedRecordingIsRejectedEarly) {
   r = run_rollsim("diagnose --vehicle ev --recording '" + many + "'");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_TRUE(has(r.err, many + ": line 1000002: more than 1000000 samples")) << r.err;
+}
+
+
+// Address space bound for a command that should fail before allocating much (not under ASan, whose shadow
+// memory needs terabytes of address space).
+std::string memory_bound() {
+#if defined(__SANITIZE_ADDRESS__)
+  return "";
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+  return "";
+#endif
+#endif
+  return "ulimit -v 1500000 && ";
+}
+
+// A grid is bounded before it is built: 10^6 x 10^6 points used to take 4.5 GB and then fail without a word.
+TEST_F(Hardening, HugeSweepGridIsRefusedBeforeAllocating) {
+  const CmdResult r = run_rollsim("sweep --tyre 175-70R14 --param pressure --from 1 --to 3 --steps 1000000 "
+                                  "--param speed --from 0 --to 100 --steps 1000000",
+                                  memory_bound());
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_TRUE(has(r.err, "--steps: 1000000 x 1000000 points is more than the 1000000 allowed")) << r.err;
+  EXPECT_TRUE(r.out.empty());
+}
+
+// Every destination is checked before the work and all outputs are written after it: a bad one writes none.
+TEST_F(Hardening, NoOutputIsLeftBehindWhenAnotherFails) {
+  const fs::path csv = dir_ / "s.csv";
+  CmdResult r = run_rollsim("sweep --tyre 175-70R14 --param pressure --from 2 --to 3 --steps 3 --output '" +
+                            csv.string() + "' --plot '" + (dir_ / "nodir" / "p.svg").string() + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, "--plot")) << r.err;
+  EXPECT_FALSE(fs::exists(csv));
+
+  const fs::path report = dir_ / "newrep";
+  r = run_rollsim("diagnose --vehicle ev --recording '" + (dir_ / "missing.csv").string() + "' --report '" +
+                  report.string() + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_FALSE(fs::exists(report)) << "the report folder was created before the recording was read";
+
+  const fs::path json = dir_ / "d.json";
+  const std::string rec = std::string(ROLLSIM_SHARED_DIR) + "/data/recordings/anl_d3_2018_toyota_camry/61811012_test_data.csv";
+  r = run_rollsim("diagnose --vehicle camry_2018 --preset anl_d3 --recording '" + rec + "' --json '" + json.string() +
+                  "' --write-vehicle '" + (dir_ / "nodir" / "f.yaml").string() + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, "--write-vehicle")) << r.err;
+  EXPECT_FALSE(fs::exists(json));
+  EXPECT_TRUE(r.out.empty()) << "the diagnosis ran before the outputs were checked";
+
+  r = run_rollsim("simulate --vehicle ev --trace '" + dir_.string() + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, "is a folder")) << r.err;
+  EXPECT_TRUE(r.out.empty());
+  // Nothing but the test's own files: no temporaries either.
+  for (const auto& e : fs::directory_iterator(dir_)) EXPECT_FALSE(has(e.path().filename().string(), ".tmp")) << e.path();
 }
 
 }  // namespace

@@ -125,8 +125,9 @@ class WeakBrakes final : public Powertrain {
   double max_wheel_force_n(int g, double v, double r) const override { return inner_->max_wheel_force_n(g, v, r); }
   std::vector<double> shift_speeds_mps(int g) const override { return inner_->shift_speeds_mps(g); }
   std::vector<double> regime_speeds_mps() const override { return inner_->regime_speeds_mps(); }
-  double usable_battery_energy_j() const override { return inner_->usable_battery_energy_j(); }
-  bool is_electric() const override { return inner_->is_electric(); }
+  const BatteryParams* battery() const override { return inner_->battery(); }
+  const FuelParams* fuel() const override { return inner_->fuel(); }
+  void add_electric_load(double power_w, PowerFlow& flow) const override { inner_->add_electric_load(power_w, flow); }
 
  private:
   std::shared_ptr<const Powertrain> inner_;
@@ -142,4 +143,61 @@ TEST(Standstill, CarStillMovingWhenTheTraceStopsIsBrakedAndBooked) {
   // 50 km/h to rest in 2 s asks for 11.6 kN; 3 kN of brakes leave the car at about 36 km/h when the trace stops.
   const auto r = simulate_forward(m, trace({{0.0, 0.0}, {20.0, 50.0}, {60.0, 50.0}, {62.0, 0.0}, {120.0, 0.0}}));
   EXPECT_LT(std::abs(r.energy.wheel_residual_j()) / r.energy.traction_j, 1e-4);
+}
+
+namespace {
+// NEDC driven `times` times back to back (one shared sample at each join).
+DriveCycle repeated_nedc(int times) {
+  const DriveCycle one = load_cycle("nedc");
+  DriveCycle c;
+  c.name = "nedc_x" + std::to_string(times);
+  for (int k = 0; k < times; ++k) {
+    for (std::size_t i = k == 0 ? 0 : 1; i < one.time_s.size(); ++i) {
+      c.time_s.push_back(one.time_s[i] + k * one.duration_s());
+      c.speed_mps.push_back(one.speed_mps[i]);
+      c.grade.push_back(0.0);
+    }
+  }
+  return c;
+}
+}  // namespace
+
+// NEDC for 24 h asks for 14 times what the battery holds (it went from 95 % to -544 % without a word). Where it runs
+// empty follows from one NEDC's energy: the chemical energy of one lap divides the usable charge into whole laps,
+// and the battery is empty within the lap after them. Forward and replay find the same point.
+TEST(BatteryDepletion, TwentyFourHoursOfNedcRunTheBatteryEmptyWhereTheEnergySays) {
+  const auto m = model_of("vehicles/ev.yaml");
+  const auto one = simulate_forward(m, load_cycle("nedc"));
+  EXPECT_FALSE(one.battery_empty);
+  const double lap_j = one.energy.battery_terminal_j + one.energy.battery_loss_j;
+  const double charge_j = one.battery->initial_soc * one.battery->usable_j;
+  const int laps = static_cast<int>(24 * 3600 / 1180);
+  const auto forward = simulate_forward(m, repeated_nedc(laps));
+  const auto replay = simulate_replay(m, repeated_nedc(laps));
+  for (const auto* r : {&forward, &replay}) {
+    SCOPED_TRACE(r->mode);
+    ASSERT_TRUE(r->battery_empty.has_value());
+    const double whole_laps = std::floor(charge_j / lap_j);
+    EXPECT_GE(r->battery_empty->time_s, whole_laps * 1180.0);
+    EXPECT_LE(r->battery_empty->time_s, (whole_laps + 1.0) * 1180.0);
+    EXPECT_LT(r->battery->final_soc, 0.0);
+    // The distance at that time is the trace's own distance up to it.
+    DriveCycle upto = repeated_nedc(laps);
+    double d = 0.0;
+    for (std::size_t i = 0; i + 1 < upto.time_s.size() && upto.time_s[i + 1] <= r->battery_empty->time_s; ++i)
+      d += 0.5 * (upto.speed_mps[i] + upto.speed_mps[i + 1]) * (upto.time_s[i + 1] - upto.time_s[i]);
+    EXPECT_NEAR(r->battery_empty->distance_m, d, 40.0);  // within the last second's travel (max 33 m/s)
+  }
+  EXPECT_NEAR(forward.battery_empty->time_s, replay.battery_empty->time_s, 5.0);
+}
+
+// A trace that never moves has no per-distance figure: NaN in the library (the report prints it as undefined),
+// never inf.
+TEST(ZeroDistance, StandstillOnlyTraceHasNoPerDistanceFigures) {
+  const auto m = model_of("vehicles/ev.yaml");
+  const auto r = simulate_forward(m, trace({{0.0, 0.0}, {600.0, 0.0}}));
+  EXPECT_FALSE(r.moved());
+  EXPECT_TRUE(std::isnan(r.aec_kwh_per_10km()));
+  EXPECT_TRUE(std::isnan(r.range_km()));
+  EXPECT_GT(r.energy.battery_terminal_j, 0.0);  // the auxiliaries still draw
 }

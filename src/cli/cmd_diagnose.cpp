@@ -29,7 +29,10 @@ void run_diagnose(const DiagnoseCliOptions& o) {
   Vehicle v = load_vehicle_file(vehicle_path);
   const std::string tyre_path = o.tyre.empty() ? "" : resolve_data_file(o.tyre, "tyres", ".yaml", "--tyre");
   if (!o.tyre.empty()) fit_tyres(v, load_tyre_file(tyre_path));
-  if (!o.report.empty()) check_report_dir(o.report);  // fail before the diagnosis, not after it
+  // Every destination is checked before the diagnosis, and all are written together after it.
+  if (!o.report.empty()) check_report_dir(o.report);
+  if (!o.json.empty()) check_output_file(o.json, "--json");
+  if (!o.write_vehicle.empty()) check_output_file(o.write_vehicle, "--write-vehicle");
   // Column mapping: a preset, then the vehicle file's own logger mapping, then the command line's options.
   ColumnMapping mapping;
   if (!o.preset.empty()) mapping = preset_mapping(o.preset);
@@ -49,17 +52,20 @@ void run_diagnose(const DiagnoseCliOptions& o) {
   if (o.window_s > 0.0) dopt.window_s = o.window_s;
   const Diagnosis d = diagnose(v, recs, dopt);
   std::cout << diagnosis_text(d);
-  if (!o.json.empty()) write_file_atomically(o.json, "--json", [&](std::ostream& os) { os << diagnosis_json(d); });
+  std::vector<OutputFile> files;
+  if (!o.json.empty()) files.push_back({o.json, "--json", diagnosis_json(d)});
+  // The fitted vehicle names its files resolved (and the --tyre used), so it loads from the folder it is written to.
+  if (!o.write_vehicle.empty())
+    files.push_back({o.write_vehicle, "--write-vehicle", portable_vehicle_yaml(fitted_vehicle_yaml(vehicle_path, d), vehicle_path, tyre_path)});
+  std::size_t report_files = 0;
   if (!o.report.empty()) {
-    const auto files = write_diagnosis_report(o.report, d, "rollsim diagnose: " + v.name);
-    std::cout << "report written to " << o.report << " (" << files.size() << " files, report.html)\n";
+    const auto report = render_diagnosis_report(o.report, d, "rollsim diagnose: " + v.name);
+    report_files = report.size();
+    files.insert(files.end(), report.begin(), report.end());
   }
-  if (!o.write_vehicle.empty()) {
-    // The files it names resolved (and the --tyre used), so it loads from the folder it is written to.
-    const std::string text = portable_vehicle_yaml(fitted_vehicle_yaml(vehicle_path, d), vehicle_path, tyre_path);
-    write_file_atomically(o.write_vehicle, "--write-vehicle", [&](std::ostream& os) { os << text; });
-    std::cout << "fitted vehicle written to " << o.write_vehicle << "\n";
-  }
+  write_files_atomically(files);
+  if (!o.report.empty()) std::cout << "report written to " << o.report << " (" << report_files << " files, report.html)\n";
+  if (!o.write_vehicle.empty()) std::cout << "fitted vehicle written to " << o.write_vehicle << "\n";
 }
 
 }  // namespace

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "rollsim/common/atomic_file.hpp"
 #include "rollsim/report/gnuplot.hpp"
 #include "rollsim/common/units.hpp"
 #include "rollsim/report/table.hpp"
@@ -76,7 +77,7 @@ std::string render_plot(const selection::SweepResult& r, const std::string& tyre
   }
   data.close();
   const auto& a0 = r.axes[0];
-  std::string load_text = report::fixed(r.points.front().load_n, 0) + " N";
+  std::string load_text = fixed(r.points.front().load_n, 0) + " N";
   std::string title = "RRC of " + tyre_name;
   if (a0.param != selection::SweepParam::Load && a0.param != selection::SweepParam::LoadPct &&
       (r.axes.size() < 2 || (r.axes[1].param != selection::SweepParam::Load &&
@@ -84,7 +85,7 @@ std::string render_plot(const selection::SweepResult& r, const std::string& tyre
     title += " at " + load_text;
   }
   if (a0.param != selection::SweepParam::Speed && (r.axes.size() < 2 || r.axes[1].param != selection::SweepParam::Speed)) {
-    title += ", " + report::fixed(r.points.front().speed_kmh, 0) + " km/h";
+    title += ", " + fixed(r.points.front().speed_kmh, 0) + " km/h";
   }
   const fs::path figure = work / ("figure" + ext);
   std::ofstream gp(work / "plot.gp");
@@ -148,9 +149,13 @@ void run_sweep(const SweepOptionsText& o) {
   if (!o.load_n.empty()) so.load_n = parse_option_number(o.load_n, "--load-n", Range::open_low(0.0, 1e6));
   so.speed_kmh = parse_option_number(o.speed_kmh, "--speed-kmh", Range::closed(0.0, 500.0));
   if (!o.threads.empty()) so.threads = static_cast<unsigned>(parse_option_number(o.threads, "--threads", Range::closed(1, 1024)));
+  // Every destination is checked before the sweep, and all are written after it (nothing is left behind).
+  if (!o.output.empty()) check_output_file(o.output, "--output");
   if (!o.plot.empty()) {
     const std::string ext = std::filesystem::path(o.plot).extension().string();
     if (ext != ".svg" && ext != ".png") throw InputError("--plot " + o.plot, "must end in .svg or .png");
+    check_output_file(o.plot, "--plot");
+    if (report::find_gnuplot().empty()) throw InputError("--plot " + o.plot, gnuplot_missing);
   }
 
   const TyreSpec tyre = load_tyre_file(resolve_data_file(o.tyre, "tyres", ".yaml", "--tyre"));
@@ -162,14 +167,14 @@ void run_sweep(const SweepOptionsText& o) {
     const DriveCycle c = load_cycle(o.cycle, "--cycle");
     r = selection::sweep_vehicle(v, tyre, c, so);
   } else {
-    so.progress = nullptr;  // the tyre alone takes milliseconds
     r = selection::sweep_tyre(tyre, so);
   }
 
+  std::string table;
   if (o.json) {
     std::ostringstream out;
     for (const auto& p : r.points) {
-      report::JsonObject j;
+      JsonObject j;
       for (std::size_t i = 0; i < r.axes.size(); ++i) {
         j.add(selection::sweep_param_key(r.axes[i].param) + "_" + selection::sweep_param_unit(r.axes[i].param), p.values[i]);
       }
@@ -178,14 +183,15 @@ void run_sweep(const SweepOptionsText& o) {
       if (r.vehicle) j.add(r.energy_unit, p.energy);
       out << j.str() << "\n";
     }
-    if (o.output.empty()) std::cout << out.str();
-    else selection::write_file_atomically(o.output, out.str(), "--output");
-  } else if (o.output.empty()) {
-    std::cout << selection::sweep_csv(r);
+    table = out.str();
   } else {
-    selection::write_file_atomically(o.output, selection::sweep_csv(r), "--output");
+    table = selection::sweep_csv(r);
   }
-  if (!o.plot.empty()) selection::write_file_atomically(o.plot, render_plot(r, tyre.name, o.plot, o.base100), "--plot");
+  std::vector<OutputFile> files;
+  if (!o.output.empty()) files.push_back({o.output, "--output", table});
+  if (!o.plot.empty()) files.push_back({o.plot, "--plot", render_plot(r, tyre.name, o.plot, o.base100)});
+  write_files_atomically(files);
+  if (o.output.empty()) std::cout << table;
   if (r.stopped) {
     throw InputError("--param", *r.stopped + " (the " + std::to_string(r.points.size()) + " valid points of " +
                                     std::to_string(r.planned_points) + " were written)");

@@ -35,11 +35,16 @@ namespace {
 // yaml-cpp keeps every occurrence of a repeated key and answers lookups with the first, so a second
 // `pressure_bar:` further down would be silently ignored; keys that are lists or mappings cannot be named.
 // Both are rejected here, at the line of the offending key, for every mapping in the document.
-// Aliases can make a small file a huge tree (a "billion laughs"): the walk stops at a bound no real input nears.
-void check_keys(const YAML::Node& node, const std::string& path, std::size_t& visited) {
+// Aliases can make a small file a huge tree (a "billion laughs") or an endless one (an alias inside its own
+// anchor): the walk stops at bounds no real input nears.
+void check_keys(const YAML::Node& node, const std::string& path, std::size_t& visited, int depth = 0) {
   if (++visited > 1000000) throw InputError(path, "more than a million values (aliases repeated?); not an input file of rollsim");
+  if (depth > 64) {
+    throw InputError(path + ": line " + std::to_string(node.Mark().line + 1),
+                     "nested more than 64 levels deep (an alias inside its own anchor?)");
+  }
   if (node.IsSequence()) {
-    for (const auto& item : node) check_keys(item, path, visited);
+    for (const auto& item : node) check_keys(item, path, visited, depth + 1);
     return;
   }
   if (!node.IsMap()) return;
@@ -51,7 +56,7 @@ void check_keys(const YAML::Node& node, const std::string& path, std::size_t& vi
     if (std::find(seen.begin(), seen.end(), key) != seen.end())
       throw InputError(at + ": key '" + key + "'", "appears a second time in the same mapping; give each key once");
     seen.push_back(key);
-    check_keys(kv.second, path, visited);
+    check_keys(kv.second, path, visited, depth + 1);
   }
 }
 

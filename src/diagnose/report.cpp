@@ -1,4 +1,5 @@
 // Diagnosis report: per-window data to gnuplot (SVG), and one HTML page with the SVGs inline.
+#include "rollsim/common/units.hpp"
 #include "rollsim/diagnose/report.hpp"
 
 #include <unistd.h>
@@ -45,17 +46,13 @@ struct Figure {
 }  // namespace
 
 void check_report_dir(const std::string& dir) {
-  const std::string where = "--report '" + dir + "'";
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (!fs::is_directory(dir, ec) || access(dir.c_str(), W_OK) != 0)
-    throw InputError(where, "cannot create or write to this folder" + (ec ? ": " + ec.message() : std::string()));
+  check_output_dir(dir, "--report");
   if (report::find_gnuplot().empty())
-    throw InputError(where, "gnuplot is not installed or not on PATH (Debian: apt-get install gnuplot-nox); "
-                            "the text and --json output do not need it");
+    throw InputError("--report '" + dir + "'", "gnuplot is not installed or not on PATH (Debian: apt-get install gnuplot-nox); "
+                                               "the text and --json output do not need it");
 }
 
-std::vector<std::string> write_diagnosis_report(const std::string& dir, const Diagnosis& d, const std::string& title) {
+std::vector<OutputFile> render_diagnosis_report(const std::string& dir, const Diagnosis& d, const std::string& title) {
   const std::string where = "--report '" + dir + "'";
   check_report_dir(dir);
   std::error_code ec;
@@ -83,7 +80,7 @@ std::vector<std::string> write_diagnosis_report(const std::string& dir, const Di
       cum_after += (w.measured_j - w.fitted_j) / 1e3;
       data << (offset_s + 0.5 * (w.start_s + w.end_s)) / 60.0 << " " << w.measured_j / dur << " " << w.simulated_j / dur << " "
            << w.calibrated_j / dur << " " << w.fitted_j / dur << " " << cum_before << " " << cum_after << " "
-           << 3.6 * w.mean_speed_mps << " " << w.mean_positive_accel_mps2 << " " << 0.5 * (w.start_s + w.end_s) / 60.0 << " "
+           << units::mps_to_kmh(w.mean_speed_mps) << " " << w.mean_positive_accel_mps2 << " " << 0.5 * (w.start_s + w.end_s) / 60.0 << " "
            << (w.measured_j - w.calibrated_j) / dur << " " << (w.measured_j - w.fitted_j) / dur << "\n";
     }
   }
@@ -126,29 +123,31 @@ std::vector<std::string> write_diagnosis_report(const std::string& dir, const Di
   }
   fs::remove_all(work, ec);
 
-  std::vector<std::string> written;
+  std::vector<OutputFile> files;
+  for (std::size_t k = 0; k < figs.size(); ++k) files.push_back({(fs::path(dir) / figs[k].file).string(), "--report", svgs[k]});
+  std::ostringstream os;
+  os << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>" << html_escape(title)
+     << "</title>\n<style>body{font-family:sans-serif;max-width:900px;margin:auto}pre{background:#f4f4f4;padding:8px;"
+        "overflow-x:auto}figure{margin:1em 0}</style></head><body>\n<h1>"
+     << html_escape(title) << "</h1>\n<h2>Verdict: " << html_escape(d.verdict) << "</h2>\n<pre>" << html_escape(diagnosis_text(d))
+     << "</pre>\n";
   for (std::size_t k = 0; k < figs.size(); ++k) {
-    const std::string path = (fs::path(dir) / figs[k].file).string();
-    write_file_atomically(path, "--report", [&](std::ostream& os) { os << svgs[k]; });
-    written.push_back(path);
+    // Inline SVG: drop the XML prolog and doctype, which are not allowed inside HTML.
+    const std::string& s = svgs[k];
+    const auto at = s.find("<svg");
+    os << "<figure>\n" << (at == std::string::npos ? s : s.substr(at)) << "\n<figcaption>" << html_escape(figs[k].caption)
+       << "</figcaption></figure>\n";
   }
-  const std::string html_path = (fs::path(dir) / "report.html").string();
-  write_file_atomically(html_path, "--report", [&](std::ostream& os) {
-    os << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>" << html_escape(title)
-       << "</title>\n<style>body{font-family:sans-serif;max-width:900px;margin:auto}pre{background:#f4f4f4;padding:8px;"
-          "overflow-x:auto}figure{margin:1em 0}</style></head><body>\n<h1>"
-       << html_escape(title) << "</h1>\n<h2>Verdict: " << html_escape(d.verdict) << "</h2>\n<pre>" << html_escape(diagnosis_text(d))
-       << "</pre>\n";
-    for (std::size_t k = 0; k < figs.size(); ++k) {
-      // Inline SVG: drop the XML prolog and doctype, which are not allowed inside HTML.
-      const std::string& s = svgs[k];
-      const auto at = s.find("<svg");
-      os << "<figure>\n" << (at == std::string::npos ? s : s.substr(at)) << "\n<figcaption>" << html_escape(figs[k].caption)
-         << "</figcaption></figure>\n";
-    }
-    os << "<h2>JSON</h2>\n<pre>" << html_escape(diagnosis_json(d)) << "</pre>\n</body></html>\n";
-  });
-  written.push_back(html_path);
+  os << "<h2>JSON</h2>\n<pre>" << html_escape(diagnosis_json(d)) << "</pre>\n</body></html>\n";
+  files.push_back({(fs::path(dir) / "report.html").string(), "--report", os.str()});
+  return files;
+}
+
+std::vector<std::string> write_diagnosis_report(const std::string& dir, const Diagnosis& d, const std::string& title) {
+  const auto files = render_diagnosis_report(dir, d, title);
+  write_files_atomically(files);
+  std::vector<std::string> written;
+  for (const auto& f : files) written.push_back(f.path);
   return written;
 }
 

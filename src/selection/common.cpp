@@ -1,11 +1,5 @@
-// Running a car for tyre selection, its headline figure, and atomic file writes.
+// Running a car for tyre selection and its headline figure.
 #include "rollsim/selection/common.hpp"
-
-#include <unistd.h>
-
-#include <cstdio>
-#include <filesystem>
-#include <fstream>
 
 #include "rollsim/common/error.hpp"
 
@@ -33,31 +27,6 @@ EnergyFigure energy_figure(const SimulationResult& r) {
 EnergyFigure run_forward(const Vehicle& vehicle, const DriveCycle& cycle) {
   const VehicleModel model = VehicleModel::assemble(vehicle);
   return energy_figure(simulate_forward(model, cycle));
-}
-
-void write_file_atomically(const std::string& path, const std::string& content, const std::string& option) {
-  namespace fs = std::filesystem;
-  const fs::path target(path);
-  const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  // The temporary file sits in the target's folder so that the rename cannot cross file systems.
-  const fs::path tmp = dir / ("." + target.filename().string() + ".tmp" + std::to_string(getpid()));
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw InputError(option + " " + path, "cannot write here (folder missing or not writable)");
-    out << content;
-    out.flush();
-    if (!out) {
-      std::error_code ec;
-      fs::remove(tmp, ec);
-      throw InputError(option + " " + path, "writing failed (disk full?); nothing was written");
-    }
-  }
-  std::error_code ec;
-  fs::rename(tmp, target, ec);
-  if (ec) {
-    fs::remove(tmp, ec);
-    throw InputError(option + " " + path, "cannot replace the file: " + ec.message());
-  }
 }
 
 }  // namespace rollsim::selection

@@ -1,4 +1,4 @@
-// Shared helpers of tyre selection: running a car on a cycle with a given tyre, the car's figure of merit, safe file writes.
+// Shared helpers of tyre selection: running a car on a cycle with a given tyre, the car's figure of merit.
 #pragma once
 
 #include <string>
@@ -26,9 +26,5 @@ EnergyFigure energy_figure(const SimulationResult& result);
 
 /// Assembles `vehicle` and runs it forward (driver + CVODE) over `cycle`.
 EnergyFigure run_forward(const Vehicle& vehicle, const DriveCycle& cycle);
-
-/// Writes `content` to a temporary file beside `path` and renames it over `path`, so readers never see a
-/// half-written file. Throws InputError naming `option` and the path if the folder is not writable.
-void write_file_atomically(const std::string& path, const std::string& content, const std::string& option);
 
 }  // namespace rollsim::selection
