@@ -74,9 +74,17 @@ Calibration calibrate(const Observations& o, const Variant& base, const Variant&
   const double rho = std::clamp(lag1_autocorrelation(resid), 0.0, 0.95);
   m.n_eff = std::max(4.0, static_cast<double>(n) * (1.0 - rho) / (1.0 + rho));
   m.inflate = std::sqrt(static_cast<double>(n) / m.n_eff);  // autocorrelated windows carry less information
-  // The data want out of the boxes when freeing them passes the same evidence bar as a discovery.
+  // The data want out of the boxes when the free estimate lies beyond one by more than 1 % (of the scale, or of the
+  // RRC level or C), or when freeing them passes a discovery's evidence bar. Either way it is reported, never a
+  // silent nothing_missing; the Delta BIC says whether this data alone is sure of it.
   c.dbic_leave = c.at_bound ? m.n_eff * std::log(m.fit.rss / std::max(1e-300, free.rss)) - std::log(m.n_eff) : 0.0;
-  c.outside_prior = c.at_bound && c.dbic_leave >= bic_threshold;
+  double excess = 0.0;
+  for (const auto& b : m.prior.boxes) {
+    const double unit = b.column == 0 ? 1.0 : 0.1;  // RRC and C coefficients are per 10 %
+    excess = std::max({excess, unit * (free.coef[b.column] - b.high), unit * (b.low - free.coef[b.column])});
+  }
+  c.sure = c.at_bound && c.dbic_leave >= bic_threshold;
+  c.outside_prior = c.at_bound && (excess >= 0.01 || c.sure);
   m.heldout = heldout_prediction(m.x, o.measured_j, o.fold_of, m.prior);
   return c;
 }
@@ -99,7 +107,8 @@ std::string calibration_outside_prior_text(const Calibration& c, const Observati
   return "the calibration alone wanted a channel scale of " + fixed(f[0], 3) + " (prior [" + fixed(1.0 - c.prior_scale_bound, 2) +
          ", " + fixed(1.0 + c.prior_scale_bound, 2) + "] for a " + to_string(o.channel) + " channel), RRC level " +
          fixed(100.0 * 0.1 * f[1] / f[0], 0) + " % and aero C " + fixed(100.0 * 0.1 * f[2] / f[0], 0) +
-         " % (Delta BIC " + fixed(c.dbic_leave, 1) + " for leaving its prior); it would have absorbed " +
+         " % (Delta BIC " + fixed(c.dbic_leave, 1) + " for leaving its prior: " +
+         (c.sure ? "this data is sure of it" : "this data alone cannot tell") + "); it would have absorbed " +
          fixed(100.0 * c.absorbed_j / std::max(1e-9, std::abs(o.measured_j.sum())), 1) + " % of the measured energy. " +
          (could.empty() ? std::string("No catalogue effect alone explains that energy: a drive efficiency, usable capacity "
                                       "or consumer the model lacks")

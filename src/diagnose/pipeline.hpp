@@ -143,7 +143,8 @@ struct Calibration {
   Eigen::VectorXd free_coef;   // without the boxes (penalties kept)
   bool at_bound = false;       // a box is active
   double dbic_leave = 0.0;     // how strongly the data want out of the boxes (Delta BIC, free against boxed)
-  bool outside_prior = false;  // at a bound, and significantly so
+  bool sure = false;           // freeing the boxes passes a discovery's evidence bar
+  bool outside_prior = false;  // at a bound, beyond it by over 1 % or surely
   double absorbed_j = 0.0;     // energy the free calibration would have absorbed beyond the boxed one
 };
 Calibration calibrate(const Observations& o, const Variant& base, const Variant& rrc, const Variant& drag,
