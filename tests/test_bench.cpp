@@ -1,7 +1,7 @@
 // Discovery benchmark, CI subset: the null's false-discovery rate, the warm-up's detection, the time-reversed null.
 #include <gtest/gtest.h>
 
-#include "rollsim/diagnose/bench.hpp"
+#include "rollsim/discovery/scorecard.hpp"
 
 namespace rollsim {
 namespace {
@@ -16,10 +16,12 @@ TEST(Bench, QuickSubsetMeetsTheIssuesBars) {
   o.null_seeds = 60;
   const BenchResult r = run_discovery_bench(v, o);
   bool saw_null = false, saw_reversed = false, saw_warmup = false, saw_ambient = false, saw_trip_null = false;
+  bool saw_real_logger_null = false;
   for (const auto& row : r.rows) {
     if (row.group == "null") {
       saw_null = true;
       saw_trip_null = saw_trip_null || row.label.find("4 trips") != std::string::npos;
+      saw_real_logger_null = saw_real_logger_null || row.label.find("real logger") != std::string::npos;
       EXPECT_LE(row.rollsim.mistaken, 0.05 * row.rollsim.n()) << bench_text(r);
     } else if (row.group == "reversed") {
       saw_reversed = true;
@@ -34,11 +36,32 @@ TEST(Bench, QuickSubsetMeetsTheIssuesBars) {
       EXPECT_GE(row.rollsim.named + row.rollsim.confounded, 0.8 * row.rollsim.n()) << bench_text(r);
     }
   }
-  EXPECT_TRUE(saw_null && saw_reversed && saw_warmup && saw_ambient && saw_trip_null);
+  EXPECT_TRUE(saw_null && saw_reversed && saw_warmup && saw_ambient && saw_trip_null && saw_real_logger_null);
   // The sparse baseline was scored at every threshold of its sweep, and its best is one of them.
   ASSERT_EQ(r.sparse_summary.size(), sparse_thresholds().size());
   EXPECT_GE(r.sparse_best, 0);
   EXPECT_LT(r.sparse_best, static_cast<int>(sparse_thresholds().size()));
+}
+
+// Issue 9's bar for the engine: an RRC rising over the trip (a null for warm-up) is never called tyre_warmup, of
+// either sign. Today's engine calls it a warm-up with a negative cold excess in 19 of 20 seeds (docs/diagnose.md);
+// enable this when the effects' signs are enforced.
+TEST(Bench, DISABLED_RisingRrcIsNeverCalledWarmup) {
+  const Vehicle v = load_vehicle_file(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/ev.yaml");
+  BenchOptions o;
+  o.seeds = 20;
+  o.only = {"rising_rrc 0.2"};
+  const BenchResult r = run_discovery_bench(v, o);
+  ASSERT_EQ(r.rows.size(), 1u);
+  EXPECT_EQ(r.rows.front().rollsim.mistaken, 0) << bench_text(r);
+}
+
+TEST(Bench, OnlyKeepsTheRowsAskedFor) {
+  BenchOptions o;
+  o.seeds = 1;
+  o.null_seeds = 1;
+  o.only = {"no row has this label"};
+  EXPECT_TRUE(run_discovery_bench(load_vehicle_file(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/ev.yaml"), o).rows.empty());
 }
 
 TEST(Bench, WilsonIntervalBracketsTheRate) {

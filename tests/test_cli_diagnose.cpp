@@ -36,7 +36,7 @@ TEST(CliDiagnose, MisspeltMappingColumnIsNamed) {
 #include <cstdio>
 #include <vector>
 
-#include "rollsim/diagnose/generate.hpp"
+#include "rollsim/discovery/generate.hpp"
 
 // Several recordings at different ambients, as CSV files with an ambient_temp_c column: `diagnose` names
 // ambient_rrc with its coefficient and interval in the JSON, and `--write-vehicle` switches it on.

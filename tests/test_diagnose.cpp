@@ -8,6 +8,7 @@
 
 #include "rollsim/cycle/drive_cycle.hpp"
 #include "rollsim/diagnose/diagnose.hpp"
+#include "rollsim/discovery/generate.hpp"
 #include "rollsim/sim/simulation.hpp"
 
 namespace rollsim {
@@ -91,7 +92,7 @@ double measured_over_simulated(const Vehicle& v, const Recording& r, double t0, 
     if (r.time_s[i] < t0 || r.time_s[i] >= t1) continue;
     const double dt = r.time_s[i + 1] - r.time_s[i];
     em += (*r.battery_power_w)[i] * dt;
-    es += s.trace[i].battery_power_w * dt;
+    es += s.trace[i].segment_battery_power_w * dt;  // the segment's mean, as simulate integrates it
   }
   return em / es;
 }
@@ -240,7 +241,6 @@ TEST(DiagnoseLimits, LocatesSocRecordingsByWindow) {
   EXPECT_GT(first, late + 500.0);
 }
 
-#include "rollsim/diagnose/generate.hpp"
 
 // The fuel and SOC channels of the generator: the artefacts are in the channel's own units (a non-negative flow
 // on its meter's quantum; SOC on the BMS's 0.1 % steps), and the concealed truths add energy where they should.

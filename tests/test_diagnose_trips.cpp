@@ -8,9 +8,10 @@
 
 #include "rollsim/common/error.hpp"
 #include "rollsim/cycle/drive_cycle.hpp"
-#include "rollsim/diagnose/bench.hpp"
 #include "rollsim/diagnose/diagnose.hpp"
-#include "rollsim/diagnose/generate.hpp"
+#include "rollsim/discovery/baselines.hpp"
+#include "rollsim/discovery/generate.hpp"
+#include "rollsim/discovery/scorecard.hpp"
 #include "rollsim/effects/catalogue.hpp"
 #include "rollsim/sim/simulation.hpp"
 

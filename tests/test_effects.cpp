@@ -26,7 +26,7 @@ SimulationResult run(const Vehicle& v, std::shared_ptr<const Effect> e, bool for
   return forward ? simulate_forward(m, c) : simulate_replay(m, c);
 }
 
-double source_j(const SimulationResult& r) { return r.electric ? r.energy.battery_terminal_j : r.energy.fuel_j; }
+double source_j(const SimulationResult& r) { return r.source_energy_j(); }
 
 TEST(EffectCatalogue, NeutralParametersLeaveEnergyUnchanged) {
   for (const char* file : {"ev.yaml", "ice.yaml"}) {
@@ -88,7 +88,7 @@ TEST(EffectCatalogue, BatteryResistanceDrainsTheCellsNotTheTerminals) {
     i2dt += i * i * (a.trace[k + 1].time_s - a.trace[k].time_s);
   }
   EXPECT_NEAR(extra, 0.1 * i2dt, 0.05 * 0.1 * i2dt);
-  EXPECT_LT(b.final_soc, a.final_soc);
+  EXPECT_LT(b.battery->final_soc, a.battery->final_soc);
   // A combustion car has no traction battery: nothing changes.
   const Vehicle ice = vehicle("ice.yaml");
   EXPECT_NEAR(source_j(run(ice, make_effect("battery_resistance", {{"extra_resistance_ohm", 0.1}}, context(ice)))),
@@ -162,7 +162,7 @@ TEST(EffectCatalogue, EnergyBalancesCloseWithEveryEffectOn) {
         const SimulationResult r = run(v, make_effect(info.id, p, ctx), forward);
         const SimulationResult& b = forward ? base_forward : base_replay;
         EXPECT_NEAR(r.energy.wheel_residual_j(), b.energy.wheel_residual_j(), 2e-3 * r.energy.traction_j) << file << " " << info.name << " fwd " << forward;
-        EXPECT_NEAR(r.energy.powertrain_residual_j(r.electric), b.energy.powertrain_residual_j(b.electric), 2e-3 * source_j(r)) << file << " " << info.name;
+        EXPECT_NEAR(r.energy.powertrain_residual_j(), b.energy.powertrain_residual_j(), 2e-3 * source_j(r)) << file << " " << info.name;
       }
     }
   }

@@ -162,7 +162,7 @@ TEST(RecordingMapping, OptionsParseAndErrorsNameTheOption) {
   EXPECT_TRUE(has(column_error("speed_kmh"), "CANONICAL="));
   EXPECT_TRUE(has(column_error("velocity=Speed"), "'velocity' is not a canonical column"));
   EXPECT_TRUE(has(column_error("velocity=Speed"), "speed_kmh"));
-  EXPECT_TRUE(has(column_error("speed_kmh="), "nothing after"));
+  EXPECT_TRUE(has(column_error("speed_kmh="), "cannot be dropped"));
   EXPECT_TRUE(has(column_error("soc_pct=SOC2"), "already mapped"));
   EXPECT_TRUE(has(scale_error("speed_kmh=fast"), "--scale 'speed_kmh=fast'"));
   EXPECT_TRUE(has(scale_error("speed_kmh=fast"), "not a number"));
@@ -352,4 +352,34 @@ TEST_F(RecordingFiles, BadInputNamesFileRowAndColumn) {
   EXPECT_EQ(r.speed_mps[3], 0.0);
   ASSERT_EQ(r.repairs.size(), 1u);
   EXPECT_TRUE(has(r.repairs[0], "set to 0"));
+}
+
+// A GPS position the diagnosis does not need: a glitch there is a warning and a missing value, never an abort, and a
+// mapping to "" (--column longitude=) drops the column, a preset's included.
+TEST_F(RecordingFiles, GpsGlitchIsAWarningAndColumnsCanBeDropped) {
+  std::string text = "time_s,speed_kmh,soc_pct,latitude,longitude\n";
+  for (int t = 0; t <= 70; ++t)
+    text += std::to_string(t) + ",36,80," + (t == 30 ? "48.1,1555.6" : "48.1,11.5") + "\n";
+  const Recording r = load_recording(write("gps.csv", text), {});
+  ASSERT_TRUE(r.longitude_deg.has_value());
+  EXPECT_DOUBLE_EQ((*r.longitude_deg)[30], 11.5);  // bridged from its neighbours
+  ASSERT_EQ(r.repairs.size(), 2u);  // the warning, then the bridge
+  EXPECT_TRUE(has(r.repairs[0], "warning:"));
+  EXPECT_TRUE(has(r.repairs[0], "line 32: '1555.6'"));
+  EXPECT_TRUE(has(r.repairs[1], "bridged"));
+  // A GPS column too broken to bridge (a 20 s dropout written as text) is dropped with a warning.
+  std::string broken = "time_s,speed_kmh,soc_pct,latitude\n";
+  for (int t = 0; t <= 70; ++t) broken += std::to_string(t) + ",36,80," + (t >= 20 && t < 40 ? "nofix" : "48.1") + "\n";
+  const Recording b = load_recording(write("broken.csv", broken), {});
+  EXPECT_FALSE(b.latitude_deg.has_value());
+  ASSERT_FALSE(b.repairs.empty());
+  EXPECT_TRUE(has(b.repairs.back(), "dropped"));
+  // Dropped by mapping: not read at all; the measurement columns stay strict.
+  ColumnMapping drop;
+  rollsim::parse_column_option("longitude=", drop);
+  const Recording d = load_recording(write("gps.csv", text), drop);
+  EXPECT_FALSE(d.longitude_deg.has_value());
+  const auto twizy_dropped = rollsim::merge_mapping(rollsim::preset_mapping("rsk_twizy"), drop);
+  EXPECT_EQ(twizy_dropped.source_for_canonical.at("longitude"), "");
+  EXPECT_TRUE(has(error_of(trip(70, [](int t) -> std::string { return t == 3 ? "3,36,140" : ""; })), "[0, 100]"));
 }

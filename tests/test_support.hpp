@@ -44,11 +44,14 @@ inline std::filesystem::path temp_dir() {
 }
 
 /// Runs `[env] rollsim <args>` through the shell from the source folder (args are shell words, quote as needed).
+/// ROLLSIM_TEST_BINARY, when set, names another rollsim to run (to show that a new test fails on an old build).
 inline CmdResult run_rollsim(const std::string& args, const std::string& env = "") {
+  const char* other = std::getenv("ROLLSIM_TEST_BINARY");
+  const std::string binary = other && *other ? other : ROLLSIM_BINARY;
   const auto dir = temp_dir();
   const auto out = dir / "stdout.txt";
   const auto err = dir / "stderr.txt";
-  const std::string cmd = "cd '" + std::string(ROLLSIM_SOURCE_DIR) + "' && " + env + " '" + ROLLSIM_BINARY + "' " +
+  const std::string cmd = "cd '" + std::string(ROLLSIM_SOURCE_DIR) + "' && " + env + " '" + binary + "' " +
                           args + " >'" + out.string() + "' 2>'" + err.string() + "'";
   const int status = std::system(cmd.c_str());
   CmdResult r;

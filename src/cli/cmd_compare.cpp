@@ -26,19 +26,19 @@ struct CompareOptionsText {
 
 std::string size_text(const TyreSpec& t) {
   if (t.size) return t.size->designation;
-  return "R" + report::fixed(t.state.geometry.outer_radius_m * 1e3, 0) + " W" +
-         report::fixed(t.state.geometry.section_width_m * 1e3, 0);
+  return "R" + fixed(t.state.geometry.outer_radius_m * 1e3, 0) + " W" +
+         fixed(t.state.geometry.section_width_m * 1e3, 0);
 }
 
-std::string signed_fixed(double v, int d) { return (v > 0 ? "+" : "") + report::fixed(v, d); }
+std::string signed_fixed(double v, int d) { return (v > 0 ? "+" : "") + fixed(v, d); }
 
 void print_table(const selection::Comparison& c) {
   const std::string unit = selection::energy_unit_label(c.unit);
-  std::cout << c.vehicle << " on " << c.cycle << ": tyres ranked by " << (c.electric ? "battery energy" : "fuel")
+  std::cout << c.vehicle << " on " << c.cycle << ": tyres ranked by " << (c.shows_range ? "battery energy" : "fuel")
             << " (forward simulation, tyre on all four wheels; RRC and RR power at 80 km/h and "
-            << report::fixed(c.ranked.empty() ? 0.0 : c.ranked.front().fit.wheel_load_n, 0) << " N per wheel)\n";
+            << fixed(c.ranked.empty() ? 0.0 : c.ranked.front().fit.wheel_load_n, 0) << " N per wheel)\n";
   std::vector<std::string> h{"#", "tyre", "size", "p [bar]", "RRC x1000", "P_RR [W]", unit, "vs own [%]"};
-  if (c.electric) h.push_back("range chg [km]");
+  if (c.shows_range) h.push_back("range chg [km]");
   h.push_back("fit");
   report::TextTable t(h);
   t.set_left_aligned(1);
@@ -46,29 +46,29 @@ void print_table(const selection::Comparison& c) {
   t.set_left_aligned(h.size() - 1);
   auto row = [&](const selection::CandidateResult& r, const std::string& rank) {
     std::vector<std::string> cells{rank, r.tyre.name + (r.is_own ? " (own)" : ""), size_text(r.tyre),
-                                   report::fixed(units::pa_to_bar(r.tyre.state.pressure_pa), 1),
-                                   report::fixed(r.rrc_80 * 1e3, 3), report::fixed(r.rr_power_80_w, 1),
-                                   report::fixed(r.value, c.electric ? 4 : 3),
+                                   fixed(units::pa_to_bar(r.tyre.state.pressure_pa), 1),
+                                   fixed(r.rrc_80 * 1e3, 3), fixed(r.rr_power_80_w, 1),
+                                   fixed(r.value, c.shows_range ? 4 : 3),
                                    r.simulated ? signed_fixed(r.diff_pct, 2) : "-"};
-    if (c.electric) cells.push_back(r.simulated ? signed_fixed(r.range_change_km, 1) : "-");
+    if (c.shows_range) cells.push_back(r.simulated ? signed_fixed(r.range_change_km, 1) : "-");
     cells.push_back(r.fit.fits ? "ok (" + signed_fixed(r.fit.diameter_change_pct, 1) + " % dia., load " +
-                                     report::fixed(100.0 * r.fit.wheel_load_n / r.fit.capacity_n, 0) + " %)"
+                                     fixed(100.0 * r.fit.wheel_load_n / r.fit.capacity_n, 0) + " %)"
                                : r.fit.reason);
     t.add_row(cells);
   };
   for (std::size_t i = 0; i < c.ranked.size(); ++i) row(c.ranked[i], std::to_string(i + 1));
   for (const auto& r : c.unfit) row(r, "-");
   std::cout << t.render();
-  if (c.electric) {
-    std::cout << "own tyre: " << report::fixed(c.own_value, 4) << " " << unit << ", range "
-              << report::fixed(c.own_range_km, 1) << " km; range column: gained (+) or lost (-) km\n";
+  if (c.shows_range) {
+    std::cout << "own tyre: " << fixed(c.own_value, 4) << " " << unit << ", range "
+              << fixed(c.own_range_km, 1) << " km; range column: gained (+) or lost (-) km\n";
   }
   std::cout << "\n";
 }
 
 void print_json(const selection::Comparison& c) {
   auto emit = [&](const selection::CandidateResult& r, int rank) {
-    report::JsonObject j;
+    JsonObject j;
     j.add("vehicle", c.vehicle).add("cycle", c.cycle).add("tyre", r.tyre.name).add("source", r.tyre.source);
     j.add("size", size_text(r.tyre)).add("own", r.is_own);
     if (rank > 0) j.add("rank", rank); else j.add_null("rank");
@@ -80,7 +80,7 @@ void print_json(const selection::Comparison& c) {
         .add("rr_power_80kmh_w", r.rr_power_80_w)
         .add(c.unit, r.value)
         .add("diff_pct", r.diff_pct);
-    if (c.electric) j.add("range_km", r.range_km).add("range_change_km", r.range_change_km);
+    if (c.shows_range) j.add("range_km", r.range_km).add("range_change_km", r.range_change_km);
     j.add("fits", r.fit.fits).add("reason", r.fit.reason);
     std::cout << j.str() << "\n";
   };
@@ -100,11 +100,11 @@ void print_csv(const selection::Comparison& c, bool header) {
   };
   auto emit = [&](const selection::CandidateResult& r, int rank) {
     std::cout << q(c.vehicle) << "," << c.cycle << "," << (rank > 0 ? std::to_string(rank) : "") << "," << q(r.tyre.name)
-              << "," << q(size_text(r.tyre)) << "," << report::fixed(units::pa_to_bar(r.tyre.state.pressure_pa), 2)
-              << "," << report::fixed(r.rrc_80, 6) << "," << report::fixed(r.rr_power_80_w, 2) << ","
-              << report::fixed(r.value, 5) << "," << c.unit << "," << report::fixed(r.diff_pct, 3) << ","
-              << (c.electric ? report::fixed(r.range_km, 2) : "") << ","
-              << (c.electric ? report::fixed(r.range_change_km, 2) : "") << "," << (r.fit.fits ? "yes" : "no") << ","
+              << "," << q(size_text(r.tyre)) << "," << fixed(units::pa_to_bar(r.tyre.state.pressure_pa), 2)
+              << "," << fixed(r.rrc_80, 6) << "," << fixed(r.rr_power_80_w, 2) << ","
+              << fixed(r.value, 5) << "," << c.unit << "," << fixed(r.diff_pct, 3) << ","
+              << (c.shows_range ? fixed(r.range_km, 2) : "") << ","
+              << (c.shows_range ? fixed(r.range_change_km, 2) : "") << "," << (r.fit.fits ? "yes" : "no") << ","
               << q(r.fit.reason) << "\n";
   };
   for (std::size_t i = 0; i < c.ranked.size(); ++i) emit(c.ranked[i], static_cast<int>(i + 1));

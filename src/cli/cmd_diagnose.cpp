@@ -13,6 +13,7 @@
 #include "rollsim/diagnose/report.hpp"
 #include "rollsim/recording/recording.hpp"
 #include "rollsim/tyre/tyre_spec.hpp"
+#include "rollsim/vehicle/vehicle_file.hpp"
 
 namespace rollsim::cli {
 namespace {
@@ -26,8 +27,12 @@ struct DiagnoseCliOptions {
 void run_diagnose(const DiagnoseCliOptions& o) {
   const std::string vehicle_path = resolve_data_file(o.vehicle, "vehicles", ".yaml", "--vehicle");
   Vehicle v = load_vehicle_file(vehicle_path);
-  if (!o.tyre.empty()) fit_tyres(v, load_tyre_file(resolve_data_file(o.tyre, "tyres", ".yaml", "--tyre")));
-  if (!o.report.empty()) check_report_dir(o.report);  // fail before the diagnosis, not after it
+  const std::string tyre_path = o.tyre.empty() ? "" : resolve_data_file(o.tyre, "tyres", ".yaml", "--tyre");
+  if (!o.tyre.empty()) fit_tyres(v, load_tyre_file(tyre_path));
+  // Every destination is checked before the diagnosis, and all are written together after it.
+  if (!o.report.empty()) check_report_dir(o.report);
+  if (!o.json.empty()) check_output_file(o.json, "--json");
+  if (!o.write_vehicle.empty()) check_output_file(o.write_vehicle, "--write-vehicle");
   // Column mapping: a preset, then the vehicle file's own logger mapping, then the command line's options.
   ColumnMapping mapping;
   if (!o.preset.empty()) mapping = preset_mapping(o.preset);
@@ -42,20 +47,25 @@ void run_diagnose(const DiagnoseCliOptions& o) {
   std::vector<Recording> recs;
   for (const auto& r : o.recordings) recs.push_back(load_recording(r, mapping));
   for (const auto& r : recs)
-    for (const auto& rep : r.repairs) std::cout << r.source << ": " << rep << "\n";
+    for (const auto& rep : r.repairs) (rep.rfind("warning:", 0) == 0 ? std::cerr : std::cout) << r.source << ": " << rep << "\n";
   DiagnoseOptions dopt;
   if (o.window_s > 0.0) dopt.window_s = o.window_s;
   const Diagnosis d = diagnose(v, recs, dopt);
   std::cout << diagnosis_text(d);
-  if (!o.json.empty()) write_file_atomically(o.json, "--json", [&](std::ostream& os) { os << diagnosis_json(d); });
+  std::vector<OutputFile> files;
+  if (!o.json.empty()) files.push_back({o.json, "--json", diagnosis_json(d)});
+  // The fitted vehicle names its files resolved (and the --tyre used), so it loads from the folder it is written to.
+  if (!o.write_vehicle.empty())
+    files.push_back({o.write_vehicle, "--write-vehicle", portable_vehicle_yaml(fitted_vehicle_yaml(vehicle_path, d), vehicle_path, tyre_path)});
+  std::size_t report_files = 0;
   if (!o.report.empty()) {
-    const auto files = write_diagnosis_report(o.report, d, "rollsim diagnose: " + v.name);
-    std::cout << "report written to " << o.report << " (" << files.size() << " files, report.html)\n";
+    const auto report = render_diagnosis_report(o.report, d, "rollsim diagnose: " + v.name);
+    report_files = report.size();
+    files.insert(files.end(), report.begin(), report.end());
   }
-  if (!o.write_vehicle.empty()) {
-    write_file_atomically(o.write_vehicle, "--write-vehicle", [&](std::ostream& os) { os << fitted_vehicle_yaml(vehicle_path, d); });
-    std::cout << "fitted vehicle written to " << o.write_vehicle << "\n";
-  }
+  write_files_atomically(files);
+  if (!o.report.empty()) std::cout << "report written to " << o.report << " (" << report_files << " files, report.html)\n";
+  if (!o.write_vehicle.empty()) std::cout << "fitted vehicle written to " << o.write_vehicle << "\n";
 }
 
 }  // namespace
@@ -67,7 +77,8 @@ void register_diagnose_command(CLI::App& app) {
   sub->add_option("--tyre", o->tyre, "Tyre YAML fitted to all four wheels")->type_name("FILE");
   sub->add_option("--recording", o->recordings, "Recording CSV (repeatable)")->required()->type_name("CSV");
   sub->add_option("--preset", o->preset, "Column mapping preset: anl_d3, rsk_twizy")->type_name("NAME");
-  sub->add_option("--column", o->columns, "CANONICAL=SOURCE column mapping (repeatable)")->type_name("C=S");
+  sub->add_option("--column", o->columns, "CANONICAL=SOURCE column mapping (repeatable); CANONICAL= drops a column")
+      ->type_name("C=S");
   sub->add_option("--scale", o->scales, "CANONICAL=FACTOR scale (repeatable)")->type_name("C=F");
   sub->add_option("--json", o->json, "Write the diagnosis as JSON")->type_name("FILE");
   sub->add_option("--window-s", o->window_s, "Energy window length [s] (default 60; SOC channels lengthen it by the quantum)")

@@ -8,7 +8,7 @@
 
 #include "commands.hpp"
 #include "rollsim/common/yaml_reader.hpp"
-#include "rollsim/diagnose/bench.hpp"
+#include "rollsim/discovery/scorecard.hpp"
 #include "rollsim/diagnose/diagnose.hpp"
 #include "rollsim/recording/recording.hpp"
 
@@ -34,6 +34,8 @@ void register_diagnose_bench_command(CLI::App& app) {
   sub->add_flag("--quick", o->bench.quick, "CI subset: warm-up at 30 %, two pairs, the nulls");
   sub->add_option("--real-trace", o->real_traces, "A real recording whose speed trace also carries the null and a "
                   "concealed tyre warm-up (repeatable)")->type_name("CSV");
+  sub->add_option("--only", o->bench.only, "Only the rows whose label contains this text (repeatable), e.g. 'real logger'")
+      ->type_name("TEXT");
   sub->add_option("--real-trace-preset", o->real_trace_preset, "Column preset of the --real-trace files (default rsk_twizy)")
       ->type_name("NAME");
   sub->callback([o] {

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "rollsim/common/atomic_file.hpp"
 #include "rollsim/report/table.hpp"
 #include "rollsim/selection/common.hpp"
 #include "rollsim/selection/regress.hpp"
@@ -17,29 +18,30 @@ struct RegressOptionsText {
   bool update = false;
 };
 
-std::string signed_pct(double v) { return (v > 0 ? "+" : "") + report::fixed(v, 3); }
+std::string signed_pct(double v) { return (v > 0 ? "+" : "") + fixed(v, 3); }
 
 int run_regress(const RegressOptionsText& o) {
   const selection::Baseline b = selection::load_baseline(o.file);
+  if (o.update) check_output_file(o.file, "--update");
   const auto outcomes = selection::run_baseline(b);
   report::TextTable t({"case", "vehicle", "tyre", "cycle", "expected", "actual", "unit", "drift [%]", "tol [%]", "status"});
   for (std::size_t c : {0u, 1u, 2u, 3u, 6u, 9u}) t.set_left_aligned(c);
   std::size_t drifted = 0;
   for (const auto& r : outcomes) {
-    t.add_row({r.c.name, r.c.vehicle, r.c.tyre, r.c.cycle, report::fixed(r.c.expected, 4), report::fixed(r.actual, 4),
+    t.add_row({r.c.name, r.c.vehicle, r.c.tyre, r.c.cycle, fixed(r.c.expected, 4), fixed(r.actual, 4),
                selection::energy_unit_label(r.c.unit), signed_pct(r.drift_pct), format_value(r.c.tolerance_pct),
                r.drifted ? "DRIFTED" : "ok"});
     drifted += r.drifted;
   }
   std::cout << t.render();
   if (o.update) {
-    selection::write_file_atomically(o.file, selection::baseline_yaml(b, outcomes), "--update");
+    write_files_atomically({{o.file, "--update", selection::baseline_yaml(b, outcomes)}});
     std::size_t changed = 0;
     for (const auto& r : outcomes) {
       if (r.actual != r.c.expected) {
         ++changed;
-        std::cout << "updated " << r.c.name << ": " << report::fixed(r.c.expected, 4) << " -> "
-                  << report::fixed(r.actual, 4) << " " << selection::energy_unit_label(r.c.unit) << " ("
+        std::cout << "updated " << r.c.name << ": " << fixed(r.c.expected, 4) << " -> "
+                  << fixed(r.actual, 4) << " " << selection::energy_unit_label(r.c.unit) << " ("
                   << signed_pct(r.drift_pct) << " %)\n";
       }
     }
@@ -50,8 +52,8 @@ int run_regress(const RegressOptionsText& o) {
   for (const auto& r : outcomes) {
     if (r.drifted) {
       std::cerr << "error: case '" << r.c.name << "' drifted " << signed_pct(r.drift_pct) << " % ("
-                << (r.drift_pct > 0 ? "up" : "down") << ": expected " << report::fixed(r.c.expected, 4) << ", got "
-                << report::fixed(r.actual, 4) << " " << selection::energy_unit_label(r.c.unit) << ", tolerance "
+                << (r.drift_pct > 0 ? "up" : "down") << ": expected " << fixed(r.c.expected, 4) << ", got "
+                << fixed(r.actual, 4) << " " << selection::energy_unit_label(r.c.unit) << ", tolerance "
                 << format_value(r.c.tolerance_pct) << " %)\n";
     }
   }

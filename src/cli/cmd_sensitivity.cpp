@@ -22,10 +22,10 @@ struct SensitivityOptionsText {
 std::string value_text(const selection::SensitivityRow& r) {
   switch (r.parameter) {
     case TyreParameter::OuterDiameter:
-    case TyreParameter::SectionWidth: return report::fixed(r.value_si * 1e3, 1) + " mm";
-    case TyreParameter::Pressure: return report::fixed(units::pa_to_bar(r.value_si), 2) + " bar";
-    case TyreParameter::Load: return report::fixed(r.value_si, 0) + " N";
-    case TyreParameter::Speed: return report::fixed(units::mps_to_kmh(r.value_si), 1) + " km/h";
+    case TyreParameter::SectionWidth: return fixed(r.value_si * 1e3, 1) + " mm";
+    case TyreParameter::Pressure: return fixed(units::pa_to_bar(r.value_si), 2) + " bar";
+    case TyreParameter::Load: return fixed(r.value_si, 0) + " N";
+    case TyreParameter::Speed: return fixed(units::mps_to_kmh(r.value_si), 1) + " km/h";
   }
   return "";
 }
@@ -61,11 +61,11 @@ void run_sensitivity(const SensitivityOptionsText& o) {
       s = selection::tyre_sensitivity(tyre, load_n, speed_mps);
     }
   } catch (const ModelDomainError& e) {
-    throw InputError(tyre.source + " at " + report::fixed(load_n, 0) + " N", e.what());
+    throw InputError(tyre.source + " at " + fixed(load_n, 0) + " N", e.what());
   }
 
   if (o.json) {
-    report::JsonObject j;
+    JsonObject j;
     j.add("tyre", s.tyre).add("load_n", s.load_n).add("speed_kmh", units::mps_to_kmh(s.speed_mps))
         .add("relative_step", s.relative_step).add("rr_power_w", s.rr_power_w);
     if (vehicle) j.add("vehicle", s.vehicle).add("cycle", s.cycle).add(s.energy_unit, s.energy);
@@ -78,11 +78,11 @@ void run_sensitivity(const SensitivityOptionsText& o) {
     std::cout << j.str() << "\n";
     return;
   }
-  std::cout << "Sensitivity of tyre " << s.tyre << " at " << report::fixed(s.load_n, 0) << " N, "
-            << report::fixed(units::mps_to_kmh(s.speed_mps), 0) << " km/h (RR power " << report::fixed(s.rr_power_w, 1)
+  std::cout << "Sensitivity of tyre " << s.tyre << " at " << fixed(s.load_n, 0) << " N, "
+            << fixed(units::mps_to_kmh(s.speed_mps), 0) << " km/h (RR power " << fixed(s.rr_power_w, 1)
             << " W)";
   if (vehicle) {
-    std::cout << "; " << s.vehicle << " on " << s.cycle << ": " << report::fixed(s.energy, 4) << " "
+    std::cout << "; " << s.vehicle << " on " << s.cycle << ": " << fixed(s.energy, 4) << " "
               << selection::energy_unit_label(s.energy_unit);
   }
   std::cout << "\nElasticities: % change of the output per % change of the parameter (central differences +-"
@@ -92,14 +92,14 @@ void run_sensitivity(const SensitivityOptionsText& o) {
   report::TextTable t(h);
   t.set_left_aligned(0);
   for (const auto& r : s.rows) {
-    std::vector<std::string> cells{r.name, value_text(r), report::fixed(r.power_elasticity, 3),
-                                   report::fixed(r.rrc_elasticity, 3)};
-    if (vehicle) cells.push_back(report::fixed(*r.energy_elasticity, 4));
+    std::vector<std::string> cells{r.name, value_text(r), fixed(r.power_elasticity, 3),
+                                   fixed(r.rrc_elasticity, 3)};
+    if (vehicle) cells.push_back(fixed(*r.energy_elasticity, 4));
     t.add_row(cells);
   }
   std::cout << t.render();
   std::cout << "Matters most for RR power: " << s.dominant_power;
-  if (vehicle) std::cout << "; for the car's " << (vehicle->is_electric() ? "energy" : "fuel") << ": " << s.dominant_energy;
+  if (vehicle) std::cout << "; for the car's " << (s.energy_unit == "kwh_per_10km" ? "energy" : "fuel") << ": " << s.dominant_energy;
   std::cout << "\n";
   if (vehicle) {
     std::cout << "(car: load = test mass, all wheel loads scaled together; diameter also changes the gearing)\n";

@@ -1,6 +1,7 @@
 // `rollsim simulate`: a car over one or more drive cycles with one or more tyre sets; CLI glue only.
 #include <CLI/CLI.hpp>
 
+#include <cmath>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -8,6 +9,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "rollsim/common/units.hpp"
 #include "rollsim/common/atomic_file.hpp"
 #include "rollsim/common/error.hpp"
 #include "rollsim/common/yaml_reader.hpp"
@@ -41,6 +43,7 @@ void run_simulate(const SimulateOptions& o) {
   for (const auto& c : o.cycles.empty() ? std::vector<std::string>{"nedc"} : o.cycles) cycles.push_back(load_cycle(c));
   if (!o.trace_path.empty() && tyre_sets.size() * cycles.size() > 1)
     throw InputError("--trace", "writes the time series of one run; give one --tyre and one --cycle with it");
+  if (!o.trace_path.empty()) check_output_file(o.trace_path, "--trace");
 
   SimulationOptions sim_opt;
   sim_opt.record_trace = !o.trace_path.empty();
@@ -69,8 +72,8 @@ void run_simulate(const SimulateOptions& o) {
       // With coast-down road load, say how much of A the tyres account for (the rest is driveline drag).
       if (v.coastdown && v.front_tyre && !o.json) {
         const double tyre_a_n = tyre_rolling_force_at_standstill_limit_n(v);
-        std::cout << "tyres' share of coast-down A: " << report::fixed(tyre_a_n, 1) << " N of "
-                  << report::fixed(v.coastdown->a_n, 1) << " N (" << report::fixed(100.0 * tyre_a_n / v.coastdown->a_n, 1)
+        std::cout << "tyres' share of coast-down A: " << fixed(tyre_a_n, 1) << " N of "
+                  << fixed(v.coastdown->a_n, 1) << " N (" << fixed(100.0 * tyre_a_n / v.coastdown->a_n, 1)
                   << " %)\n";
       }
       runs.push_back({label, std::move(r)});
@@ -91,18 +94,19 @@ void run_simulate(const SimulateOptions& o) {
   // Several runs: one table, each against the first run on the same cycle.
   const std::string unit = report::headline_unit(runs.front().result);
   report::TextTable t({"cycle", "tyre", unit, "diff %", "rolling kWh", "rolling diff %",
-                       runs.front().result.electric ? "range km" : "CO2 g/km", "max err km/h"});
+                       runs.front().result.fuel ? "CO2 g/km" : "range km", "max err km/h"});
   t.set_left_aligned(0);
   t.set_left_aligned(1);
   for (std::size_t i = 0; i < runs.size(); ++i) {
     const auto& r = runs[i].result;
     const auto& ref = runs[i - i % tyre_sets.size()].result;
     const double value = report::headline_value(r), ref_value = report::headline_value(ref);
-    t.add_row({r.cycle, runs[i].tyre_label, report::fixed(value, 3), report::fixed(100.0 * (value / ref_value - 1.0), 2),
-               report::fixed(r.energy.rolling_j / 3.6e6, 4),
-               report::fixed(100.0 * (r.energy.rolling_j / ref.energy.rolling_j - 1.0), 2),
-               r.electric ? report::fixed(r.range_km(), 1) : report::fixed(r.co2_g_per_km(), 1),
-               report::fixed(r.max_speed_error_mps * 3.6, 2)});
+    // A run that did not move has no per-distance figure (and no rolling energy to compare): "-", not inf or NaN.
+    auto shown = [](double x, int digits) { return std::isfinite(x) ? fixed(x, digits) : std::string("-"); };
+    t.add_row({r.cycle, runs[i].tyre_label, shown(value, 3), shown(100.0 * (value / ref_value - 1.0), 2),
+               fixed(units::j_to_kwh(r.energy.rolling_j), 4),
+               shown(100.0 * (r.energy.rolling_j / ref.energy.rolling_j - 1.0), 2),
+               shown(r.fuel ? r.co2_g_per_km() : r.range_km(), 1), fixed(units::mps_to_kmh(r.max_speed_error_mps), 2)});
   }
   std::cout << base.name << " (" << (o.replay ? "replay" : "forward") << " simulation)\n" << t.render();
   std::cout << "diff %: against the first tyre on the same cycle\n";

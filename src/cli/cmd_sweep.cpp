@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "rollsim/common/atomic_file.hpp"
 #include "rollsim/report/gnuplot.hpp"
 #include "rollsim/common/units.hpp"
 #include "rollsim/report/table.hpp"
@@ -45,29 +46,24 @@ std::string axis_label(selection::SweepParam p) {
 }
 
 
+const char* const gnuplot_missing =
+    "gnuplot is not installed or not on PATH (Debian: apt-get install gnuplot-nox); the CSV output does not need it";
+
 std::string display_unit(selection::SweepParam p) {
   const std::string u = selection::sweep_param_unit(p);
   return u == "kmh" ? "km/h" : u == "pct" ? "%" : u;
 }
 
 
-// Draws RRC against the first swept parameter (one line per value of the second) with gnuplot.
-void plot(const selection::SweepResult& r, const std::string& tyre_name, const std::string& file, bool base100) {
+// Draws RRC against the first swept parameter (one line per value of the second) with gnuplot, in a scratch
+// folder; returns the figure's bytes (the caller writes them with the other outputs).
+std::string render_plot(const selection::SweepResult& r, const std::string& tyre_name, const std::string& file,
+                        bool base100) {
   namespace fs = std::filesystem;
   if (r.points.empty()) throw InputError("--plot " + file, "no valid point to draw");
   const std::string ext = fs::path(file).extension().string();
-  if (ext != ".svg" && ext != ".png") throw InputError("--plot " + file, "must end in .svg or .png");
   const std::string gnuplot = report::find_gnuplot();
-  if (gnuplot.empty()) {
-    throw InputError("--plot " + file, "gnuplot is not installed or not on PATH (Debian: apt-get install gnuplot-nox); "
-                                       "the CSV output does not need it");
-  }
-  const fs::path target(file);
-  const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  std::error_code ec;
-  if (!fs::is_directory(dir, ec) || access(dir.c_str(), W_OK) != 0) {
-    throw InputError("--plot " + file, "cannot write here (folder missing or not writable)");
-  }
+  if (gnuplot.empty()) throw InputError("--plot " + file, gnuplot_missing);
   const fs::path work = fs::temp_directory_path() / ("rollsim_plot_" + std::to_string(getpid()));
   fs::create_directories(work);
   // Series: one per value of the second axis (or one), x = first axis, y = RRC (or base 100 of its first point).
@@ -81,7 +77,7 @@ void plot(const selection::SweepResult& r, const std::string& tyre_name, const s
   }
   data.close();
   const auto& a0 = r.axes[0];
-  std::string load_text = report::fixed(r.points.front().load_n, 0) + " N";
+  std::string load_text = fixed(r.points.front().load_n, 0) + " N";
   std::string title = "RRC of " + tyre_name;
   if (a0.param != selection::SweepParam::Load && a0.param != selection::SweepParam::LoadPct &&
       (r.axes.size() < 2 || (r.axes[1].param != selection::SweepParam::Load &&
@@ -89,39 +85,40 @@ void plot(const selection::SweepResult& r, const std::string& tyre_name, const s
     title += " at " + load_text;
   }
   if (a0.param != selection::SweepParam::Speed && (r.axes.size() < 2 || r.axes[1].param != selection::SweepParam::Speed)) {
-    title += ", " + report::fixed(r.points.front().speed_kmh, 0) + " km/h";
+    title += ", " + fixed(r.points.front().speed_kmh, 0) + " km/h";
   }
-  const fs::path tmp_out = dir / ("." + target.filename().string() + ".tmp" + std::to_string(getpid()) + ext);
+  const fs::path figure = work / ("figure" + ext);
   std::ofstream gp(work / "plot.gp");
-  gp << (ext == ".svg" ? "set terminal svg size 800,500 dynamic font 'Sans,12'\n"
-                       : "set terminal pngcairo size 800,500 font 'Sans,11'\n")
-     << "set output '" << report::gnuplot_escape(tmp_out.string()) << "'\n"
-     << "set title \"" << title << " (rollsim tyre model)\"\n"
-     << "set xlabel \"" << axis_label(a0.param) << "\"\n"
-     << "set ylabel \"" << (base100 ? "RRC, base 100 at " + format_value(r.points.front().values[0]) + " " +
-                                          display_unit(a0.param)
-                                    : std::string("RRC x 1000 [-]"))
-     << "\"\nset grid\nset key top right\n";
+  using report::gnuplot_string;
+  gp << report::gnuplot_terminal(ext == ".svg" ? "svg size 800,500 dynamic font 'Sans,12'" : "pngcairo size 800,500 font 'Sans,11'")
+     << "set output " << gnuplot_string(figure.string()) << "\n"
+     << "set title " << gnuplot_string(title + " (rollsim tyre model)") << "\n"
+     << "set xlabel " << gnuplot_string(axis_label(a0.param)) << "\n"
+     << "set ylabel "
+     << gnuplot_string(base100 ? "RRC, base 100 at " + format_value(r.points.front().values[0]) + " " + display_unit(a0.param)
+                               : std::string("RRC x 1000 [-]"))
+     << "\nset grid\nset key top right\n";
   gp << "plot ";
   std::size_t i = 0;
   for (auto& [key, pts] : series) {
     std::string label = r.axes.size() > 1 ? selection::sweep_param_key(r.axes[1].param) + " " + format_value(key) + " " +
                                                 display_unit(r.axes[1].param)
                                           : tyre_name;
-    gp << (i ? ", " : "") << "'" << report::gnuplot_escape((work / "data.dat").string()) << "' index " << i << " with linespoints lw 2 pt 7 ps 0.6 title \""
-       << label << "\"";
+    gp << (i ? ", " : "") << gnuplot_string((work / "data.dat").string()) << " index " << i
+       << " with linespoints lw 2 pt 7 ps 0.6 title " << gnuplot_string(label);
     ++i;
   }
   gp << "\n";
   gp.close();
-  if (const std::string err = report::run_gnuplot_script(gnuplot, (work / "plot.gp").string()); !err.empty()) {
-    fs::remove(tmp_out, ec);
-    fs::remove_all(work, ec);
-    throw InputError("--plot " + file, "gnuplot failed: " + err);
-  }
-  fs::rename(tmp_out, target, ec);
-  fs::remove_all(work);
-  if (ec) throw InputError("--plot " + file, "cannot replace the file: " + ec.message());
+  const std::string err = report::run_gnuplot_script(gnuplot, (work / "plot.gp").string());
+  std::ifstream in(figure, std::ios::binary);
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  in.close();
+  std::error_code ec;
+  fs::remove_all(work, ec);
+  if (!err.empty()) throw InputError("--plot " + file, "gnuplot failed: " + err);
+  return bytes.str();
 }
 
 void run_sweep(const SweepOptionsText& o) {
@@ -152,9 +149,13 @@ void run_sweep(const SweepOptionsText& o) {
   if (!o.load_n.empty()) so.load_n = parse_option_number(o.load_n, "--load-n", Range::open_low(0.0, 1e6));
   so.speed_kmh = parse_option_number(o.speed_kmh, "--speed-kmh", Range::closed(0.0, 500.0));
   if (!o.threads.empty()) so.threads = static_cast<unsigned>(parse_option_number(o.threads, "--threads", Range::closed(1, 1024)));
+  // Every destination is checked before the sweep, and all are written after it (nothing is left behind).
+  if (!o.output.empty()) check_output_file(o.output, "--output");
   if (!o.plot.empty()) {
     const std::string ext = std::filesystem::path(o.plot).extension().string();
     if (ext != ".svg" && ext != ".png") throw InputError("--plot " + o.plot, "must end in .svg or .png");
+    check_output_file(o.plot, "--plot");
+    if (report::find_gnuplot().empty()) throw InputError("--plot " + o.plot, gnuplot_missing);
   }
 
   const TyreSpec tyre = load_tyre_file(resolve_data_file(o.tyre, "tyres", ".yaml", "--tyre"));
@@ -166,14 +167,14 @@ void run_sweep(const SweepOptionsText& o) {
     const DriveCycle c = load_cycle(o.cycle, "--cycle");
     r = selection::sweep_vehicle(v, tyre, c, so);
   } else {
-    so.progress = nullptr;  // the tyre alone takes milliseconds
     r = selection::sweep_tyre(tyre, so);
   }
 
+  std::string table;
   if (o.json) {
     std::ostringstream out;
     for (const auto& p : r.points) {
-      report::JsonObject j;
+      JsonObject j;
       for (std::size_t i = 0; i < r.axes.size(); ++i) {
         j.add(selection::sweep_param_key(r.axes[i].param) + "_" + selection::sweep_param_unit(r.axes[i].param), p.values[i]);
       }
@@ -182,14 +183,15 @@ void run_sweep(const SweepOptionsText& o) {
       if (r.vehicle) j.add(r.energy_unit, p.energy);
       out << j.str() << "\n";
     }
-    if (o.output.empty()) std::cout << out.str();
-    else selection::write_file_atomically(o.output, out.str(), "--output");
-  } else if (o.output.empty()) {
-    std::cout << selection::sweep_csv(r);
+    table = out.str();
   } else {
-    selection::write_file_atomically(o.output, selection::sweep_csv(r), "--output");
+    table = selection::sweep_csv(r);
   }
-  if (!o.plot.empty()) plot(r, tyre.name, o.plot, o.base100);
+  std::vector<OutputFile> files;
+  if (!o.output.empty()) files.push_back({o.output, "--output", table});
+  if (!o.plot.empty()) files.push_back({o.plot, "--plot", render_plot(r, tyre.name, o.plot, o.base100)});
+  write_files_atomically(files);
+  if (o.output.empty()) std::cout << table;
   if (r.stopped) {
     throw InputError("--param", *r.stopped + " (the " + std::to_string(r.points.size()) + " valid points of " +
                                     std::to_string(r.planned_points) + " were written)");

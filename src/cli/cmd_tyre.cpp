@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "selection_cli.hpp"
 #include "rollsim/common/error.hpp"
 #include "rollsim/common/units.hpp"
 #include "rollsim/common/yaml_reader.hpp"
@@ -30,18 +31,7 @@ struct TyreOptions {
   bool explain = false;
 };
 
-double parse_number(const std::string& text, const std::string& option, Range range) {
-  double v = 0.0;
-  char* end = nullptr;
-  v = std::strtod(text.c_str(), &end);
-  if (text.empty() || end != text.c_str() + text.size()) {
-    throw InputError(option, "'" + text + "' is not a number; " + range.describe());
-  }
-  if (!range.contains(v)) throw InputError(option, format_value(v) + " is not allowed: " + range.describe());
-  return v;
-}
-
-std::string kg_text(double n) { return report::fixed(n / units::kStandardGravity_mps2, 0) + " kg"; }
+std::string kg_text(double n) { return fixed(n / units::kStandardGravity_mps2, 0) + " kg"; }
 
 // Builds the tyre from a file, a designation, or explicit geometry; --pressure-bar overrides a file's pressure.
 TyreSpec build_tyre(const TyreOptions& o) {
@@ -76,11 +66,11 @@ TyreSpec build_tyre(const TyreOptions& o) {
     }
     spec.name = "R " + o.outer_radius_m + " m, W " + o.width_m + " m";
     spec.source = "command line";
-    spec.state.geometry.outer_radius_m = parse_number(o.outer_radius_m, "--outer-radius-m", Range::open_low(0.0, 1.5));
-    spec.state.geometry.section_width_m = parse_number(o.width_m, "--width-m", Range::open_low(0.0, 1.0));
+    spec.state.geometry.outer_radius_m = parse_option_number(o.outer_radius_m, "--outer-radius-m", Range::open_low(0.0, 1.5));
+    spec.state.geometry.section_width_m = parse_option_number(o.width_m, "--width-m", Range::open_low(0.0, 1.0));
   }
   if (!o.pressure_bar.empty()) {
-    spec.state.pressure_pa = units::bar_to_pa(parse_number(o.pressure_bar, "--pressure-bar", Range::open_low(0.0, 20.0)));
+    spec.state.pressure_pa = units::bar_to_pa(parse_option_number(o.pressure_bar, "--pressure-bar", Range::open_low(0.0, 20.0)));
   } else if (o.file.empty()) {
     throw InputError("--pressure-bar", "missing: the inflation pressure in bar is needed (e.g. --pressure-bar 2.1)");
   }
@@ -97,10 +87,10 @@ LoadChoice choose_load(const TyreOptions& o, const TyreSpec& spec) {
     throw InputError("--load-pct", "not allowed together with --load-n: give one of them");
   }
   if (!o.load_n.empty()) {
-    return {parse_number(o.load_n, "--load-n", Range::open_low(0.0, 1e6)), "--load-n " + o.load_n};
+    return {parse_option_number(o.load_n, "--load-n", Range::open_low(0.0, 1e6)), "--load-n " + o.load_n};
   }
   const bool pct_given = !o.load_pct.empty();
-  const double pct = pct_given ? parse_number(o.load_pct, "--load-pct", Range::open_low(0.0, 300.0)) : 80.0;
+  const double pct = pct_given ? parse_option_number(o.load_pct, "--load-pct", Range::open_low(0.0, 300.0)) : 80.0;
   if (!(spec.max_load_n > 0.0)) {
     throw InputError(pct_given ? "--load-pct " + o.load_pct : "--load-n",
                      pct_given ? "the tyre's maximum load is unknown (no load index): give --load-n N instead"
@@ -127,12 +117,12 @@ std::string describe_tyre(const TyreSpec& spec) {
   const auto& g = spec.state.geometry;
   std::string s = "tyre " + spec.name;
   if (spec.size && spec.size->designation != spec.name) s += " (" + spec.size->designation + ")";
-  s += ": outer radius " + report::fixed(g.outer_radius_m * 1e3, 1) + " mm, section width " +
-       report::fixed(g.section_width_m * 1e3, 0) + " mm";
-  if (g.rim_radius_m > 0.0) s += ", rim radius " + report::fixed(g.rim_radius_m * 1e3, 1) + " mm";
-  s += ", " + report::fixed(units::pa_to_bar(spec.state.pressure_pa), 2) + " bar";
+  s += ": outer radius " + fixed(g.outer_radius_m * 1e3, 1) + " mm, section width " +
+       fixed(g.section_width_m * 1e3, 0) + " mm";
+  if (g.rim_radius_m > 0.0) s += ", rim radius " + fixed(g.rim_radius_m * 1e3, 1) + " mm";
+  s += ", " + fixed(units::pa_to_bar(spec.state.pressure_pa), 2) + " bar";
   if (spec.max_load_n > 0.0) {
-    s += ", max load " + report::fixed(spec.max_load_n, 0) + " N (" + kg_text(spec.max_load_n) + ")";
+    s += ", max load " + fixed(spec.max_load_n, 0) + " N (" + kg_text(spec.max_load_n) + ")";
   } else {
     s += ", max load unknown";
   }
@@ -140,8 +130,8 @@ std::string describe_tyre(const TyreSpec& spec) {
 }
 
 std::string explanation_text(const TyreExplanation& x) {
-  std::string out = "\nElasticities at " + report::fixed(x.load_n, 0) + " N, " +
-                    report::fixed(units::mps_to_kmh(x.speed_mps), 1) +
+  std::string out = "\nElasticities at " + fixed(x.load_n, 0) + " N, " +
+                    fixed(units::mps_to_kmh(x.speed_mps), 1) +
                     " km/h (% change of the output per % change of the parameter; model, central differences)\n";
   report::TextTable t({"parameter", "value", "RRC", "sign", "RR power", "deflection", "contact length"});
   t.set_left_aligned(0);
@@ -149,15 +139,15 @@ std::string explanation_text(const TyreExplanation& x) {
   for (const auto& p : x.parameters) {
     std::string value;
     switch (p.parameter) {
-      case TyreParameter::OuterDiameter: value = report::fixed(p.value_si * 1e3, 1) + " mm"; break;
-      case TyreParameter::SectionWidth: value = report::fixed(p.value_si * 1e3, 1) + " mm"; break;
-      case TyreParameter::Pressure: value = report::fixed(units::pa_to_bar(p.value_si), 2) + " bar"; break;
-      case TyreParameter::Load: value = report::fixed(p.value_si, 0) + " N"; break;
-      case TyreParameter::Speed: value = report::fixed(units::mps_to_kmh(p.value_si), 1) + " km/h"; break;
+      case TyreParameter::OuterDiameter: value = fixed(p.value_si * 1e3, 1) + " mm"; break;
+      case TyreParameter::SectionWidth: value = fixed(p.value_si * 1e3, 1) + " mm"; break;
+      case TyreParameter::Pressure: value = fixed(units::pa_to_bar(p.value_si), 2) + " bar"; break;
+      case TyreParameter::Load: value = fixed(p.value_si, 0) + " N"; break;
+      case TyreParameter::Speed: value = fixed(units::mps_to_kmh(p.value_si), 1) + " km/h"; break;
     }
-    t.add_row({p.name, value, report::fixed(p.rrc_elasticity, 3), elasticity_sign(p.rrc_elasticity),
-               report::fixed(p.power_elasticity, 3), report::fixed(p.deflection_elasticity, 3),
-               report::fixed(p.contact_length_elasticity, 3)});
+    t.add_row({p.name, value, fixed(p.rrc_elasticity, 3), elasticity_sign(p.rrc_elasticity),
+               fixed(p.power_elasticity, 3), fixed(p.deflection_elasticity, 3),
+               fixed(p.contact_length_elasticity, 3)});
   }
   out += t.render() + "\nMechanisms in this model:\n";
   for (const auto& p : x.parameters) out += "- " + p.name + ": " + p.mechanism + "\n";
@@ -167,15 +157,30 @@ std::string explanation_text(const TyreExplanation& x) {
 void run_tyre(const TyreOptions& o) {
   const TyreSpec spec = build_tyre(o);
   const LoadChoice load = choose_load(o, spec);
+  if (o.explain && spec.state.model != TyreModelKind::Thesis) {
+    throw InputError("--explain", "explains the thesis model's mechanisms; " + spec.source +
+                                      " uses the hysteresis model (model: kind: hysteresis)");
+  }
 
   std::vector<double> speeds_kmh;
-  for (const auto& s : o.speeds_kmh) speeds_kmh.push_back(parse_number(s, "--speed-kmh", Range::closed(0.0, 500.0)));
+  for (const auto& given : o.speeds_kmh) {
+    // Split here rather than by CLI11, which drops empty items: "1,,2" is a typo, not two speeds.
+    std::size_t start = 0;
+    while (true) {
+      const std::size_t comma = given.find(',', start);
+      const std::string item = given.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+      if (item.empty()) throw InputError("--speed-kmh '" + given + "'", "an empty value between commas; give e.g. 50,80,120");
+      speeds_kmh.push_back(parse_option_number(item, "--speed-kmh", Range::closed(0.0, 500.0)));
+      if (comma == std::string::npos) break;
+      start = comma + 1;
+    }
+  }
   if (speeds_kmh.empty()) speeds_kmh.push_back(80.0);
   // Explaining needs a rolling tyre: at standstill RRC is 0 and has no elasticity.
   if (o.explain) {
     for (std::size_t i = 0; i < speeds_kmh.size(); ++i) {
       if (!(speeds_kmh[i] > 0.0)) {
-        throw InputError("--speed-kmh " + o.speeds_kmh[i], "0 is not allowed with --explain: must be > 0");
+        throw InputError("--speed-kmh " + format_value(speeds_kmh[i]), "0 is not allowed with --explain: must be > 0");
       }
     }
   }
@@ -190,8 +195,8 @@ void run_tyre(const TyreOptions& o) {
 
   // Warned only once the point is known to be solvable, so a rejected load gets one message, not two.
   if (spec.max_load_n > 0.0 && load.load_n > spec.max_load_n) {
-    std::cerr << "warning: load " << report::fixed(load.load_n, 0) << " N is above the tyre's rated maximum "
-              << report::fixed(spec.max_load_n, 0) << " N (" << kg_text(spec.max_load_n)
+    std::cerr << "warning: load " << fixed(load.load_n, 0) << " N is above the tyre's rated maximum "
+              << fixed(spec.max_load_n, 0) << " N (" << kg_text(spec.max_load_n)
               << "); results are outside the tyre's rating\n";
   }
 
@@ -199,8 +204,9 @@ void run_tyre(const TyreOptions& o) {
   if (o.json) {
     for (std::size_t i = 0; i < results.size(); ++i) {
       const auto& r = results[i];
-      report::JsonObject j;
+      JsonObject j;
       j.add("tyre", spec.name).add("source", spec.source);
+      j.add("model", spec.state.model == TyreModelKind::Thesis ? "thesis" : "hysteresis");
       if (spec.size) j.add("size", spec.size->designation);
       j.add("outer_radius_m", spec.state.geometry.outer_radius_m)
           .add("section_width_m", spec.state.geometry.section_width_m)
@@ -235,12 +241,12 @@ void run_tyre(const TyreOptions& o) {
   t.set_left_aligned(0);
   for (std::size_t i = 0; i < results.size(); ++i) {
     const auto& r = results[i];
-    t.add_row({spec.name, report::fixed(p_bar, 2), report::fixed(load.load_n, 0), report::fixed(speeds_kmh[i], 1),
-               report::fixed(r.stiffness_n_per_m * 1e-3, 1), report::fixed(r.deflection_m * 1e3, 2),
-               report::fixed(r.contact_length_m * 1e3, 1), report::fixed(r.rrc * 1e3, 3),
-               report::fixed(r.rrc_coulomb * 1e3, 3), report::fixed(r.rrc_viscous * 1e3, 3),
-               report::fixed(r.rrc_rotational_drag * 1e3, 3), report::fixed(r.rr_force_n, 2),
-               report::fixed(r.rr_power_w, 1)});
+    t.add_row({spec.name, fixed(p_bar, 2), fixed(load.load_n, 0), fixed(speeds_kmh[i], 1),
+               fixed(r.stiffness_n_per_m * 1e-3, 1), fixed(r.deflection_m * 1e3, 2),
+               fixed(r.contact_length_m * 1e3, 1), fixed(r.rrc * 1e3, 3),
+               fixed(r.rrc_coulomb * 1e3, 3), fixed(r.rrc_viscous * 1e3, 3),
+               fixed(r.rrc_rotational_drag * 1e3, 3), fixed(r.rr_force_n, 2),
+               fixed(r.rr_power_w, 1)});
   }
   std::cout << t.render();
   for (const auto& x : explanations) std::cout << explanation_text(x);
@@ -266,11 +272,14 @@ void register_tyre_command(CLI::App& app) {
       ->type_name("PCT");
   sub->add_option("--speed-kmh", opts->speeds_kmh, "Speed(s) [km/h]: several values, repeated or comma-separated "
                                                     "(default 80)")
-      ->delimiter(',')
       ->type_name("KMH");
   sub->add_flag("--json", opts->json, "One JSON object per operating point per line");
   sub->add_flag("--explain", opts->explain, "Elasticities of RRC and RR power and the mechanism behind each");
-  sub->callback([opts] { run_tyre(*opts); });
+  register_tyre_fit_command(*sub);
+  sub->callback([opts, sub] {
+    if (sub->got_subcommand("fit")) return;  // `rollsim tyre fit` runs its own callback
+    run_tyre(*opts);
+  });
 }
 
 }  // namespace rollsim::cli

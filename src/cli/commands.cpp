@@ -11,6 +11,7 @@ void register_commands(CLI::App& app) {
   register_sensitivity_command(app);
   register_regress_command(app);
   register_simulate_command(app);
+  register_validate_command(app);
 }
 
 }  // namespace rollsim::cli

@@ -3,6 +3,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
@@ -21,7 +22,7 @@ inline double parse_option_number(const std::string& text, const std::string& op
   if (text.empty() || end != text.c_str() + text.size()) {
     throw InputError(option, "'" + text + "' is not a number; " + range.describe());
   }
-  if (!range.contains(v)) throw InputError(option, format_value(v) + " is not allowed: " + range.describe());
+  if (!range.contains(v)) throw InputError(option, format_value(v) + " is not allowed: " + range.describe_for(v));
   return v;
 }
 
@@ -32,6 +33,9 @@ class Progress {
   void operator()(std::size_t done, std::size_t total) {
     if (!on_) return;
     std::lock_guard<std::mutex> lock(m_);
+    // At most one line per per-mille: a million-point tyre sweep must not spend its time printing.
+    const std::size_t step = std::max<std::size_t>(1, total / 1000);
+    if (done % step != 0 && done != total) return;
     std::fprintf(stderr, "\r%zu/%zu points", done, total);
     if (done == total) std::fprintf(stderr, "\n");
     std::fflush(stderr);

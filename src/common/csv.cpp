@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "rollsim/common/error.hpp"
+#include "rollsim/common/input_file.hpp"
 
 namespace rollsim {
 
@@ -56,15 +57,8 @@ std::string CsvTable::where(std::size_t row, std::size_t col) const {
   return file + ": line " + std::to_string(row_line.at(row)) + ", column '" + header.at(col) + "'";
 }
 
-CsvTable read_csv(const std::string& path, char delimiter) {
-  namespace fs = std::filesystem;
-  if (!fs::exists(path)) throw InputError(path, "file not found");
-  if (!fs::is_regular_file(path)) throw InputError(path, "is not a regular file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, "cannot be opened for reading");
-  std::ostringstream buf;
-  buf << in.rdbuf();
-  std::string text = buf.str();
+CsvTable read_csv(const std::string& path, char delimiter, std::size_t max_rows, const std::string& rows_are) {
+  std::string text = read_input_file(path, kMaxCsvFileBytes);
   if (text.size() >= 3 && text.compare(0, 3, "\xEF\xBB\xBF") == 0) text.erase(0, 3);
 
   CsvTable table;
@@ -140,6 +134,10 @@ CsvTable read_csv(const std::string& path, char delimiter) {
                        "has " + std::to_string(cells.size()) + " cells but the header (line " +
                            std::to_string(table.header_line) + ") has " + std::to_string(table.header.size()) +
                            " columns: " + table.columns_list());
+    }
+    if (table.rows.size() == max_rows) {
+      throw InputError(path + ": line " + std::to_string(record_line),
+                       "more than " + std::to_string(max_rows) + " " + rows_are + "; the limit keeps memory bounded");
     }
     table.rows.push_back(std::move(cells));
     table.row_line.push_back(record_line);

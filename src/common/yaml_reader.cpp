@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "rollsim/common/error.hpp"
+#include "rollsim/common/input_file.hpp"
 
 namespace rollsim {
 
@@ -29,15 +30,58 @@ std::string Range::describe() const {
   return "must be a finite number";
 }
 
-YamlMap YamlMap::load_file(const std::string& path) {
-  if (!std::filesystem::exists(path)) throw InputError(path, "file not found");
+namespace {
+
+// yaml-cpp keeps every occurrence of a repeated key and answers lookups with the first, so a second
+// `pressure_bar:` further down would be silently ignored; keys that are lists or mappings cannot be named.
+// Both are rejected here, at the line of the offending key, for every mapping in the document.
+// Aliases can make a small file a huge tree (a "billion laughs") or an endless one (an alias inside its own
+// anchor): the walk stops at bounds no real input nears.
+void check_keys(const YAML::Node& node, const std::string& path, std::size_t& visited, int depth = 0) {
+  if (++visited > 1000000) throw InputError(path, "more than a million values (aliases repeated?); not an input file of rollsim");
+  if (depth > 64) {
+    throw InputError(path + ": line " + std::to_string(node.Mark().line + 1),
+                     "nested more than 64 levels deep (an alias inside its own anchor?)");
+  }
+  if (node.IsSequence()) {
+    for (const auto& item : node) check_keys(item, path, visited, depth + 1);
+    return;
+  }
+  if (!node.IsMap()) return;
+  std::vector<std::string> seen;
+  for (const auto& kv : node) {
+    const std::string at = path + ": line " + std::to_string(kv.first.Mark().line + 1);
+    if (!kv.first.IsScalar()) throw InputError(at, "a key must be a plain word, not a list or mapping");
+    const std::string& key = kv.first.Scalar();
+    if (std::find(seen.begin(), seen.end(), key) != seen.end())
+      throw InputError(at + ": key '" + key + "'", "appears a second time in the same mapping; give each key once");
+    seen.push_back(key);
+    check_keys(kv.second, path, visited, depth + 1);
+  }
+}
+
+}  // namespace
+
+std::string Range::describe_for(double v) const {
+  // Beyond the default bound of +-1e300, "must be > 0" would read as if the value were too small.
+  if (std::isfinite(v) && (v > max || v < min) && std::abs(v) > 1e299 && (max >= 1e299 || min <= -1e299))
+    return describe() + (describe() == "must be a finite number" ? "" : ",") + " with a magnitude of at most 1e300";
+  if (std::isinf(v)) return describe() + " (and finite)";
+  return describe();
+}
+
+YamlMap YamlMap::load_file(const std::string& path) { return load_text(read_input_file(path, kMaxYamlFileBytes), path); }
+
+YamlMap YamlMap::load_text(const std::string& text, const std::string& path) {
   YAML::Node root;
   try {
-    root = YAML::LoadFile(path);
+    root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
     throw InputError(path + ": line " + std::to_string(e.mark.line + 1), "malformed YAML: " + e.msg);
   }
   if (!root.IsMap()) throw InputError(path, "expected a YAML mapping of keys to values at the top level");
+  std::size_t visited = 0;
+  check_keys(root, path, visited);
   return YamlMap(root, path, "");
 }
 
@@ -88,7 +132,7 @@ double YamlMap::to_number(const YAML::Node& n, const std::string& key, Range ran
       throw InputError(where(key), "'" + text + "' is not a number");
     }
   }
-  if (!range.contains(v)) throw InputError(where(key), format_value(v) + " is not allowed: " + range.describe());
+  if (!range.contains(v)) throw InputError(where(key), format_value(v) + " is not allowed: " + range.describe_for(v));
   return v;
 }
 
@@ -198,6 +242,9 @@ std::string resolve_data_file(const std::string& name, const std::string& shippe
   for (const auto& c : candidates) {
     if (fs::is_regular_file(c)) return c.string();
   }
+  // A folder given by name: say so rather than "not found".
+  std::error_code ec;
+  if (fs::is_directory(fs::path(name), ec)) throw InputError(option + " '" + name + "'", "is a folder; a file is expected here");
   throw InputError(option + " '" + name + "'",
                    "file not found (looked in the current folder and in " + shipped.string() + ")");
 }

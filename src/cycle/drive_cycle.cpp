@@ -110,6 +110,7 @@ DriveCycle load_cycle(const std::string& name_or_path, const std::string& option
     return read_cycle_csv(resolve_data_file(key, "cycles", ".csv", option), key);
   }
   namespace fs = std::filesystem;
+  if (fs::is_directory(name_or_path)) throw InputError(option + " '" + name_or_path + "'", "is a folder; a file is expected here");
   if (!fs::is_regular_file(name_or_path)) {
     std::string list;
     for (std::size_t i = 0; i < names.size(); ++i) list += (i ? ", " : "") + names[i];
@@ -180,9 +181,25 @@ DriveCycle read_cycle_csv(const std::string& path, const std::string& name) {
                        format_value(c.time_s[r]) + " s is not after " + format_value(c.time_s[r - 1]) + " s on line " +
                            std::to_string(table.row_line[r - 1]) + ": time must be strictly increasing");
     }
+    const double dt = r > 0 ? c.time_s[r] - c.time_s[r - 1] : 0.0;
+    if (r > 0 && !(dt >= kMinCycleTimeStep_s && dt <= kMaxCycleTimeStep_s)) {
+      throw InputError(table.where(r, *col_t),
+                       format_value(c.time_s[r]) + " s is " + format_value(dt) + " s after the sample on line " +
+                           std::to_string(table.row_line[r - 1]) + "; allowed: 0.001 to 86400 s between samples");
+    }
     const double v = number(r, col_v);
-    if (v < 0.0) throw InputError(table.where(r, col_v), format_value(v) + " is not allowed: speed must be >= 0");
+    const double v_max = col_kmh ? units::mps_to_kmh(kMaxCycleSpeed_mps) : kMaxCycleSpeed_mps;
+    if (!(v >= 0.0 && v <= v_max)) {
+      throw InputError(table.where(r, col_v), format_value(v) + " is not allowed: speed must be in [0, " +
+                                                  format_value(v_max) + "] " + (col_kmh ? "km/h" : "m/s") + " (500 km/h)");
+    }
     c.speed_mps[r] = col_kmh ? units::kmh_to_mps(v) : v;
+    if (r > 0 && std::abs(c.speed_mps[r] - c.speed_mps[r - 1]) / dt > kMaxCycleAccel_mps2) {
+      throw InputError(table.where(r, col_v),
+                       "the speed changes from line " + std::to_string(table.row_line[r - 1]) + " at " +
+                           format_value((c.speed_mps[r] - c.speed_mps[r - 1]) / dt) +
+                           " m/s^2; allowed: within +-19.6 m/s^2 (2 g, beyond any tyre's grip)");
+    }
     if (col_grade) {
       const double g = number(r, *col_grade);
       if (std::abs(g) > kMaxCycleGrade * 100.0) {

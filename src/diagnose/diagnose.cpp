@@ -25,7 +25,7 @@ std::vector<DriveCycle> cycles_of(const std::vector<Recording>& recordings, std:
     if (!r.grade && r.elevation_m)
       notes.push_back(r.source + ": grade from recorded elevation (" +
                       std::to_string(grade_from_elevation(r.time_s, r.speed_mps, *r.elevation_m).rejected_steps) +
-                      " elevation steps rejected as glitches, filtered over 200 m)");
+                      " elevation steps rejected as glitches, Savitzky-Golay slope over 300 m)");
   }
   return cycles;
 }

@@ -12,10 +12,11 @@ namespace rollsim::diag {
 namespace {
 
 // The simulated counterpart of the measured channel: fuel power, battery terminal power, or, for a state of charge
-// (which counts what leaves the cells), terminal power plus the cells' internal loss.
+// (which counts what leaves the cells), terminal power plus the cells' internal loss. Segment means, as the replay
+// integrates them: summed as mean x dt they are `simulate`'s energy on the same trace.
 double sim_power_w(const TracePoint& t, bool electric, double fuel_j_per_m3, bool cells) {
-  if (!electric) return t.fuel_rate_m3_per_s * fuel_j_per_m3;
-  return cells ? t.battery_power_w + t.battery_loss_w : t.battery_power_w;
+  if (!electric) return t.segment_fuel_rate_m3_per_s * fuel_j_per_m3;
+  return cells ? t.segment_battery_power_w + t.segment_battery_loss_w : t.segment_battery_power_w;
 }
 
 // p(i - lag) with a fractional lag, linear between samples, held at the first sample before the start.

@@ -393,7 +393,7 @@ std::shared_ptr<const Effect> make_effect(EffectId id, const EffectParameters& g
   EffectParameters p;
   for (const auto& pi : info.parameters) p[pi.name] = pi.neutral;
   for (const auto& [name, value] : given) {
-    auto it = std::find_if(info.parameters.begin(), info.parameters.end(), [&](const auto& pi) { return pi.name == name; });
+    auto it = std::find_if(info.parameters.begin(), info.parameters.end(), [&name = name](const auto& pi) { return pi.name == name; });
     if (it == info.parameters.end()) throw InputError("effect '" + info.name + "'", "has no parameter '" + name + "'");
     if (!(value >= it->min && value <= it->max))
       throw InputError("effect '" + info.name + "' parameter '" + name + "'",

@@ -34,14 +34,21 @@ double ElectricPowertrain::battery_current_a(double terminal_power_w) const {
   return (voc - std::sqrt(disc)) / (2.0 * r);
 }
 
+double ElectricPowertrain::speed_limit_factor(double speed_radps) const {
+  const double w_max = p_.motor.max_speed_radps;
+  const double band_radps = p_.motor.speed_limit_band_fraction * w_max;
+  if (speed_radps >= w_max) return 0.0;
+  if (!(band_radps > 0.0) || speed_radps <= w_max - band_radps) return 1.0;
+  return (w_max - speed_radps) / band_radps;
+}
+
 double ElectricPowertrain::max_wheel_force_n(int /*gear*/, double speed_mps, double wheel_radius_m) const {
   const double ratio = p_.reduction.ratio;
   const double eta = p_.reduction.efficiency;
   const double v = std::max(speed_mps, 0.0);
-  if (v / wheel_radius_m * ratio > p_.motor.max_speed_radps) return 0.0;
   double force_n = p_.motor.max_torque_nm * ratio * eta / wheel_radius_m;
   if (v > 0.0) force_n = std::min(force_n, p_.motor.max_power_w * eta / v);
-  return force_n;
+  return force_n * speed_limit_factor(v / wheel_radius_m * ratio);
 }
 
 PowerFlow ElectricPowertrain::deliver(double wheel_force_n, double speed_mps, int gear,
@@ -74,11 +81,14 @@ PowerFlow ElectricPowertrain::deliver(double wheel_force_n, double speed_mps, in
       fade = (v - rg.min_speed_mps) / (rg.fade_speed_mps - rg.min_speed_mps);
     }
     double regen_force_n = brake_force_n * rg.driven_axle_brake_fraction * fade;
-    regen_force_n = std::min(regen_force_n, p_.motor.max_torque_nm * ratio / (wheel_radius_m * eta));
+    // The speed limiter derates generating torque as it does motoring torque: past max_speed (only a replayed
+    // trace gets there) the machine gives nothing and the friction brakes take it all.
+    const double limiter = speed_limit_factor(motor_speed_radps);
+    regen_force_n = std::min(regen_force_n, limiter * p_.motor.max_torque_nm * ratio / (wheel_radius_m * eta));
     if (v > 0.0) {
       // Mechanical power reaching the motor is limited by the motor rating and by what the battery accepts.
       const double max_shaft_w = std::min(p_.motor.max_power_w, rg.max_power_w);
-      regen_force_n = std::min(regen_force_n, max_shaft_w / (v * eta));
+      regen_force_n = std::min(regen_force_n, limiter * max_shaft_w / (v * eta));
     } else {
       regen_force_n = 0.0;
     }
@@ -115,6 +125,11 @@ PowerFlow ElectricPowertrain::deliver(double wheel_force_n, double speed_mps, in
   out.battery_current_a = battery_current_a(out.battery_terminal_power_w);
   out.battery_loss_w = out.battery_current_a * out.battery_current_a * p_.battery.internal_resistance_ohm;
   return out;
+}
+
+void ElectricPowertrain::add_electric_load(double power_w, PowerFlow& flow) const {
+  flow.aux_power_w += power_w;
+  flow.battery_terminal_power_w += power_w;
 }
 
 std::vector<double> ElectricPowertrain::regime_speeds_mps() const {

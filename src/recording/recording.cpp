@@ -44,7 +44,7 @@ bool is_canonical(const std::string& name) {
 
 // Splits "CANONICAL=VALUE" of an option, checking the canonical name.
 std::pair<std::string, std::string> split_option(const std::string& option, const std::string& text,
-                                                 const std::string& example) {
+                                                 const std::string& example, bool allow_empty = false) {
   const std::string where = option + " '" + text + "'";
   const auto eq = text.find('=');
   if (eq == std::string::npos) throw InputError(where, "expected CANONICAL=" + example);
@@ -53,7 +53,7 @@ std::pair<std::string, std::string> split_option(const std::string& option, cons
   if (!is_canonical(canonical)) {
     throw InputError(where, "'" + canonical + "' is not a canonical column; allowed: " + canonical_list());
   }
-  if (value.empty()) throw InputError(where, "nothing after '='; expected CANONICAL=" + example);
+  if (value.empty() && !allow_empty) throw InputError(where, "nothing after '='; expected CANONICAL=" + example);
   return {canonical, value};
 }
 
@@ -103,7 +103,10 @@ double Recording::distance_m() const {
 const std::vector<std::string>& canonical_recording_columns() { return kCanonical; }
 
 void parse_column_option(const std::string& text, ColumnMapping& mapping) {
-  auto [canonical, source] = split_option("--column", text, "SOURCE, e.g. speed_kmh=Dyno_Spd[mph]");
+  auto [canonical, source] = split_option("--column", text, "SOURCE, e.g. speed_kmh=Dyno_Spd[mph]", true);
+  if (source.empty() && (canonical == "time_s" || canonical == "speed_kmh")) {
+    throw InputError("--column '" + text + "'", "'" + canonical + "' is required and cannot be dropped; map it to a column");
+  }
   // Shells keep quotes typed inside a single-quoted argument; a source name never starts and ends with one.
   if (source.size() >= 2 && (source.front() == '\'' || source.front() == '"') && source.back() == source.front()) {
     source = source.substr(1, source.size() - 2);
@@ -185,7 +188,7 @@ ColumnMapping merge_mapping(ColumnMapping base, const ColumnMapping& overrides) 
 }
 
 Recording load_recording(const std::string& path, const ColumnMapping& mapping) {
-  const CsvTable table = read_csv(path);
+  const CsvTable table = read_csv(path, ',', kMaxRecordingSamples, "samples");
   const std::string found = "found columns: " + table.columns_list();
   const std::size_t n = table.rows.size();
 
@@ -196,6 +199,7 @@ Recording load_recording(const std::string& path, const ColumnMapping& mapping) 
   // Column index of a canonical column, nullopt if absent; a mapping naming a column the file lacks is an error.
   auto find = [&](const std::string& canonical) -> std::optional<std::size_t> {
     const std::string src = source_of(canonical);
+    if (src.empty()) return std::nullopt;  // dropped (--column CANONICAL=)
     const auto col = table.column(src);
     if (!col && mapping.source_for_canonical.count(canonical)) {
       throw InputError(path, "column '" + src + "' (mapped to " + canonical + ") is not in the file; " + found);
@@ -204,6 +208,7 @@ Recording load_recording(const std::string& path, const ColumnMapping& mapping) 
   };
   for (const auto& [canonical, factor] : mapping.scale_for_canonical) {
     (void)factor;
+    if (source_of(canonical).empty()) continue;  // dropped: its scale has nothing to scale
     if (!find(canonical)) {
       throw InputError(path, "a scale is given for " + canonical + " but the file has no column '" + source_of(canonical) +
                                  "'; " + found + "; map one with --column " + canonical + "=SOURCE");
@@ -384,24 +389,51 @@ Recording load_recording(const std::string& path, const ColumnMapping& mapping) 
     const auto col = find(canonical);
     if (!col) return std::nullopt;
     Channel ch = read_channel(canonical, *col);
-    if (canonical == "latitude" || canonical == "longitude") {
-      // GPS loggers write exactly 0 when they have no fix (the Twizy files do, for a few seconds); a trip on
-      // the equator or the prime meridian to the last logged digit is not plausible, so 0 is read as missing.
-      std::size_t zeros = 0;
-      for (double& v : ch.values) {
-        if (v == 0.0) {
-          v = kNaN;
-          ++zeros;
-        }
-      }
-      if (zeros) {
-        rec.repairs.push_back("column '" + table.header[*col] + "' (" + canonical + "): " + std::to_string(zeros) +
-                              " value(s) of exactly 0 read as 'no GPS fix', i.e. missing");
-      }
-    }
     check_range(ch, lo, hi, unit);
     bridge(ch);
     for (double& v : ch.values) v = v * to_si + offset;
+    return std::move(ch.values);
+  };
+  // GPS position: the diagnosis reads it only to describe a trip, so a bad cell (text, out of range: a longitude of
+  // 1555.6 on one line) is read as missing and reported, and a column too broken to bridge is dropped with a note.
+  // A glitch there never stops a run.
+  auto gps_channel = [&](const std::string& canonical, double limit_deg) -> std::optional<std::vector<double>> {
+    const auto col = find(canonical);
+    if (!col) return std::nullopt;
+    const std::string name = "column '" + table.header[*col] + "' (" + canonical + ")";
+    auto it = mapping.scale_for_canonical.find(canonical);
+    const double scale = it != mapping.scale_for_canonical.end() ? it->second : 1.0;
+    Channel ch{canonical, *col, std::vector<double>(n, kNaN)};
+    std::size_t zeros = 0, bad = 0;
+    std::string first_bad;
+    for (std::size_t r = 0; r < n; ++r) {
+      const std::string& cell = table.rows[r][*col];
+      if (is_missing(cell)) continue;
+      const auto v = parse_number(cell);
+      // GPS loggers write exactly 0 when they have no fix (the Twizy files do, for a few seconds); a trip on
+      // the equator or the prime meridian to the last logged digit is not plausible, so 0 is read as missing.
+      if (v && *v == 0.0) {
+        ++zeros;
+        continue;
+      }
+      if (!v || !std::isfinite(*v * scale) || std::abs(*v * scale) > limit_deg) {
+        if (bad++ == 0) first_bad = "line " + std::to_string(table.row_line[r]) + ": '" + cell + "'";
+        continue;
+      }
+      ch.values[r] = *v * scale;
+    }
+    if (zeros) rec.repairs.push_back(name + ": " + std::to_string(zeros) + " value(s) of exactly 0 read as 'no GPS fix', i.e. missing");
+    if (bad) {
+      rec.repairs.push_back("warning: " + name + ": " + std::to_string(bad) + " value(s) not a number in [-" +
+                            format_value(limit_deg) + ", " + format_value(limit_deg) + "] deg read as missing (first: " +
+                            first_bad + ")");
+    }
+    try {
+      bridge(ch);
+    } catch (const InputError& e) {
+      rec.repairs.push_back("warning: " + name + " dropped, the diagnosis does not need it: " + e.what());
+      return std::nullopt;
+    }
     return std::move(ch.values);
   };
 
@@ -436,8 +468,8 @@ Recording load_recording(const std::string& path, const ColumnMapping& mapping) 
   rec.elevation_m = optional_channel("elevation_m", -500.0, 9000.0, "m", 1.0);
   rec.grade = optional_channel("grade_pct", -30.0, 30.0, "%", 0.01);
   rec.ambient_temp_k = optional_channel("ambient_temp_c", -60.0, 70.0, "C", 1.0, units::kKelvinOffset);
-  rec.latitude_deg = optional_channel("latitude", -90.0, 90.0, "deg", 1.0);
-  rec.longitude_deg = optional_channel("longitude", -180.0, 180.0, "deg", 1.0);
+  rec.latitude_deg = gps_channel("latitude", 90.0);
+  rec.longitude_deg = gps_channel("longitude", 180.0);
 
   if (rec.battery_voltage_v.has_value() != rec.battery_current_a.has_value()) {
     const std::string have = rec.battery_voltage_v ? "battery_voltage_v" : "battery_current_a";

@@ -29,10 +29,19 @@ std::string find_gnuplot() {
   return "";
 }
 
-std::string gnuplot_escape(const std::string& text) {
-  std::string o;
-  for (char c : text) o += c == '\'' ? std::string("''") : std::string(1, c);
-  return o;
+std::string gnuplot_string(const std::string& text) {
+  std::string o = "'";
+  for (const char c : text) {
+    const auto u = static_cast<unsigned char>(c);
+    if (c == '\'') o += "''";
+    else if (u < 0x20 || u == 0x7f) o += ' ';
+    else o += c;
+  }
+  return o + "'";
+}
+
+std::string gnuplot_terminal(const std::string& terminal) {
+  return "set terminal " + terminal + "\nset termoption noenhanced\n";
 }
 
 std::string run_gnuplot_script(const std::string& gnuplot, const std::string& script_path) {

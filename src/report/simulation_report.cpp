@@ -24,11 +24,12 @@ std::vector<std::pair<std::string, double>> energy_terms_kwh(const SimulationRes
       {"gearbox", k(e.gearbox_loss_j)},
       {"auxiliaries", k(e.aux_j)},
   };
-  if (r.electric) {
+  if (r.battery) {
     t.push_back({"motor", k(e.motor_loss_j)});
     t.push_back({"battery_internal", k(e.battery_loss_j)});
     t.push_back({"battery_terminals", k(e.battery_terminal_j)});
-  } else {
+  }
+  if (r.fuel) {
     t.push_back({"engine", k(e.engine_loss_j)});
     t.push_back({"clutch", k(e.clutch_loss_j)});
     t.push_back({"fuel", k(e.fuel_j)});
@@ -36,8 +37,9 @@ std::vector<std::pair<std::string, double>> energy_terms_kwh(const SimulationRes
   return t;
 }
 
-double headline_value(const SimulationResult& r) { return r.electric ? r.aec_kwh_per_10km() : r.fuel_l_per_100km(); }
-std::string headline_unit(const SimulationResult& r) { return r.electric ? "kWh/10 km" : "l/100 km"; }
+// A car that burns fuel is judged by its fuel (a hybrid's battery ends where it started); one without, by its battery.
+double headline_value(const SimulationResult& r) { return r.fuel ? r.fuel_l_per_100km() : r.aec_kwh_per_10km(); }
+std::string headline_unit(const SimulationResult& r) { return r.fuel ? "l/100 km" : "kWh/10 km"; }
 
 std::string summary_text(const SimulationResult& r, bool solver_stats) {
   std::ostringstream o;
@@ -46,17 +48,31 @@ std::string summary_text(const SimulationResult& r, bool solver_stats) {
   o << r.vehicle << " on " << r.cycle << " (" << r.mode << " simulation; road load: " << r.road_load << ")\n";
   o << "  distance " << fixed(km, 3) << " km in " << fixed(r.duration_s, 0) << " s, mean speed "
     << fixed(km / (r.duration_s / 3600.0), 1) << " km/h\n";
-  if (r.electric) {
+  if (!r.moved()) {
+    o << "  the car did not move: per-distance figures (" << (r.fuel ? "l/100 km, CO2 g/km" : "kWh/10 km, range")
+      << ") are undefined\n";
+  }
+  if (r.battery && r.moved()) {
     o << "  energy at the battery terminals: " << fixed(r.aec_kwh_per_10km(), 3) << " kWh/10 km = "
       << fixed(r.aec_kwh_per_10km() * 10.0, 2) << " kWh/100 km = " << fixed(r.aec_kwh_per_10km() * 100.0, 1) << " Wh/km\n";
-    o << "  range on the usable battery (" << fixed(units::j_to_kwh(r.usable_battery_j), 1) << " kWh): "
-      << fixed(r.range_km(), 0) << " km; state of charge " << fixed(r.initial_soc * 100, 1) << " % -> "
-      << fixed(r.final_soc * 100, 1) << " %\n";
-  } else {
-    o << "  fuel: " << fixed(r.fuel_l_per_100km(), 3) << " l/100 km (" << fixed(r.fuel_volume_m3 * 1e3, 3)
+    o << "  range on the usable battery (" << fixed(units::j_to_kwh(r.battery->usable_j), 1) << " kWh): "
+      << fixed(r.range_km(), 0) << " km";
+    if (!r.battery_empty) {
+      o << "; state of charge " << fixed(r.battery->initial_soc * 100, 1) << " % -> " << fixed(r.battery->final_soc * 100, 1) << " %";
+    }
+    o << "\n";
+  }
+  if (r.fuel && r.moved()) {
+    o << "  fuel: " << fixed(r.fuel_l_per_100km(), 3) << " l/100 km (" << fixed(r.fuel->volume_m3 * 1e3, 3)
       << " l), CO2 " << fixed(r.co2_g_per_km(), 1) << " g/km\n";
   }
-  const double source_j = r.electric ? e.battery_terminal_j : e.fuel_j;
+  if (r.battery && r.battery_empty) {
+    o << "  WARNING: the usable battery ran empty at t = " << fixed(r.battery_empty->time_s, 0) << " s, after "
+      << fixed(r.battery_empty->distance_m / 1000.0, 3) << " km (state of charge "
+      << fixed(r.battery->initial_soc * 100, 1) << " % -> 0 %); the rest of the trace was driven on energy the battery "
+      << "does not hold (it would need " << fixed(-r.battery->final_soc * 100, 1) << " % more)\n";
+  }
+  const double source_j = r.source_energy_j();
   TextTable t({"energy", "kWh", "share %"});
   t.set_left_aligned(0);
   auto row = [&](const std::string& name, double j, double of_j) {
@@ -68,18 +84,19 @@ std::string summary_text(const SimulationResult& r, bool solver_stats) {
   if (e.grade_j != 0.0) row("  grade (net climb)", e.grade_j, e.traction_j);
   if (e.other_resistance_j != 0.0) row("  other resistance (effects)", e.other_resistance_j, e.traction_j);
   row("  braking lost (friction)", e.friction_brake_j, e.traction_j);
-  if (r.electric) row("  regenerated at the wheels", e.regen_wheel_j, e.traction_j);
+  if (r.battery) row("  regenerated at the wheels", e.regen_wheel_j, e.traction_j);
   if (e.wheel_loss_j != 0.0) row("  tyre slip", e.wheel_loss_j, e.traction_j);
   row("  kinetic energy change", e.kinetic_change_j, e.traction_j);
   if (e.unmet_demand_j != 0.0) row("demanded beyond the powertrain (replay)", e.unmet_demand_j, e.traction_j);
-  if (r.electric) {
+  if (r.battery) {
     row("battery terminals (net)", e.battery_terminal_j, source_j);
     row("  traction - regenerated", e.traction_j - e.regen_wheel_j, source_j);
     row("  reduction gear", e.gearbox_loss_j, source_j);
     row("  motor and inverter", e.motor_loss_j, source_j);
     row("  auxiliaries", e.aux_j, source_j);
     row("battery internal loss (extra)", e.battery_loss_j, source_j);
-  } else {
+  }
+  if (r.fuel) {
     row("fuel (lower heating value)", e.fuel_j, source_j);
     row("  engine loss (heat, friction)", e.engine_loss_j, source_j);
     row("  traction", e.traction_j, source_j);
@@ -88,14 +105,18 @@ std::string summary_text(const SimulationResult& r, bool solver_stats) {
     row("  accessories (alternator)", e.aux_j, source_j);
   }
   o << t.render();
-  o << "  energy balance closes to " << fixed(100.0 * std::abs(e.wheel_residual_j()) / e.traction_j, 4)
-    << " % at the wheels and " << fixed(100.0 * std::abs(e.powertrain_residual_j(r.electric)) / std::abs(source_j), 4)
-    << " % in the powertrain\n";
-  o << "  speed tracking: max error " << fixed(r.max_speed_error_mps * 3.6, 2) << " km/h at t = "
+  // A run with no traction (standing still) has no scale for a relative balance: its residuals are given in J.
+  auto closure = [](double residual_j, double scale_j) {
+    return scale_j != 0.0 ? fixed(100.0 * std::abs(residual_j) / std::abs(scale_j), 4) + " %"
+                          : fixed(std::abs(residual_j), 3) + " J";
+  };
+  o << "  energy balance closes to " << closure(e.wheel_residual_j(), e.traction_j) << " at the wheels and "
+    << closure(e.powertrain_residual_j(), source_j) << " in the powertrain\n";
+  o << "  speed tracking: max error " << fixed(units::mps_to_kmh(r.max_speed_error_mps), 2) << " km/h at t = "
     << fixed(r.max_speed_error_time_s, 1) << " s\n";
   for (const auto& s : r.shortfalls) {
     o << "  WARNING: the car could not follow the trace from t = " << fixed(s.start_s, 0) << " to " << fixed(s.end_s, 0)
-      << " s" << (s.max_deficit_mps > 0.0 ? ", falling behind by up to " + fixed(s.max_deficit_mps * 3.6, 1) +
+      << " s" << (s.max_deficit_mps > 0.0 ? ", falling behind by up to " + fixed(units::mps_to_kmh(s.max_deficit_mps), 1) +
                                                 " km/h at t = " + fixed(s.at_s, 0) + " s"
                                           : " (powertrain at its limit)")
       << "\n";
@@ -112,23 +133,49 @@ std::string summary_text(const SimulationResult& r, bool solver_stats) {
 JsonObject to_json(const SimulationResult& r, const std::string& tyre_label) {
   JsonObject j;
   j.add("vehicle", r.vehicle).add("tyre", tyre_label).add("road_load", r.road_load).add("cycle", r.cycle);
-  j.add("mode", r.mode).add("powertrain", r.electric ? "electric" : "combustion");
+  j.add("mode", r.mode).add("powertrain", r.battery && r.fuel ? "hybrid" : r.battery ? "electric" : "combustion");
   j.add("distance_km", r.distance_m / 1000.0).add("duration_s", r.duration_s);
-  if (r.electric) {
-    j.add("aec_kwh_per_10km", r.aec_kwh_per_10km()).add("aec_kwh_per_100km", r.aec_kwh_per_10km() * 10.0);
-    j.add("aec_wh_per_km", r.aec_kwh_per_10km() * 100.0).add("range_km", r.range_km());
-    j.add("final_soc_pct", r.final_soc * 100.0);
-    j.add_null("fuel_l_per_100km");
-    j.add("co2_g_per_km", 0.0);
+  // Per-distance figures of a run that did not move are undefined: null, never inf or NaN.
+  auto per_distance = [&](const std::string& key, double value) {
+    if (r.moved()) {
+      j.add(key, value);
+    } else {
+      j.add_null(key);
+    }
+  };
+  j.add("moved", r.moved());
+  if (r.battery) {
+    per_distance("aec_kwh_per_10km", r.aec_kwh_per_10km());
+    per_distance("aec_kwh_per_100km", r.aec_kwh_per_10km() * 10.0);
+    per_distance("aec_wh_per_km", r.aec_kwh_per_10km() * 100.0);
+    per_distance("range_km", r.range_km());
+    j.add("final_soc_pct", r.battery->final_soc * 100.0);
+    j.add("battery_empty", r.battery_empty.has_value());
+    if (r.battery_empty) {
+      j.add("battery_empty_at_s", r.battery_empty->time_s).add("battery_empty_at_km", r.battery_empty->distance_m / 1000.0);
+    } else {
+      j.add_null("battery_empty_at_s").add_null("battery_empty_at_km");
+    }
   } else {
     j.add_null("aec_kwh_per_10km");
-    j.add("fuel_l_per_100km", r.fuel_l_per_100km()).add("co2_g_per_km", r.co2_g_per_km());
+  }
+  if (r.fuel) {
+    per_distance("fuel_l_per_100km", r.fuel_l_per_100km());
+    per_distance("co2_g_per_km", r.co2_g_per_km());
+  } else {
+    j.add_null("fuel_l_per_100km");
+    per_distance("co2_g_per_km", 0.0);
   }
   JsonObject b;
   for (const auto& [k, v] : energy_terms_kwh(r)) b.add(k, v);
   j.add("energy_breakdown_kwh", b);
-  j.add("energy_balance_residual_pct", 100.0 * r.energy.wheel_residual_j() / r.energy.traction_j);
-  j.add("max_speed_error_kmh", r.max_speed_error_mps * 3.6);
+  if (r.energy.traction_j != 0.0) {
+    j.add("energy_balance_residual_pct", 100.0 * r.energy.wheel_residual_j() / r.energy.traction_j);
+  } else {
+    j.add_null("energy_balance_residual_pct");
+  }
+  j.add("energy_balance_residual_j", r.energy.wheel_residual_j());
+  j.add("max_speed_error_kmh", units::mps_to_kmh(r.max_speed_error_mps));
   j.add("shortfalls", static_cast<int>(r.shortfalls.size()));
   if (r.mode == "forward") {
     JsonObject s;
@@ -146,10 +193,10 @@ void write_trace_csv(std::ostream& out, const SimulationResult& r) {
          "wheel_force_n,traction_power_kw,battery_power_kw,battery_current_a,fuel_rate_lph,tyre_rrc,soc_pct\n";
   out.precision(8);
   for (const auto& p : r.trace) {
-    out << p.time_s << ',' << p.target_speed_mps * 3.6 << ',' << p.speed_mps * 3.6 << ',' << p.accel_mps2 << ','
+    out << p.time_s << ',' << units::mps_to_kmh(p.target_speed_mps) << ',' << units::mps_to_kmh(p.speed_mps) << ',' << p.accel_mps2 << ','
         << p.grade * 100.0 << ',' << p.gear << ',' << p.rolling_force_n << ',' << p.aero_force_n << ','
         << p.grade_force_n << ',' << p.wheel_force_n << ',' << p.traction_power_w / 1e3 << ','
-        << p.battery_power_w / 1e3 << ',' << p.battery_current_a << ',' << p.fuel_rate_m3_per_s * 3.6e6 << ','
+        << p.battery_power_w / 1e3 << ',' << p.battery_current_a << ',' << p.fuel_rate_m3_per_s / units::kM3PerLitre * 3600.0 << ','
         << p.rrc << ',' << p.soc * 100.0 << '\n';
   }
 }

@@ -37,13 +37,13 @@ FitCheck check_fit(const Vehicle& vehicle, const TyreSpec& own, const TyreSpec& 
   if (f.capacity_n <= 0.0) {
     reasons.push_back("load capacity unknown (no load index or max load)");
   } else if (f.wheel_load_n > f.capacity_n) {
-    reasons.push_back("load " + report::fixed(f.wheel_load_n, 0) + " N > " + report::fixed(f.capacity_n, 0) +
-                      " N capacity at " + report::fixed(units::pa_to_bar(candidate.state.pressure_pa), 1) + " bar");
+    reasons.push_back("load " + fixed(f.wheel_load_n, 0) + " N > " + fixed(f.capacity_n, 0) +
+                      " N capacity at " + fixed(units::pa_to_bar(candidate.state.pressure_pa), 1) + " bar");
   }
   if (std::abs(f.diameter_change_pct) > diameter_tolerance_pct) {
-    reasons.push_back("diameter " + report::fixed(d_new * 1e3, 0) + " mm is " +
-                      (f.diameter_change_pct > 0 ? "+" : "") + report::fixed(f.diameter_change_pct, 1) + " % from " +
-                      report::fixed(d_own * 1e3, 0) + " mm (tolerance " + format_value(diameter_tolerance_pct) + " %)");
+    reasons.push_back("diameter " + fixed(d_new * 1e3, 0) + " mm is " +
+                      (f.diameter_change_pct > 0 ? "+" : "") + fixed(f.diameter_change_pct, 1) + " % from " +
+                      fixed(d_own * 1e3, 0) + " mm (tolerance " + format_value(diameter_tolerance_pct) + " %)");
   }
   f.fits = reasons.empty();
   if (!f.fits) {
@@ -90,8 +90,8 @@ Comparison compare_tyres(const Vehicle& vehicle, const std::vector<TyreSpec>& ca
   Comparison cmp;
   cmp.vehicle = vehicle.name;
   cmp.cycle = cycle.name;
-  cmp.electric = vehicle.is_electric();
   cmp.unit = energy_unit(vehicle);
+  cmp.shows_range = cmp.unit == "kwh_per_10km";
 
   CandidateResult own_result = evaluate(vehicle, own, own, cycle, o);
   if (!own_result.simulated) throw InputError(vehicle.source, "cannot run the car on its own tyre: " + own_result.error);

@@ -25,7 +25,12 @@ Baseline load_baseline(const std::string& path) {
   root.finish();
   const YAML::Node list = root.node()["cases"];
   for (std::size_t i = 0; i < list.size(); ++i) {
-    YamlMap m(list[i], path, "cases[" + std::to_string(i) + "]");
+    const std::string item = "cases[" + std::to_string(i) + "]";
+    if (!list[i].IsMap()) {
+      throw InputError(path + ": line " + std::to_string(list[i].Mark().line + 1) + ": " + item,
+                       "expected a mapping {name, vehicle, tyre, cycle, unit, expected, tolerance_pct}");
+    }
+    YamlMap m(list[i], path, item + ".");
     RegressCase c;
     c.name = m.string("name");
     c.vehicle = m.string("vehicle");

@@ -1,13 +1,14 @@
 // Sweeps of tyre parameters: the tyre model point by point, or the car on a cycle on every core.
 #include "rollsim/selection/sweep.hpp"
 
+
 #include <atomic>
 #include <cmath>
 #include <exception>
 #include <sstream>
-#include <thread>
 
 #include "rollsim/common/error.hpp"
+#include "rollsim/common/parallel.hpp"
 #include "rollsim/common/units.hpp"
 #include "rollsim/report/table.hpp"
 #include "rollsim/selection/common.hpp"
@@ -86,18 +87,33 @@ TyreSpec with_parameter(const TyreSpec& tyre, SweepParam p, double value) {
 
 namespace {
 
-std::vector<std::vector<double>> grid(const std::vector<SweepAxis>& axes) {
+// The grid's points in output order (first axis outer, last axis fastest), checked against the limit before
+// anything is allocated: a grid is the product of its axes' steps, and 10^6 x 10^6 would not fit in memory.
+std::vector<std::vector<double>> grid(const std::vector<SweepAxis>& axes, std::size_t max_points, const char* what) {
+  std::size_t n = 1;
+  std::string sizes;
+  for (const auto& a : axes) {
+    const auto steps = static_cast<std::size_t>(std::max(a.steps, 1));
+    n = n > max_points / steps ? max_points + 1 : n * steps;
+    sizes += (sizes.empty() ? "" : " x ") + std::to_string(a.steps);
+  }
+  if (n > max_points) {
+    throw InputError("--steps", sizes + " points is more than the " + std::to_string(max_points) + " allowed for " + what +
+                                    "; use fewer --steps or a narrower --from/--to");
+  }
   std::vector<std::vector<double>> pts{{}};
   for (const auto& a : axes) {
     std::vector<std::vector<double>> next;
+    next.reserve(pts.size() * static_cast<std::size_t>(a.steps));
+    const auto values = a.values();
     for (const auto& p : pts) {
-      for (double v : a.values()) {
+      for (double v : values) {
         auto q = p;
         q.push_back(v);
-        next.push_back(q);
+        next.push_back(std::move(q));
       }
     }
-    pts = next;
+    pts = std::move(next);
   }
   return pts;
 }
@@ -170,8 +186,9 @@ SweepResult sweep_tyre(const TyreSpec& tyre, const SweepOptions& o) {
   check_options(tyre, o);
   SweepResult r;
   r.axes = o.axes;
-  const auto pts = grid(o.axes);
+  const auto pts = grid(o.axes, kMaxTyreSweepPoints, "a tyre sweep");
   r.planned_points = pts.size();
+  r.points.reserve(pts.size());
   for (const auto& values : pts) {
     const PointSetup s = setup(tyre, o, values);
     try {
@@ -204,7 +221,7 @@ SweepResult sweep_vehicle(const Vehicle& vehicle, const TyreSpec& tyre, const Dr
   r.axes = o.axes;
   r.vehicle = true;
   r.energy_unit = energy_unit(vehicle);
-  const auto pts = grid(o.axes);
+  const auto pts = grid(o.axes, kMaxVehicleSweepPoints, "a sweep with a car (one simulation per point)");
   r.planned_points = pts.size();
 
   struct Slot {
@@ -213,32 +230,26 @@ SweepResult sweep_vehicle(const Vehicle& vehicle, const TyreSpec& tyre, const Dr
     bool done = false;
   };
   std::vector<Slot> slots(pts.size());
-  std::atomic<std::size_t> next{0}, finished{0};
-  auto worker = [&] {
-    for (std::size_t i = next++; i < pts.size(); i = next++) {
-      Slot& s = slots[i];
-      const PointSetup ps = setup(tyre, o, pts[i]);
-      try {
-        s.point.values = pts[i];
-        s.point.load_n = ps.load_n;
-        s.point.speed_kmh = ps.speed_kmh;
-        s.point.rr = evaluate_rolling_resistance(ps.tyre.state, ps.load_n, units::kmh_to_mps(ps.speed_kmh));
-        Vehicle v = vehicle;
-        fit_tyres(v, ps.tyre);
-        s.point.energy = run_forward(v, cycle).value;  // own VehicleModel per point, so per thread
-      } catch (const std::exception& e) {
-        s.error = e.what();
-      }
-      s.done = true;
-      const std::size_t n = ++finished;
-      if (o.progress) o.progress(n, pts.size());
+  std::atomic<std::size_t> finished{0};
+  // Each point keeps its slot, so the output is in grid order whatever order the threads finish in.
+  parallel_for(pts.size(), o.threads, [&](std::size_t i) {
+    Slot& s = slots[i];
+    const PointSetup ps = setup(tyre, o, pts[i]);
+    try {
+      s.point.values = pts[i];
+      s.point.load_n = ps.load_n;
+      s.point.speed_kmh = ps.speed_kmh;
+      s.point.rr = evaluate_rolling_resistance(ps.tyre.state, ps.load_n, units::kmh_to_mps(ps.speed_kmh));
+      Vehicle v = vehicle;
+      fit_tyres(v, ps.tyre);
+      s.point.energy = run_forward(v, cycle).value;  // own VehicleModel per point, so per thread
+    } catch (const std::exception& e) {
+      s.error = e.what();
     }
-  };
-  unsigned n_threads = o.threads ? o.threads : std::max(1u, std::thread::hardware_concurrency());
-  n_threads = static_cast<unsigned>(std::min<std::size_t>(n_threads, pts.size()));
-  std::vector<std::thread> threads;
-  for (unsigned t = 0; t < n_threads; ++t) threads.emplace_back(worker);
-  for (auto& t : threads) t.join();
+    s.done = true;
+    const std::size_t n = ++finished;
+    if (o.progress) o.progress(n, pts.size());
+  });
 
   for (std::size_t i = 0; i < pts.size(); ++i) {
     if (!slots[i].error.empty()) {
@@ -258,10 +269,10 @@ std::string sweep_csv(const SweepResult& r) {
   out << "\n";
   for (const auto& p : r.points) {
     for (double v : p.values) out << format_value(v) << ",";
-    out << format_value(p.load_n) << "," << format_value(p.speed_kmh) << "," << report::fixed(p.rr.rrc, 7) << ","
-        << report::fixed(p.rr.rr_force_n, 4) << "," << report::fixed(p.rr.rr_power_w, 3) << ","
-        << report::fixed(p.rr.deflection_m, 6);
-    if (r.vehicle) out << "," << report::fixed(p.energy, 5);
+    out << format_value(p.load_n) << "," << format_value(p.speed_kmh) << "," << fixed(p.rr.rrc, 7) << ","
+        << fixed(p.rr.rr_force_n, 4) << "," << fixed(p.rr.rr_power_w, 3) << ","
+        << fixed(p.rr.deflection_m, 6);
+    if (r.vehicle) out << "," << fixed(p.energy, 5);
     out << "\n";
   }
   return out.str();

@@ -2,13 +2,16 @@
 
 #include <cvodes/cvodes.h>
 #include <nvector/nvector_serial.h>
-#include <sundials/sundials_context.h>
 #include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <numeric>
 #include <string>
+
+#include "rollsim/sim/sundials_compat.hpp"
 
 namespace rollsim {
 
@@ -29,15 +32,15 @@ void each(N_Vector z, F&& f) {
   for (sunindextype i = 0, n = length(z); i < n; ++i) zd[i] = f(i);
 }
 
-void linear_sum(realtype a, N_Vector x, realtype b, N_Vector y, N_Vector z) {
+void linear_sum(sundials::real a, N_Vector x, sundials::real b, N_Vector y, N_Vector z) {
   const double *xd = data(x), *yd = data(y);
   each(z, [&](sunindextype i) { return a * xd[i] + b * yd[i]; });
 }
-void scale(realtype c, N_Vector x, N_Vector z) {
+void scale(sundials::real c, N_Vector x, N_Vector z) {
   const double* xd = data(x);
   each(z, [&](sunindextype i) { return c * xd[i]; });
 }
-void constant(realtype c, N_Vector z) {
+void constant(sundials::real c, N_Vector z) {
   each(z, [&](sunindextype) { return c; });
 }
 void absolute(N_Vector x, N_Vector z) {
@@ -48,7 +51,7 @@ void inverse(N_Vector x, N_Vector z) {
   const double* xd = data(x);
   each(z, [&](sunindextype i) { return 1.0 / xd[i]; });
 }
-void add_constant(N_Vector x, realtype b, N_Vector z) {
+void add_constant(N_Vector x, sundials::real b, N_Vector z) {
   const double* xd = data(x);
   each(z, [&](sunindextype i) { return xd[i] + b; });
 }
@@ -56,14 +59,14 @@ void product(N_Vector x, N_Vector y, N_Vector z) {
   const double *xd = data(x), *yd = data(y);
   each(z, [&](sunindextype i) { return xd[i] * yd[i]; });
 }
-realtype weighted_square_sum(N_Vector x, N_Vector w) {
+sundials::real weighted_square_sum(N_Vector x, N_Vector w) {
   const double *xd = data(x), *wd = data(w);
   double sum = 0.0;
   for (sunindextype i = 0, n = length(x); i < n; ++i) sum += (xd[i] * wd[i]) * (xd[i] * wd[i]);
   return sum;
 }
-realtype wrms_norm(N_Vector x, N_Vector w) { return std::sqrt(weighted_square_sum(x, w) / static_cast<double>(length(x))); }
-int linear_combination(int nv, realtype* c, N_Vector* xs, N_Vector z) {
+sundials::real wrms_norm(N_Vector x, N_Vector w) { return std::sqrt(weighted_square_sum(x, w) / static_cast<double>(length(x))); }
+int linear_combination(int nv, sundials::real* c, N_Vector* xs, N_Vector z) {
   each(z, [&](sunindextype i) {
     double sum = 0.0;
     for (int j = 0; j < nv; ++j) sum += c[j] * data(xs[j])[i];
@@ -71,7 +74,7 @@ int linear_combination(int nv, realtype* c, N_Vector* xs, N_Vector z) {
   });
   return 0;
 }
-int scale_add_multi(int nv, realtype* a, N_Vector x, N_Vector* ys, N_Vector* zs) {
+int scale_add_multi(int nv, sundials::real* a, N_Vector x, N_Vector* ys, N_Vector* zs) {
   const double* xd = data(x);
   for (int j = 0; j < nv; ++j) {
     const double* yd = data(ys[j]);
@@ -79,9 +82,47 @@ int scale_add_multi(int nv, realtype* a, N_Vector x, N_Vector* ys, N_Vector* zs)
   }
   return 0;
 }
-int scale_vector_array(int nv, realtype* c, N_Vector* xs, N_Vector* zs) {
+int scale_vector_array(int nv, sundials::real* c, N_Vector* xs, N_Vector* zs) {
   for (int j = 0; j < nv; ++j) scale(c[j], xs[j], zs[j]);
   return 0;
+}
+
+// CVODES' name for a return flag. CVodeGetReturnFlagName would do, but it returns a string it malloc'ed, one
+// leak per failure; these are the flags CVode and its setters return.
+const char* flag_name(int flag) {
+  switch (flag) {
+    case CV_TOO_MUCH_WORK: return "CV_TOO_MUCH_WORK";
+    case CV_TOO_MUCH_ACC: return "CV_TOO_MUCH_ACC";
+    case CV_ERR_FAILURE: return "CV_ERR_FAILURE";
+    case CV_CONV_FAILURE: return "CV_CONV_FAILURE";
+    case CV_LINIT_FAIL: return "CV_LINIT_FAIL";
+    case CV_LSETUP_FAIL: return "CV_LSETUP_FAIL";
+    case CV_LSOLVE_FAIL: return "CV_LSOLVE_FAIL";
+    case CV_RHSFUNC_FAIL: return "CV_RHSFUNC_FAIL";
+    case CV_FIRST_RHSFUNC_ERR: return "CV_FIRST_RHSFUNC_ERR";
+    case CV_REPTD_RHSFUNC_ERR: return "CV_REPTD_RHSFUNC_ERR";
+    case CV_UNREC_RHSFUNC_ERR: return "CV_UNREC_RHSFUNC_ERR";
+    case CV_RTFUNC_FAIL: return "CV_RTFUNC_FAIL";
+    case CV_NLS_INIT_FAIL: return "CV_NLS_INIT_FAIL";
+    case CV_NLS_SETUP_FAIL: return "CV_NLS_SETUP_FAIL";
+    case CV_CONSTR_FAIL: return "CV_CONSTR_FAIL";
+    case CV_NLS_FAIL: return "CV_NLS_FAIL";
+    case CV_MEM_FAIL: return "CV_MEM_FAIL";
+    case CV_MEM_NULL: return "CV_MEM_NULL";
+    case CV_ILL_INPUT: return "CV_ILL_INPUT";
+    case CV_NO_MALLOC: return "CV_NO_MALLOC";
+    case CV_BAD_K: return "CV_BAD_K";
+    case CV_BAD_T: return "CV_BAD_T";
+    case CV_BAD_DKY: return "CV_BAD_DKY";
+    case CV_TOO_CLOSE: return "CV_TOO_CLOSE";
+    case CV_VECTOROP_ERR: return "CV_VECTOROP_ERR";
+    case CV_QRHSFUNC_FAIL: return "CV_QRHSFUNC_FAIL";
+    case CV_FIRST_QRHSFUNC_ERR: return "CV_FIRST_QRHSFUNC_ERR";
+    case CV_REPTD_QRHSFUNC_ERR: return "CV_REPTD_QRHSFUNC_ERR";
+    case CV_UNREC_QRHSFUNC_ERR: return "CV_UNREC_QRHSFUNC_ERR";
+    case CV_NO_QUAD: return "CV_NO_QUAD";
+    default: return "CVODES error";
+  }
 }
 
 N_Vector new_vector(int n, SUNContext ctx) {
@@ -117,6 +158,7 @@ struct CvodeIntegrator::Impl {
   OdeSystem* system = nullptr;
   std::string last_error;
   std::string model_error;  // what the model threw inside a callback
+  sundials::detail::SinkAndUser error_route{&Impl::on_error, this};
 
   ~Impl() {
     if (mem) CVodeFree(&mem);
@@ -139,23 +181,49 @@ struct CvodeIntegrator::Impl {
       return -1;
     }
   }
-  static int rhs(realtype t, N_Vector y, N_Vector ydot, void* user) {
+  static int rhs(sundials::real t, N_Vector y, N_Vector ydot, void* user) {
     return guarded(user, [&](Impl& s) { return s.system->rhs(t, N_VGetArrayPointer(y), N_VGetArrayPointer(ydot)); });
   }
-  static int quad_rhs(realtype t, N_Vector y, N_Vector qdot, void* user) {
+  static int quad_rhs(sundials::real t, N_Vector y, N_Vector qdot, void* user) {
     return guarded(user, [&](Impl& s) {
       return s.system->quadrature_rhs(t, N_VGetArrayPointer(y), N_VGetArrayPointer(qdot));
     });
   }
-  static int roots(realtype t, N_Vector y, realtype* g, void* user) {
+  static int roots(sundials::real t, N_Vector y, sundials::real* g, void* user) {
     return guarded(user, [&](Impl& s) {
       s.system->roots(t, N_VGetArrayPointer(y), g);
       return 0;
     });
   }
   // CVODES reports through this instead of printing; the message becomes part of the SolverError.
-  static void on_error(int, const char*, const char* function, char* msg, void* user) {
-    static_cast<Impl*>(user)->last_error = std::string(function) + ": " + msg;
+  static void on_error(const char* function, const char* msg, void* user) {
+    static_cast<Impl*>(user)->last_error = std::string(function ? function : "CVODES") + ": " + (msg ? msg : "");
+  }
+
+  // The state components with the largest weighted local error estimates (CVodeGetErrWeights times
+  // CVodeGetEstLocalErrors, as Cantera's CVodesIntegrator reports them): which part of the model the failing
+  // step could not resolve. Empty when CVODES has no step to report on.
+  std::string largest_local_errors() const {
+    if (!mem || !y) return "";
+    const sunindextype n = NV_LENGTH_S(y);
+    N_Vector w = N_VClone(y), e = N_VClone(y);
+    std::string out;
+    if (w && e && CVodeGetErrWeights(mem, w) == CV_SUCCESS && CVodeGetEstLocalErrors(mem, e) == CV_SUCCESS) {
+      std::vector<double> weighted(static_cast<std::size_t>(n));
+      for (sunindextype i = 0; i < n; ++i) weighted[static_cast<std::size_t>(i)] = std::abs(NV_Ith_S(w, i) * NV_Ith_S(e, i));
+      std::vector<std::size_t> order(weighted.size());
+      std::iota(order.begin(), order.end(), std::size_t{0});
+      std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return weighted[a] > weighted[b]; });
+      for (std::size_t k = 0; k < std::min<std::size_t>(3, order.size()); ++k) {
+        if (!(weighted[order[k]] > 0.0)) break;
+        char v[32];
+        std::snprintf(v, sizeof v, "%.3g", weighted[order[k]]);
+        out += (k ? ", " : "") + system->state_name(static_cast<int>(order[k])) + " " + v;
+      }
+    }
+    if (w) N_VDestroy(w);
+    if (e) N_VDestroy(e);
+    return out.empty() ? "" : "; largest weighted local errors: " + out;
   }
 
   void check(int flag, const char* call, double t) const {
@@ -163,8 +231,10 @@ struct CvodeIntegrator::Impl {
       char when[32];
       std::snprintf(when, sizeof when, "%.3f", t);
       const std::string cause = !model_error.empty() ? model_error : last_error;
-      throw SolverError(t, std::string(call) + " failed at t = " + when + " s: " + CVodeGetReturnFlagName(flag) +
-                               (cause.empty() ? "" : " (" + cause + ")"));
+      const bool stepping = flag == CV_TOO_MUCH_WORK || flag == CV_TOO_MUCH_ACC || flag == CV_ERR_FAILURE ||
+                            flag == CV_CONV_FAILURE || flag == CV_NLS_FAIL;
+      throw SolverError(t, std::string(call) + " failed at t = " + when + " s: " + flag_name(flag) +
+                               (cause.empty() ? "" : " (" + cause + ")") + (stepping ? largest_local_errors() : ""));
     }
   }
 };
@@ -176,7 +246,7 @@ CvodeIntegrator::CvodeIntegrator(OdeSystem& system, double t0, const std::vector
   s.system = &system;
   const int n = system.size();
   const int nq = system.num_quadratures();
-  s.check(SUNContext_Create(nullptr, &s.ctx), "SUNContext_Create", t0);
+  s.check(sundials::create_context(&s.ctx), "SUNContext_Create", t0);
   s.y = new_vector(n, s.ctx);
   s.abstol = new_vector(n, s.ctx);
   s.scratch = new_vector(n, s.ctx);
@@ -186,7 +256,7 @@ CvodeIntegrator::CvodeIntegrator(OdeSystem& system, double t0, const std::vector
   }
   s.mem = CVodeCreate(CV_ADAMS, s.ctx);
   if (!s.mem) throw SolverError(t0, "CVodeCreate failed");
-  s.check(CVodeSetErrHandlerFn(s.mem, &Impl::on_error, &s), "CVodeSetErrHandlerFn", t0);
+  s.check(sundials::set_error_handler(s.ctx, s.mem, &s.error_route), "setting the error handler", t0);
   s.check(CVodeInit(s.mem, &Impl::rhs, t0, s.y), "CVodeInit", t0);
   s.check(CVodeSVtolerances(s.mem, tol.relative, s.abstol), "CVodeSVtolerances", t0);
   s.check(CVodeSetUserData(s.mem, &s), "CVodeSetUserData", t0);
@@ -202,6 +272,7 @@ CvodeIntegrator::CvodeIntegrator(OdeSystem& system, double t0, const std::vector
       NV_Ith_S(s.q_abstol, i) = tol.quadrature_absolute.at(i);
     }
     s.check(CVodeQuadInit(s.mem, &Impl::quad_rhs, s.q), "CVodeQuadInit", t0);
+    quadrature_relative_ = tol.quadrature_relative;
     s.check(CVodeQuadSVtolerances(s.mem, tol.quadrature_relative, s.q_abstol), "CVodeQuadSVtolerances", t0);
     s.check(CVodeSetQuadErrCon(s.mem, SUNTRUE), "CVodeSetQuadErrCon", t0);
   }
@@ -222,7 +293,7 @@ bool CvodeIntegrator::step(double t_stop) {
     s.check(CVodeSetStopTime(s.mem, t_stop), "CVodeSetStopTime", t_);
     stop_time_ = t_stop;
   }
-  realtype t_reached = t_;
+  sundials::real t_reached = t_;
   const int flag = CVode(s.mem, t_stop, s.y, &t_reached, CV_ONE_STEP);
   // CVODES' fixed-point solver can take a failed callback for a failed iteration and return without a step;
   // a model error is final whatever CVODES made of it.
@@ -297,6 +368,13 @@ void CvodeIntegrator::restart(double t, const std::vector<double>& y) {
   t_ = t;
   y_ = y;
   ++restarts_;
+}
+
+void CvodeIntegrator::set_quadrature_absolute_tolerances(const std::vector<double>& absolute) {
+  auto& s = *impl_;
+  if (!s.q) return;
+  for (std::size_t i = 0; i < absolute.size(); ++i) NV_Ith_S(s.q_abstol, i) = absolute[i];
+  s.check(CVodeQuadSVtolerances(s.mem, quadrature_relative_, s.q_abstol), "CVodeQuadSVtolerances", t_);
 }
 
 OdeStats CvodeIntegrator::stats() const {

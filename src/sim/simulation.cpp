@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <map>
 
 #include "rollsim/common/units.hpp"
@@ -29,21 +30,27 @@ double EnergyBreakdown::wheel_residual_j() const {
                        wheel_loss_j + kinetic_change_j);
 }
 
-double EnergyBreakdown::powertrain_residual_j(bool electric) const {
-  if (electric) return battery_terminal_j - (traction_j - regen_wheel_j + gearbox_loss_j + motor_loss_j + aux_j);
-  return fuel_j - (engine_loss_j + traction_j + gearbox_loss_j + clutch_loss_j + aux_j);
+double EnergyBreakdown::powertrain_residual_j() const {
+  // Each source books only the flows it carries, so one sum holds for electric, combustion and hybrid cars.
+  return battery_terminal_j + fuel_j -
+         (traction_j - regen_wheel_j + gearbox_loss_j + motor_loss_j + engine_loss_j + clutch_loss_j + aux_j);
 }
 
+double SimulationResult::source_energy_j() const { return energy.battery_terminal_j + energy.fuel_j; }
+
 double SimulationResult::aec_kwh_per_10km() const {
-  return units::j_to_kwh(energy.battery_terminal_j) / (distance_m / 10000.0);
+  return moved() ? units::j_to_kwh(energy.battery_terminal_j) / (distance_m / 10000.0) : std::nan("");
 }
 double SimulationResult::fuel_l_per_100km() const {
-  return fuel_volume_m3 / units::kM3PerLitre / (distance_m / 100000.0);
+  return moved() ? (fuel ? fuel->volume_m3 : 0.0) / units::kM3PerLitre / (distance_m / 100000.0) : std::nan("");
 }
-double SimulationResult::co2_g_per_km() const { return co2_kg * 1e3 / (distance_m / 1000.0); }
+double SimulationResult::co2_g_per_km() const {
+  return moved() ? (fuel ? fuel->co2_kg : 0.0) * 1e3 / (distance_m / 1000.0) : std::nan("");
+}
 double SimulationResult::range_km() const {
+  if (!moved()) return std::nan("");
   const double per_m = (energy.battery_terminal_j + energy.battery_loss_j) / distance_m;
-  return per_m > 0.0 ? usable_battery_j / per_m / 1000.0 : 0.0;
+  return battery && per_m > 0.0 ? battery->usable_j / per_m / 1000.0 : 0.0;
 }
 
 namespace {
@@ -156,26 +163,9 @@ struct Evaluator {
     }
     double extra_electric_w = 0.0;
     for (std::size_t i = 0; i < m.effects.size(); ++i) extra_electric_w += m.effects[i]->extra_electric_power_w(in, x + effect_state_offset[i]);
-    if (extra_electric_w != 0.0) add_electric_load(extra_electric_w, out.flow);
+    if (extra_electric_w != 0.0) m.powertrain->add_electric_load(extra_electric_w, out.flow);
     // Effects' battery loss (extra internal resistance) drains the cells, not the terminals: SOC sees it.
     for (std::size_t i = 0; i < m.effects.size(); ++i) out.flow.battery_loss_w += m.effects[i]->battery_loss_w(in, out.flow.battery_terminal_power_w, x + effect_state_offset[i]);
-  }
-
-  // An extra electrical load: from the battery terminals (its own I^2 R is neglected: under 1 % of it at these
-  // currents), or from the alternator at the engine's marginal (Willans) efficiency, even in fuel cut-off.
-  void add_electric_load(double p_w, PowerFlow& flow) const {
-    flow.aux_power_w += p_w;
-    if (m.powertrain->is_electric()) {
-      flow.battery_terminal_power_w += p_w;
-      return;
-    }
-    if (const auto* c = dynamic_cast<const CombustionPowertrain*>(m.powertrain.get())) {
-      const auto& cp = c->params();
-      const double fuel_w = p_w / (cp.alternator_efficiency * cp.engine.indicated_efficiency);
-      flow.fuel_power_w += fuel_w;
-      flow.engine_loss_w += fuel_w - p_w;
-      flow.fuel_rate_m3_per_s += fuel_w / (cp.fuel.lower_heating_value_j_per_kg * cp.fuel.density_kg_per_m3);
-    }
   }
 };
 
@@ -205,7 +195,8 @@ void accumulate(const Instant& s, double speed_mps, double* d) {
 // The accumulators that can be non-zero for this car and trace; the others are zero by construction, and every
 // quadrature costs vector arithmetic in each CVODES step.
 std::vector<int> active_accumulators_for(const VehicleModel& m, const DriveCycle& c, bool unmet_demand) {
-  const bool electric = m.powertrain->is_electric();
+  const bool battery = m.powertrain->battery() != nullptr;
+  const bool fuel = m.powertrain->fuel() != nullptr;
   const bool graded = std::any_of(c.grade.begin(), c.grade.end(), [](double g) { return g != 0.0; });
   const bool effects = !m.effects.empty();
   std::vector<int> active;
@@ -213,8 +204,8 @@ std::vector<int> active_accumulators_for(const VehicleModel& m, const DriveCycle
     const bool needed = k == kGrade                              ? graded
                         : (k == kOther || k == kWheelLoss)       ? effects
                         : k == kUnmet                            ? unmet_demand
-                        : (k == kRegen || k == kMotor || k == kBatteryLoss || k == kTerminal) ? electric
-                        : (k == kFuelEnergy || k == kEngineLoss || k == kClutch || k == kFuelVolume) ? !electric || effects
+                        : (k == kRegen || k == kMotor || k == kBatteryLoss || k == kTerminal) ? battery
+                        : (k == kFuelEnergy || k == kEngineLoss || k == kClutch || k == kFuelVolume) ? fuel || effects
                         : true;
     if (needed) active.push_back(k);
   }
@@ -243,36 +234,24 @@ EnergyBreakdown breakdown_from(const double* acc) {
   return e;
 }
 
-double fuel_mass_per_volume(const VehicleModel& m) {
-  if (const auto* c = dynamic_cast<const CombustionPowertrain*>(m.powertrain.get())) return c->params().fuel.density_kg_per_m3;
-  return 0.0;
-}
-double co2_per_fuel_mass(const VehicleModel& m) {
-  if (const auto* c = dynamic_cast<const CombustionPowertrain*>(m.powertrain.get())) return c->params().fuel.co2_kg_per_kg;
-  return 0.0;
-}
-double initial_soc(const VehicleModel& m) {
-  if (const auto* e = dynamic_cast<const ElectricPowertrain*>(m.powertrain.get())) return e->params().battery.initial_soc;
-  return 0.0;
-}
-
 void finish_result(const VehicleModel& m, const DriveCycle& c, double distance_m, const double* acc, double v_start,
                    double v_end, SimulationResult& r) {
   r.vehicle = m.name;
   r.road_load = m.road_load_description;
   r.cycle = c.name;
-  r.electric = m.powertrain->is_electric();
   r.duration_s = c.duration_s();
   r.distance_m = distance_m;
   r.energy = breakdown_from(acc);
   r.energy.kinetic_change_j = 0.5 * m.inertial_mass_kg() * (v_end * v_end - v_start * v_start);
-  r.fuel_volume_m3 = acc[kFuelVolume];
-  r.co2_kg = r.fuel_volume_m3 * fuel_mass_per_volume(m) * co2_per_fuel_mass(m);
-  r.usable_battery_j = m.powertrain->usable_battery_energy_j();
-  r.initial_soc = initial_soc(m);
-  r.final_soc = r.usable_battery_j > 0.0
-                    ? r.initial_soc - (r.energy.battery_terminal_j + r.energy.battery_loss_j) / r.usable_battery_j
-                    : 0.0;
+  if (const FuelParams* f = m.powertrain->fuel()) {
+    r.fuel = FuelFigures{acc[kFuelVolume], acc[kFuelVolume] * f->density_kg_per_m3 * f->co2_kg_per_kg};
+  }
+  if (const BatteryParams* b = m.powertrain->battery()) {
+    const double final_soc = b->usable_capacity_j > 0.0
+                                 ? b->initial_soc - (r.energy.battery_terminal_j + r.energy.battery_loss_j) / b->usable_capacity_j
+                                 : 0.0;
+    r.battery = BatteryFigures{b->usable_capacity_j, b->initial_soc, final_soc};
+  }
 }
 
 TracePoint trace_point(const VehicleModel& m, double t, double target_mps, double v, double a, double grade,
@@ -292,6 +271,9 @@ TracePoint trace_point(const VehicleModel& m, double t, double target_mps, doubl
   p.battery_current_a = s.flow.battery_current_a;
   p.battery_loss_w = s.flow.battery_loss_w;
   p.fuel_rate_m3_per_s = s.flow.fuel_rate_m3_per_s;
+  p.segment_battery_power_w = p.battery_power_w;
+  p.segment_battery_loss_w = p.battery_loss_w;
+  p.segment_fuel_rate_m3_per_s = p.fuel_rate_m3_per_s;
   const double normal_n = m.mass_kg * units::kStandardGravity_mps2 / std::sqrt(1.0 + grade * grade);
   p.rrc = s.rolling_n / normal_n;
   p.soc = soc;
@@ -307,9 +289,39 @@ class ForwardSystem final : public OdeSystem {
     standstill_.resize(c.time_s.size(), false);
     for (std::size_t i = 0; i + 1 < c.time_s.size(); ++i) standstill_[i] = c.speed_mps[i] == 0.0 && c.speed_mps[i + 1] == 0.0;
     active_ = active_accumulators_for(m, c, false);  // the forward car falls behind instead of leaving demand unmet
+    aux_power_w_ = m.powertrain->deliver(0.0, 0.0, m.powertrain->select_gear(0.0, 1), m.wheel_radius_m).aux_power_w;
   }
   bool standstill_segment(double t) const { return standstill_[c_.segment_index(t, hint_)]; }
+
+  /// The energy the trace moves at the wheels over [t0, t1] [J]: the kinetic energy it swings through, the road
+  /// load's work at the trace's speed, and the auxiliaries' draw. Every energy flow of the interval is bounded by
+  /// a few times it, so it is the scale against which that interval's quadratures are judged.
+  double energy_scale_j(double t0, double t1) const {
+    double scale_j = aux_power_w_ * (t1 - t0);
+    for (std::size_t i = c_.segment_index(t0, hint_); i + 1 < c_.time_s.size() && c_.time_s[i] < t1; ++i) {
+      const double a = std::max(t0, c_.time_s[i]), b = std::min(t1, c_.time_s[i + 1]);
+      if (!(b > a)) continue;
+      const double slope = (c_.speed_mps[i + 1] - c_.speed_mps[i]) / (c_.time_s[i + 1] - c_.time_s[i]);
+      const double va = c_.speed_mps[i] + slope * (a - c_.time_s[i]), vb = c_.speed_mps[i] + slope * (b - c_.time_s[i]);
+      const double v_mid = 0.5 * (va + vb);
+      const double road_n = loads_[i].rolling_n(v_mid) + loads_[i].aero_n(v_mid) +
+                            std::abs(grade_force_n(m_.mass_kg, c_.grade.empty() ? 0.0 : c_.grade[i]));
+      scale_j += 0.5 * m_.inertial_mass_kg() * std::abs(vb * vb - va * va) + road_n * v_mid * (b - a);
+    }
+    return scale_j;
+  }
   int size() const override { return kBaseStates + eval_.effect_states; }
+  std::string state_name(int i) const override {
+    if (i == kSpeed) return "speed";
+    if (i == kDistance) return "distance";
+    if (i == kDriverIntegral) return "driver integral";
+    for (std::size_t k = m_.effects.size(); k-- > 0;) {
+      if (i >= kBaseStates + eval_.effect_state_offset[k]) {
+        return m_.effects[k]->id() + " state " + std::to_string(i - kBaseStates - eval_.effect_state_offset[k]);
+      }
+    }
+    return OdeSystem::state_name(i);
+  }
   int num_quadratures() const override { return static_cast<int>(active_.size()); }
   int quadrature_rhs(double t, const double* y, double* qdot) override {
     Instant s;
@@ -451,14 +463,22 @@ class ForwardSystem final : public OdeSystem {
   SegmentRoadLoads loads_;
   std::vector<bool> standstill_;
   std::vector<int> active_;
-  std::size_t hint_ = 0;
+  mutable std::size_t hint_ = 0;
+  double aux_power_w_ = 0.0;
   double window_end_ = 1e300;
   double shifts_up_ = -1.0, shifts_down_ = -1.0;
 };
 
 double soc_of(const VehicleModel& m, const double* acc) {
-  const double cap = m.powertrain->usable_battery_energy_j();
-  return cap > 0.0 ? initial_soc(m) - (acc[kTerminal] + acc[kBatteryLoss]) / cap : 0.0;
+  const BatteryParams* b = m.powertrain->battery();
+  return b && b->usable_capacity_j > 0.0 ? b->initial_soc - (acc[kTerminal] + acc[kBatteryLoss]) / b->usable_capacity_j : 0.0;
+}
+
+// The most chemical power the battery can give [W]: Voc^2 / 4R at its terminals plus as much again in I^2 R,
+// doubled for effects' extra losses; infinite without internal resistance. No step can empty the battery faster.
+double max_battery_drain_w(const BatteryParams& b) {
+  const double voc = b.open_circuit_voltage_v;
+  return b.internal_resistance_ohm > 0.0 ? voc * voc / b.internal_resistance_ohm : std::numeric_limits<double>::infinity();
 }
 
 }  // namespace
@@ -484,20 +504,27 @@ SimulationResult simulate_forward(const VehicleModel& m, const DriveCycle& c, co
 
   OdeTolerances tol;
   tol.relative = opt.relative_tolerance;
-  tol.absolute.assign(n, 1e-4);  // effects' hidden states (temperatures [K], ...)
-  tol.absolute[kSpeed] = 1e-4;
-  tol.absolute[kDistance] = 1e-2;
-  tol.absolute[kDriverIntegral] = 1e-3;
+  // Absolute tolerances at the default relative tolerance (1e-5), scaled with it, so that a tighter run (the
+  // self-convergence reference) is tighter in every component.
+  const double scale = opt.relative_tolerance / 1e-5;
+  tol.absolute.assign(n, 1e-4 * scale);  // effects' hidden states (temperatures [K], ...)
+  tol.absolute[kSpeed] = 1e-4 * scale;
+  tol.absolute[kDistance] = 1e-2 * scale;
+  tol.absolute[kDriverIntegral] = 1e-3 * scale;
   tol.quadrature_relative = opt.relative_tolerance;
   const auto& active = sys.active_accumulators();
-  // Energies [J] per restart interval (the quadratures restart there, so errors do not compound in the totals).
-  // Measured: 10 J closes the wheel balance to <= 2e-4 on NEDC, WLTC, UDDS and US06 in 920 steps on NEDC;
-  // 1 J to 1e-5 in 1120 steps; 0.1 J to 1e-6 in 1380 steps.
-  constexpr double kEnergyAbsTol_j = 10.0;
-  tol.quadrature_absolute.assign(active.size(), kEnergyAbsTol_j);
-  for (std::size_t k = 0; k < active.size(); ++k) {
-    if (active[k] == kFuelVolume) tol.quadrature_absolute[k] = 1e-9;
-  }
+  // Energies [J] per restart interval (the quadratures restart there, so errors do not compound in the totals):
+  // each interval's absolute tolerance is a fixed fraction of the energy the trace moves in it (energy_scale_j),
+  // so the errors summed over the run are that fraction of the energy the whole run moves, on any cycle. A
+  // fixed 10 J per interval left the balance at 0.013-0.047 % on the stop-and-go cycles, whose many short
+  // intervals each carry little energy. Fuel volume [m^3] has its own 1 ml, well below a cycle's fuel.
+  auto quadrature_tolerances = [&](double t_from, double t_to) {
+    std::vector<double> atol(active.size(), opt.quadrature_energy_fraction * sys.energy_scale_j(t_from, t_to));
+    for (std::size_t k = 0; k < active.size(); ++k) {
+      if (active[k] == kFuelVolume) atol[k] = 1e-9;
+    }
+    return atol;
+  };
   const std::vector<double> q0(active.size(), 0.0);
   auto all_accumulators = [&](const std::vector<double>& q) {
     std::array<double, kAccumulators> acc{};
@@ -507,9 +534,18 @@ SimulationResult simulate_forward(const VehicleModel& m, const DriveCycle& c, co
 
   const double t0 = c.time_s.front();
   const double t_end = c.time_s.back();
-  CvodeIntegrator integ(sys, t0, y0, q0, tol);
   std::vector<double> stops = breakpoints_s(c);
   stops.push_back(t_end);
+  auto stop_after = [&](double t) {
+    const auto it = std::upper_bound(stops.begin(), stops.end(), t);
+    return it == stops.end() ? t_end : *it;
+  };
+  tol.quadrature_absolute = quadrature_tolerances(t0, stop_after(t0));
+  CvodeIntegrator integ(sys, t0, y0, q0, tol);
+  auto restart = [&](double t, const std::vector<double>& y) {
+    integ.restart(t, y);
+    integ.set_quadrature_absolute_tolerances(quadrature_tolerances(t, stop_after(t)));
+  };
 
   SimulationResult r;
   r.mode = "forward";
@@ -517,6 +553,7 @@ SimulationResult simulate_forward(const VehicleModel& m, const DriveCycle& c, co
   std::size_t record_hint = 0;
   Shortfall open{};
   bool in_shortfall = false;
+  double standstill_brake_j = 0.0;  // kinetic energy braked away where a standstill segment starts
   auto record = [&](double t, const std::vector<double>& y) {
     const double target = c.speed_mps_at(t, record_hint);
     const double err = target - y[kSpeed];
@@ -546,12 +583,37 @@ SimulationResult simulate_forward(const VehicleModel& m, const DriveCycle& c, co
   };
   if (opt.record_trace) record(t0, y0);
 
+  // Where the usable battery runs empty. Until the charge left could be drained at the battery's greatest power,
+  // no step can empty it, so the quadratures are read only from then on; the crossing is then located within
+  // the step on CVODES' dense output.
+  const BatteryParams* battery = m.powertrain->battery();
+  const double capacity_j = battery ? battery->usable_capacity_j : 0.0;
+  const double drain_w = battery ? max_battery_drain_w(*battery) : 0.0;
+  auto charge_left_j = [&](const std::vector<double>& q) { return soc_of(m, all_accumulators(q).data()) * capacity_j; };
+  double check_battery_from_s = capacity_j > 0.0 ? t0 + charge_left_j(q0) / drain_w : 1e300;
+  auto watch_battery = [&](double t_before, double t_after) {
+    if (r.battery_empty || t_after < check_battery_from_s) return;
+    const double left_j = charge_left_j(integ.quadratures());
+    if (left_j > 0.0) {
+      check_battery_from_s = t_after + left_j / drain_w;
+      return;
+    }
+    double lo = t_before, hi = t_after;
+    for (int k = 0; k < 60 && hi - lo > 1e-6; ++k) {
+      const double mid = 0.5 * (lo + hi);
+      (charge_left_j(integ.quadratures_at(mid)) > 0.0 ? lo : hi) = mid;
+    }
+    r.battery_empty = BatteryDepletion{hi, integ.state_at(hi)[kDistance]};
+  };
+
   while (integ.time() < t_end) {
     while (next_stop < stops.size() && stops[next_stop] <= integ.time()) ++next_stop;
     const double t_stop = stops[next_stop];
     sys.set_window_end(t_stop);
+    const double t_before = integ.time();
     const bool root = integ.step(t_stop);
     const double t = integ.time();
+    watch_battery(t_before, t);
     // Trace samples this step passed: read from the interpolating polynomial, no extra solver work.
     while (next_sample < c.time_s.size() && c.time_s[next_sample] <= t) {
       const double ts = c.time_s[next_sample];
@@ -574,11 +636,14 @@ SimulationResult simulate_forward(const VehicleModel& m, const DriveCycle& c, co
         engaged = sys.gear + 1;
       }
       sys.set_gears(scheduled, engaged);
-      integ.restart(t, integ.state());
+      restart(t, integ.state());
     } else if (t >= t_stop && t < t_end) {
       std::vector<double> y = integ.state();
       if (sys.standstill_segment(t)) {
-        y[kSpeed] = 0.0;  // stopped and braked: the driver releases the pedal
+        // Stopped and braked: the driver holds the car on its brakes. Whatever speed is left (the integration's
+        // error, or a car the trace left running) is braked away by friction, and booked so the balance closes.
+        standstill_brake_j += 0.5 * m.inertial_mass_kg() * y[kSpeed] * y[kSpeed];
+        y[kSpeed] = 0.0;
         y[kDriverIntegral] = 0.0;
       }
       // The demand jumps at a kink of the trace: choose the gear for the segment that starts here.
@@ -587,13 +652,14 @@ SimulationResult simulate_forward(const VehicleModel& m, const DriveCycle& c, co
         const int scheduled = m.powertrain->select_gear(y[kSpeed], sys.scheduled_gear());
         sys.set_gears(scheduled, sys.kickdown_gear(scheduled, y[kSpeed], sys.force_request(t, y.data())));
       }
-      integ.restart(t, y);
+      restart(t, y);
     }
   }
   if (in_shortfall) r.shortfalls.push_back(open);
   r.solver = integ.stats();
-  finish_result(m, c, integ.state()[kDistance], all_accumulators(integ.quadratures()).data(), c.speed_mps.front(),
-                integ.state()[kSpeed], r);
+  auto acc = all_accumulators(integ.quadratures());
+  acc[kFriction] += standstill_brake_j;
+  finish_result(m, c, integ.state()[kDistance], acc.data(), c.speed_mps.front(), integ.state()[kSpeed], r);
   return r;
 }
 
@@ -707,10 +773,25 @@ SimulationResult simulate_replay(const VehicleModel& m, const DriveCycle& c, con
     }
   };
   // A run of identical cruise seconds is booked once, when it ends: its powers do not change.
-  double cruise_pending_s = 0.0;
+  // Where the usable battery runs empty: the state of charge is linear in time over a cruise and nearly so over
+  // a ramp of a second or two, so the crossing is interpolated within the span just booked.
+  const BatteryParams* battery = m.powertrain->battery();
+  const double capacity_j = battery ? battery->usable_capacity_j : 0.0, soc0 = battery ? battery->initial_soc : 0.0;
+  auto soc_now = [&] { return capacity_j > 0.0 ? soc0 - (acc[kTerminal] + acc[kBatteryLoss]) / capacity_j : 0.0; };
+  auto watch_battery = [&](double soc_before, double t_a, double t_b, double d_a, double d_b) {
+    if (!(capacity_j > 0.0) || r.battery_empty) return;
+    const double soc_after = soc_now();
+    if (soc_after > 0.0) return;
+    const double f = soc_before > 0.0 ? soc_before / (soc_before - soc_after) : 0.0;
+    r.battery_empty = BatteryDepletion{t_a + f * (t_b - t_a), d_a + f * (d_b - d_a)};
+  };
+  double cruise_pending_s = 0.0, cruise_start_s = 0.0, cruise_start_m = 0.0, cruise_speed_mps = 0.0;
   auto book_cruise = [&] {
     if (cruise_pending_s == 0.0) return;
+    const double soc_before = soc_now();
     for (int j = 0; j < kAccumulators; ++j) acc[j] += cruise_pending_s * cruise_rate[j];
+    watch_battery(soc_before, cruise_start_s, cruise_start_s + cruise_pending_s, cruise_start_m,
+                  cruise_start_m + cruise_speed_mps * cruise_pending_s);
     cruise_pending_s = 0.0;
   };
 
@@ -722,6 +803,8 @@ SimulationResult simulate_replay(const VehicleModel& m, const DriveCycle& c, con
     const double grade = c.grade.empty() ? 0.0 : c.grade[i];
     const RoadLoadCoeffs& rl = loads[i];
     bool segment_limited = false;
+    double soc_before_ramp = 0.0;
+    std::array<double, kAccumulators> segment_energy_j{};  // a ramp's integral (for the trace)
     if (opt.record_trace) {
       const int g = gear;
       evaluate_at(t0, v0, a, grade, rl, distance_m);
@@ -740,14 +823,21 @@ SimulationResult simulate_replay(const VehicleModel& m, const DriveCycle& c, con
         cruise_valid = true;
         xdot_sum = xdot;
       }
+      if (cruise_pending_s == 0.0) {
+        cruise_start_s = t0;
+        cruise_start_m = distance_m;
+        cruise_speed_mps = v0;
+      }
       cruise_pending_s += dt;
       segment_limited = cruise_limited;
     } else {
       book_cruise();
       cruise_valid = false;
+      soc_before_ramp = soc_now();
       const SegmentKey key{v0, c.speed_mps[i + 1], dt, grade, scheduled_gear};
       if (const SegmentEnergy* hit = stateless ? seen.find(key) : nullptr) {
         for (int j = 0; j < kAccumulators; ++j) acc[j] += hit->energy_j[j];
+        segment_energy_j = hit->energy_j;
         segment_limited = hit->limited;
         scheduled_gear = hit->scheduled_gear_after;
       } else {
@@ -761,12 +851,22 @@ SimulationResult simulate_replay(const VehicleModel& m, const DriveCycle& c, con
           for (int j = 0; j < eval.effect_states; ++j) xdot_sum[j] += kWeight[k] * xdot[j];
         }
         for (int j = 0; j < kAccumulators; ++j) acc[j] += e.energy_j[j];
+        segment_energy_j = e.energy_j;
         if (stateless) {
           e.limited = segment_limited;
           e.scheduled_gear_after = scheduled_gear;
           seen.insert(key, e);
         }
       }
+    }
+    if (a != 0.0) watch_battery(soc_before_ramp, t0, t0 + dt, distance_m, distance_m + (v0 + c.speed_mps[i + 1]) / 2.0 * dt);
+    if (opt.record_trace) {
+      // The segment's integrated powers (a cruise is evaluated per segment when recording, so `rate` is its own).
+      const auto seg = [&](int j) { return a == 0.0 ? cruise_rate[j] : segment_energy_j[j] / dt; };
+      TracePoint& p = r.trace.back();
+      p.segment_battery_power_w = seg(kTerminal);
+      p.segment_battery_loss_w = seg(kBatteryLoss);
+      p.segment_fuel_rate_m3_per_s = seg(kFuelVolume);
     }
     // Hidden effect states advance with the segment-mean rate (time constants are minutes, segments seconds).
     for (int j = 0; j < eval.effect_states; ++j) x[j] += dt * xdot_sum[j];

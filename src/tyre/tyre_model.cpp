@@ -6,6 +6,7 @@
 #include <string>
 
 #include "rollsim/common/error.hpp"
+#include "rollsim/tyre/hysteresis_model.hpp"
 
 namespace rollsim {
 namespace {
@@ -86,6 +87,7 @@ void check_operating_point(const TyreState& tyre, double load_n, double speed_mp
     throw ModelDomainError("element count " + std::to_string(c.elements) + ": must be an even number >= 2");
   if (!(c.viscous_damping_ns_per_m >= 0.0) || !(c.coulomb_damping_n >= 0.0) || !(c.rotational_drag_kg_per_m2 >= 0.0))
     throw ModelDomainError("damping and drag constants must be >= 0");
+  if (tyre.model == TyreModelKind::Hysteresis) check_hysteresis_constants(tyre.hysteresis);
   const double kz = vertical_stiffness_n_per_m(tyre);
   if (!(kz > 0.0) || !std::isfinite(kz)) throw ModelDomainError("vertical stiffness " + v(kz) + " N/m: must be > 0");
   const double deflection_m = load_n / kz;
@@ -98,8 +100,35 @@ void check_operating_point(const TyreState& tyre, double load_n, double speed_mp
   }
 }
 
+namespace {
+
+RollingResistance evaluate_hysteresis(const TyreState& tyre, double load_n, double speed_mps) {
+  const Patch p = loaded_patch(tyre, load_n);
+  const SpeedPolynomial k = hysteresis_polynomial(tyre, load_n);
+  const double r = tyre.geometry.outer_radius_m;
+  RollingResistance out;
+  out.stiffness_n_per_m = p.stiffness_n_per_m;
+  out.deflection_m = p.deflection_m;
+  out.loaded_radius_m = p.loaded_radius_m;
+  out.half_angle_rad = p.half_angle_rad;
+  out.contact_length_m = 2.0 * r * std::sin(p.half_angle_rad);
+  if (speed_mps > 0.0) {  // standstill: no rolling loss, as in the thesis model
+    out.rrc_coulomb = k.k0;
+    out.rrc_viscous = k.k1_s_per_m * speed_mps;
+    out.rrc_rotational_drag = k.k2_s2_per_m2 * speed_mps * speed_mps;
+  }
+  out.rrc = out.rrc_coulomb + out.rrc_viscous + out.rrc_rotational_drag;
+  out.offset_e_m = out.rrc * r;
+  out.rr_force_n = out.rrc * load_n;
+  out.rr_power_w = out.rr_force_n * speed_mps;
+  return out;
+}
+
+}  // namespace
+
 RollingResistance evaluate_rolling_resistance(const TyreState& tyre, double load_n, double speed_mps) {
   check_operating_point(tyre, load_n, speed_mps);
+  if (tyre.model == TyreModelKind::Hysteresis) return evaluate_hysteresis(tyre, load_n, speed_mps);
   const Patch p = loaded_patch(tyre, load_n);
   const auto& c = tyre.constants;
   const double r = tyre.geometry.outer_radius_m;
@@ -144,6 +173,15 @@ RollingResistance evaluate_rolling_resistance(const TyreState& tyre, double load
 
 TyreAtLoad TyreAtLoad::prepare(const TyreState& tyre, double load_n) {
   check_operating_point(tyre, load_n, 0.0);
+  if (tyre.model == TyreModelKind::Hysteresis) {
+    const SpeedPolynomial k = hysteresis_polynomial(tyre, load_n);
+    TyreAtLoad t;
+    t.k0_ = k.k0;
+    t.k1_s_per_m_ = k.k1_s_per_m;
+    t.k2_s2_per_m2_ = k.k2_s2_per_m2;
+    t.load_n_ = load_n;
+    return t;
+  }
   const Patch p = loaded_patch(tyre, load_n);
   const auto& c = tyre.constants;
   const double r = tyre.geometry.outer_radius_m;

@@ -124,6 +124,73 @@ void reject_unknown_keys(const YamlMap& y, std::initializer_list<const char*> al
   }
 }
 
+TyreModelKind model_kind(const std::string& text, const std::string& where) {
+  if (text == "thesis") return TyreModelKind::Thesis;
+  if (text == "hysteresis") return TyreModelKind::Hysteresis;
+  throw InputError(where, "'" + text + "' is not a model: allowed thesis (the default), hysteresis");
+}
+
+// The `model` mapping: `kind` and the constants of that kind. Rhyne's stiffness constants serve both kinds
+// (the hysteresis model scales its loss with the deflection they give).
+void read_model_map(YamlMap& m, TyreState& state) {
+  const char* kThesisOnly[] = {"viscous_damping_ns_per_m", "coulomb_damping_n", "rotational_drag_kg_per_m2", "elements"};
+  const char* kHysteresisOnly[] = {"reference_pressure_bar", "reference_load_n", "rrc_ref", "deflection_exponent",
+                                   "load_exponent", "frequency_slope_per_hz", "speed_loss_rrc_per_hz2",
+                                   "speed_loss_load_exponent"};
+  reject_unknown_keys(m, {"kind", "viscous_damping_ns_per_m", "coulomb_damping_n", "rotational_drag_kg_per_m2",
+                          "stiffness_pressure_coeff", "stiffness_offset_kgf_per_mm", "elements",
+                          "reference_pressure_bar", "reference_load_n", "rrc_ref", "deflection_exponent",
+                          "load_exponent", "frequency_slope_per_hz", "speed_loss_rrc_per_hz2",
+                          "speed_loss_load_exponent"});
+  if (auto kind = opt_string(m, "kind")) state.model = model_kind(*kind, m.where("kind"));
+  const bool thesis = state.model == TyreModelKind::Thesis;
+  auto reject_other_kind = [&](const char* k) {
+    if (m.has(k)) {
+      throw InputError(m.where(k), std::string("only for kind ") + (thesis ? "hysteresis" : "thesis") +
+                                       "; this model is " + (thesis ? "thesis (the default)" : "hysteresis"));
+    }
+  };
+  if (thesis) {
+    for (const char* k : kHysteresisOnly) reject_other_kind(k);
+  } else {
+    for (const char* k : kThesisOnly) reject_other_kind(k);
+  }
+  auto& k = state.constants;
+  k.stiffness_pressure_coeff = opt_number(m, "stiffness_pressure_coeff", Range::positive()).value_or(k.stiffness_pressure_coeff);
+  k.stiffness_offset_kgf_per_mm =
+      opt_number(m, "stiffness_offset_kgf_per_mm", Range::non_negative()).value_or(k.stiffness_offset_kgf_per_mm);
+  if (thesis) {
+    k.viscous_damping_ns_per_m = opt_number(m, "viscous_damping_ns_per_m", Range::non_negative()).value_or(k.viscous_damping_ns_per_m);
+    k.coulomb_damping_n = opt_number(m, "coulomb_damping_n", Range::non_negative()).value_or(k.coulomb_damping_n);
+    k.rotational_drag_kg_per_m2 =
+        opt_number(m, "rotational_drag_kg_per_m2", Range::non_negative()).value_or(k.rotational_drag_kg_per_m2);
+    if (auto n = opt_number(m, "elements", Range::closed(2, 1e6))) {
+      if (*n != std::floor(*n) || static_cast<long>(*n) % 2 != 0) {
+        throw InputError(m.where("elements"), format_value(*n) + " is not allowed: must be an even whole number >= 2");
+      }
+      k.elements = static_cast<int>(*n);
+    }
+  } else {
+    auto& h = state.hysteresis;
+    if (!m.has("rrc_ref")) {
+      throw InputError(m.where("rrc_ref"), "required key is missing for kind hysteresis (the tyre's RRC level at the "
+                                           "reference point; 'rollsim tyre fit' writes it)");
+    }
+    h.rrc_ref = m.number("rrc_ref", Range::closed(0.001, 0.05));
+    h.reference_pressure_pa =
+        units::bar_to_pa(opt_number(m, "reference_pressure_bar", Range::closed(0.5, 6.0)).value_or(units::pa_to_bar(h.reference_pressure_pa)));
+    h.reference_load_n = opt_number(m, "reference_load_n", Range::open_low(0.0, 1e5)).value_or(h.reference_load_n);
+    h.deflection_exponent = opt_number(m, "deflection_exponent", Range::closed(-5, 5)).value_or(h.deflection_exponent);
+    h.load_exponent = opt_number(m, "load_exponent", Range::closed(-5, 5)).value_or(h.load_exponent);
+    h.frequency_slope_per_hz = opt_number(m, "frequency_slope_per_hz", Range::closed(0, 1)).value_or(h.frequency_slope_per_hz);
+    h.speed_loss_rrc_per_hz2 =
+        opt_number(m, "speed_loss_rrc_per_hz2", Range::closed(0, 1e-3)).value_or(h.speed_loss_rrc_per_hz2);
+    h.speed_loss_load_exponent =
+        opt_number(m, "speed_loss_load_exponent", Range::closed(-5, 5)).value_or(h.speed_loss_load_exponent);
+  }
+  m.finish();
+}
+
 const char* kFormat =
     "expected a size designation like '205/55 R16 91V' ([P|LT]width/aspect [Z]R rim [load index][speed symbol] "
     "[XL|Reinforced])";
@@ -164,6 +231,7 @@ TyreSize parse_tyre_size(const std::string& designation, const std::string& wher
   c.skip_spaces();
   const std::string rim = c.number();
   if (rim.empty()) return fail("missing rim diameter in inches");
+  if (rim.size() > 5) return fail("rim diameter " + rim.substr(0, 8) + "... in is outside 8..30 in");
 
   out.section_width_m = std::stod(width) * units::kMPerMm;
   out.aspect_ratio = std::stod(aspect) / 100.0;
@@ -283,24 +351,15 @@ TyreSpec load_tyre_file(const std::string& path) {
     spec.max_load_n = *load_index_max_load_kg(*spec.size->load_index) * units::kStandardGravity_mps2;
   }
 
-  if (auto m = opt_map(y, "model")) {
-    reject_unknown_keys(*m, {"viscous_damping_ns_per_m", "coulomb_damping_n", "rotational_drag_kg_per_m2",
-                             "stiffness_pressure_coeff", "stiffness_offset_kgf_per_mm", "elements"});
-    auto& k = spec.state.constants;
-    k.viscous_damping_ns_per_m = opt_number(*m, "viscous_damping_ns_per_m", Range::non_negative()).value_or(k.viscous_damping_ns_per_m);
-    k.coulomb_damping_n = opt_number(*m, "coulomb_damping_n", Range::non_negative()).value_or(k.coulomb_damping_n);
-    k.rotational_drag_kg_per_m2 =
-        opt_number(*m, "rotational_drag_kg_per_m2", Range::non_negative()).value_or(k.rotational_drag_kg_per_m2);
-    k.stiffness_pressure_coeff = opt_number(*m, "stiffness_pressure_coeff", Range::positive()).value_or(k.stiffness_pressure_coeff);
-    k.stiffness_offset_kgf_per_mm =
-        opt_number(*m, "stiffness_offset_kgf_per_mm", Range::non_negative()).value_or(k.stiffness_offset_kgf_per_mm);
-    if (auto n = opt_number(*m, "elements", Range::closed(2, 1e6))) {
-      if (*n != std::floor(*n) || static_cast<long>(*n) % 2 != 0) {
-        throw InputError(m->where("elements"), format_value(*n) + " is not allowed: must be an even whole number >= 2");
-      }
-      k.elements = static_cast<int>(*n);
+  if (y.has("model") && y.node()["model"].IsScalar()) {
+    spec.state.model = model_kind(y.string("model"), y.where("model"));
+    if (spec.state.model == TyreModelKind::Hysteresis) {
+      throw InputError(y.where("model"), "kind hysteresis needs the tyre's constants, at least its level: write "
+                                         "'model:' as a mapping with 'kind: hysteresis' and 'rrc_ref' ('rollsim tyre "
+                                         "fit' writes such files)");
     }
-    m->finish();
+  } else if (auto m = opt_map(y, "model")) {
+    read_model_map(*m, spec.state);
   }
   y.finish();
   return spec;

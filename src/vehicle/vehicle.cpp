@@ -9,6 +9,7 @@
 #include "rollsim/common/units.hpp"
 #include "rollsim/common/yaml_reader.hpp"
 #include "rollsim/tyre/tyre_model.hpp"
+#include "rollsim/vehicle/vehicle_file.hpp"
 
 namespace rollsim {
 namespace {
@@ -17,22 +18,13 @@ constexpr double kRadPerSPerRpm = 2.0 * std::numbers::pi / 60.0;
 
 // A tyre named in a vehicle file: relative to the vehicle file first, then the shipped tyres/ folder.
 TyreSpec load_tyre_named(const std::string& name, const YamlMap& m, const std::string& key) {
-  namespace fs = std::filesystem;
-  const fs::path beside = fs::path(m.file()).parent_path() / name;
-  for (const fs::path& p : {beside, fs::path(beside.string() + ".yaml")}) {
-    if (fs::is_regular_file(p)) return load_tyre_file(p.string());
-  }
-  try {
-    return load_tyre_file(resolve_data_file(name, "tyres", ".yaml", m.where(key)));
-  } catch (const InputError&) {
-    throw InputError(m.where(key), "tyre file '" + name + "' not found beside the vehicle file or in the shipped tyres/");
-  }
+  return load_tyre_file(resolve_tyre_path(name, m.file(), m.where(key)));
 }
 
 BodyParams read_body(YamlMap m) {
   BodyParams b;
-  b.test_mass_kg = m.number("test_mass_kg", Range::positive());
-  b.rotating_mass_kg = m.number_or("rotating_mass_kg", 0.0, Range::non_negative());
+  b.test_mass_kg = m.number("test_mass_kg", Range::open_low(0.0, 1e5));
+  b.rotating_mass_kg = m.number_or("rotating_mass_kg", 0.0, Range::closed(0.0, b.test_mass_kg));
   b.drag_coefficient = m.number("drag_coefficient", Range::open_low(0.0, 2.0));
   b.frontal_area_m2 = m.number("frontal_area_m2", Range::open_low(0.0, 20.0));
   b.air_density_kg_per_m3 = m.number_or("air_density_kg_per_m3", 1.2, Range::open_low(0.0, 2.0));
@@ -58,13 +50,13 @@ CoastdownParams read_coastdown(YamlMap m) {
   if (us) {
     constexpr double kNPerLbf = 4.4482216152605;
     constexpr double kMpsPerMph = units::kMPerMile / 3600.0;
-    c.a_n = m.number("a_lbf", Range::non_negative()) * kNPerLbf;
+    c.a_n = m.number("a_lbf", Range::closed(0.0, 1e4)) * kNPerLbf;
     c.b_n_s_per_m = m.number("b_lbf_per_mph", Range::closed(-50.0, 50.0)) * kNPerLbf / kMpsPerMph;
-    c.c_n_s2_per_m2 = m.number("c_lbf_per_mph2", Range::non_negative()) * kNPerLbf / (kMpsPerMph * kMpsPerMph);
+    c.c_n_s2_per_m2 = m.number("c_lbf_per_mph2", Range::closed(0.0, 10.0)) * kNPerLbf / (kMpsPerMph * kMpsPerMph);
   } else {
-    c.a_n = m.number("a_n", Range::non_negative());
+    c.a_n = m.number("a_n", Range::closed(0.0, 5e4));
     c.b_n_s_per_m = m.number("b_n_per_kmh", Range::closed(-50.0, 50.0)) * 3.6;
-    c.c_n_s2_per_m2 = m.number("c_n_per_kmh2", Range::non_negative()) * 3.6 * 3.6;
+    c.c_n_s2_per_m2 = m.number("c_n_per_kmh2", Range::closed(0.0, 1.0)) * 3.6 * 3.6;
   }
   m.finish();
   return c;
@@ -74,40 +66,41 @@ ElectricPowertrainParams read_electric(YamlMap& pt) {
   ElectricPowertrainParams p;
   {
     YamlMap m = pt.map("motor");
-    p.motor.max_torque_nm = m.number("max_torque_nm", Range::positive());
-    p.motor.max_power_w = m.number("max_power_kw", Range::positive()) * 1e3;
-    p.motor.max_speed_radps = m.number("max_speed_rpm", Range::positive()) * kRadPerSPerRpm;
-    p.motor.losses.copper_w_per_nm2 = m.number("copper_loss_w_per_nm2", Range::non_negative());
-    p.motor.losses.iron_w_s_per_rad = m.number("iron_loss_w_per_radps", Range::non_negative());
-    p.motor.losses.windage_w_s3_per_rad3 = m.number_or("windage_loss_w_per_radps3", 0.0, Range::non_negative());
-    p.motor.losses.constant_w = m.number_or("constant_loss_w", 0.0, Range::non_negative());
+    p.motor.max_torque_nm = m.number("max_torque_nm", Range::open_low(0.0, 1e5));
+    p.motor.max_power_w = m.number("max_power_kw", Range::open_low(0.0, 5000.0)) * 1e3;
+    p.motor.max_speed_radps = m.number("max_speed_rpm", Range::open_low(0.0, 1e5)) * kRadPerSPerRpm;
+    p.motor.speed_limit_band_fraction = m.number_or("speed_limit_band_pct", 3.0, Range::closed(0.0, 50.0)) / 100.0;
+    p.motor.losses.copper_w_per_nm2 = m.number("copper_loss_w_per_nm2", Range::closed(0.0, 100.0));
+    p.motor.losses.iron_w_s_per_rad = m.number("iron_loss_w_per_radps", Range::closed(0.0, 1e4));
+    p.motor.losses.windage_w_s3_per_rad3 = m.number_or("windage_loss_w_per_radps3", 0.0, Range::closed(0.0, 1.0));
+    p.motor.losses.constant_w = m.number_or("constant_loss_w", 0.0, Range::closed(0.0, 1e5));
     m.finish();
   }
   {
     YamlMap m = pt.map("reduction");
-    p.reduction.ratio = m.number("ratio", Range::positive());
+    p.reduction.ratio = m.number("ratio", Range::closed(0.1, 100.0));
     p.reduction.efficiency = m.number("efficiency", Range::efficiency());
     m.finish();
   }
   {
     YamlMap m = pt.map("battery");
-    p.battery.open_circuit_voltage_v = m.number("open_circuit_voltage_v", Range::positive());
-    p.battery.internal_resistance_ohm = m.number("internal_resistance_ohm", Range::non_negative());
-    p.battery.usable_capacity_j = units::kwh_to_j(m.number("usable_capacity_kwh", Range::positive()));
+    p.battery.open_circuit_voltage_v = m.number("open_circuit_voltage_v", Range::open_low(0.0, 2000.0));
+    p.battery.internal_resistance_ohm = m.number("internal_resistance_ohm", Range::closed(0.0, 100.0));
+    p.battery.usable_capacity_j = units::kwh_to_j(m.number("usable_capacity_kwh", Range::open_low(0.0, 1e4)));
     p.battery.initial_soc = m.number_or("initial_soc_pct", 100.0, Range::closed(0.0, 100.0)) / 100.0;
     m.finish();
   }
   {
     YamlMap m = pt.map("regen");
-    p.regen.max_power_w = m.number("max_power_kw", Range::non_negative()) * 1e3;
+    p.regen.max_power_w = m.number("max_power_kw", Range::closed(0.0, 5000.0)) * 1e3;
     p.regen.driven_axle_brake_fraction = m.number("driven_axle_brake_fraction", Range::fraction());
-    p.regen.min_speed_mps = units::kmh_to_mps(m.number_or("min_speed_kmh", 0.0, Range::non_negative()));
-    p.regen.fade_speed_mps = units::kmh_to_mps(m.number_or("fade_speed_kmh", p.regen.min_speed_mps * 3.6, Range::non_negative()));
+    p.regen.min_speed_mps = units::kmh_to_mps(m.number_or("min_speed_kmh", 0.0, Range::closed(0.0, 100.0)));
+    p.regen.fade_speed_mps = units::kmh_to_mps(m.number_or("fade_speed_kmh", p.regen.min_speed_mps * 3.6, Range::closed(0.0, 200.0)));
     if (p.regen.fade_speed_mps < p.regen.min_speed_mps)
       throw InputError(m.where("fade_speed_kmh"), "must be >= min_speed_kmh");
     m.finish();
   }
-  p.aux_power_w = pt.number_or("aux_power_w", 0.0, Range::non_negative());
+  p.aux_power_w = pt.number_or("aux_power_w", 0.0, Range::closed(0.0, 1e5));
   return p;
 }
 
@@ -116,29 +109,29 @@ CombustionPowertrainParams read_combustion(YamlMap& pt) {
   {
     YamlMap m = pt.map("engine");
     auto& e = p.engine;
-    e.displacement_m3 = m.number("displacement_l", Range::positive()) * units::kM3PerLitre;
+    e.displacement_m3 = m.number("displacement_l", Range::open_low(0.0, 100.0)) * units::kM3PerLitre;
     e.indicated_efficiency = m.number("indicated_efficiency", Range::open_low(0.0, 0.6));
-    e.friction_mep_pa = m.number("friction_mep_bar", Range::non_negative()) * units::kPaPerBar;
+    e.friction_mep_pa = m.number("friction_mep_bar", Range::closed(0.0, 20.0)) * units::kPaPerBar;
     e.friction_mep_pa_s_per_rad =
-        m.number_or("friction_mep_bar_per_1000rpm", 0.0, Range::non_negative()) * units::kPaPerBar / (1000.0 * kRadPerSPerRpm);
-    e.idle_speed_radps = m.number("idle_speed_rpm", Range::positive()) * kRadPerSPerRpm;
-    e.max_speed_radps = m.number("max_speed_rpm", Range::positive()) * kRadPerSPerRpm;
-    e.max_torque_nm = m.number("max_torque_nm", Range::positive());
-    e.max_power_w = m.number("max_power_kw", Range::positive()) * 1e3;
+        m.number_or("friction_mep_bar_per_1000rpm", 0.0, Range::closed(0.0, 10.0)) * units::kPaPerBar / (1000.0 * kRadPerSPerRpm);
+    e.idle_speed_radps = m.number("idle_speed_rpm", Range::open_low(0.0, 1e4)) * kRadPerSPerRpm;
+    e.max_speed_radps = m.number("max_speed_rpm", Range::open_low(0.0, 1e5)) * kRadPerSPerRpm;
+    e.max_torque_nm = m.number("max_torque_nm", Range::open_low(0.0, 1e5));
+    e.max_power_w = m.number("max_power_kw", Range::open_low(0.0, 5000.0)) * 1e3;
     e.fuel_cut_min_speed_radps = m.number_or("fuel_cut_min_speed_rpm", 1.2 * e.idle_speed_radps / kRadPerSPerRpm,
-                                             Range::non_negative()) * kRadPerSPerRpm;
+                                             Range::closed(0.0, 1e5)) * kRadPerSPerRpm;
     if (e.max_speed_radps <= e.idle_speed_radps) throw InputError(m.where("max_speed_rpm"), "must exceed idle_speed_rpm");
     m.finish();
   }
   {
     YamlMap m = pt.map("gearbox");
     auto& g = p.gearbox;
-    g.ratios = m.numbers("ratios", Range::positive());
-    g.final_drive_ratio = m.number("final_drive_ratio", Range::positive());
+    g.ratios = m.numbers("ratios", Range::closed(0.1, 100.0));
+    g.final_drive_ratio = m.number("final_drive_ratio", Range::closed(0.1, 100.0));
     g.efficiency = m.number("efficiency", Range::efficiency());
     const std::size_t shifts = g.ratios.size() - 1;
-    auto up = m.numbers("upshift_speeds_kmh", Range::positive(), shifts);
-    auto down = m.numbers("downshift_speeds_kmh", Range::positive(), shifts);
+    auto up = m.numbers("upshift_speeds_kmh", Range::open_low(0.0, 500.0), shifts);
+    auto down = m.numbers("downshift_speeds_kmh", Range::open_low(0.0, 500.0), shifts);
     if (up.size() != shifts || down.size() != shifts)
       throw InputError(m.where("upshift_speeds_kmh"), "needs exactly " + std::to_string(shifts) +
                                                           " values (one per shift) for both up and down shifts");
@@ -155,11 +148,11 @@ CombustionPowertrainParams read_combustion(YamlMap& pt) {
   {
     YamlMap m = pt.map("fuel");
     p.fuel.density_kg_per_m3 = m.number("density_kg_per_l", Range::open_low(0.0, 2.0)) / units::kM3PerLitre;
-    p.fuel.lower_heating_value_j_per_kg = m.number("lower_heating_value_mj_per_kg", Range::positive()) * 1e6;
-    p.fuel.co2_kg_per_kg = m.number("co2_kg_per_kg", Range::non_negative());
+    p.fuel.lower_heating_value_j_per_kg = m.number("lower_heating_value_mj_per_kg", Range::open_low(0.0, 150.0)) * 1e6;
+    p.fuel.co2_kg_per_kg = m.number("co2_kg_per_kg", Range::closed(0.0, 5.0));
     m.finish();
   }
-  p.aux_power_w = pt.number_or("aux_power_w", 0.0, Range::non_negative());
+  p.aux_power_w = pt.number_or("aux_power_w", 0.0, Range::closed(0.0, 1e5));
   p.alternator_efficiency = pt.number_or("alternator_efficiency", 1.0, Range::efficiency());
   return p;
 }

@@ -1,15 +1,36 @@
-// Output files written whole or not at all: content goes to a temporary beside the target, then is renamed.
+// Output files written whole or not at all: checked before any computation, content goes to a temporary
+// beside the target, and all of a command's outputs are renamed into place together at the end.
 #pragma once
 
 #include <functional>
 #include <ostream>
 #include <string>
+#include <vector>
 
 namespace rollsim {
 
-/// Calls `write` with a stream to a temporary file in the target's folder and renames it to `path` only when
-/// `write` returned and the stream is good. Throws InputError naming `option` and the path when the folder is
-/// not writable; a failed or throwing `write` leaves no file behind.
+/// Checks, before any computation, that `path` can be written: it is not a folder, and its folder exists
+/// and is writable. Throws InputError naming `option` and the path otherwise.
+void check_output_file(const std::string& path, const std::string& option);
+
+/// Checks that `dir` is a writable folder, or can be created as one (its nearest existing parent is a
+/// writable folder). Creates nothing. Throws InputError naming `option` and the folder otherwise.
+void check_output_dir(const std::string& dir, const std::string& option);
+
+/// One output of a command: where it goes, the option that asked for it (for errors), its whole content.
+struct OutputFile {
+  std::string path;
+  std::string option;
+  std::string content;
+};
+
+/// Writes every file to a temporary beside its target (creating missing folders), and only when all were
+/// written renames them into place. Any failure removes the temporaries and throws InputError naming the
+/// option and path: no output is left half-written, and none is written when another could not be.
+void write_files_atomically(const std::vector<OutputFile>& files);
+
+/// One file, its content produced by `write` on a stream: write_files_atomically of a single output.
+/// A throwing `write` leaves no file behind.
 void write_file_atomically(const std::string& path, const std::string& option,
                            const std::function<void(std::ostream&)>& write);
 

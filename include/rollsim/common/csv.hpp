@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -27,8 +28,10 @@ struct CsvTable {
 
 /// Reads `path`. Supports RFC 4180 quoting ("a,b" and "" inside quotes, line breaks inside quotes), CRLF
 /// line ends and a UTF-8 byte-order mark. Blank lines are skipped. Throws InputError for a missing or
-/// unreadable file, an empty file, an unterminated quote, or a row whose cell count differs from the header.
-CsvTable read_csv(const std::string& path, char delimiter = ',');
+/// unreadable file, an empty file, an unterminated quote, or a row whose cell count differs from the header,
+/// a file larger than kMaxCsvFileBytes (input_file.hpp) or more than `max_rows` data rows (named `rows_are`).
+CsvTable read_csv(const std::string& path, char delimiter = ',', std::size_t max_rows = SIZE_MAX,
+                  const std::string& rows_are = "rows");
 
 /// Parses a whole cell as a number (surrounding spaces allowed, nothing else). Returns nullopt for text
 /// that is not a number. "nan" and "inf" parse (to NaN and infinity) so callers can reject them by name.

@@ -26,6 +26,8 @@ struct Range {
   static Range open_low(double lo, double hi) { return {lo, hi, true, false}; }
   bool contains(double v) const;
   std::string describe() const;  ///< e.g. "must be > 0", "must be in [0, 1]"
+  /// describe() for a rejected `v`, also naming the implicit bound it broke (1e308: "at most 1e300").
+  std::string describe_for(double v) const;
 };
 
 /// A view on one YAML mapping of a file, remembering its path ("vehicle.yaml: body.mass_kg") so that every
@@ -34,7 +36,10 @@ struct Range {
 class YamlMap {
  public:
   /// Loads `path` and returns its top-level mapping; throws InputError if missing or malformed.
+  /// Also rejects a key given twice in one mapping and a key that is not a plain word, at its line.
   static YamlMap load_file(const std::string& path);
+  /// The same for YAML text already in memory; `path` names it in errors.
+  static YamlMap load_text(const std::string& text, const std::string& path);
   YamlMap(YAML::Node node, std::string file, std::string prefix);
 
   bool has(const std::string& key) const;

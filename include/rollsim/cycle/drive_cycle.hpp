@@ -43,9 +43,10 @@ std::vector<double> breakpoints_s(const DriveCycle& cycle);
 std::vector<std::string> shipped_cycle_names();
 
 /// Loads a shipped cycle by name (case-insensitive, see shipped_cycle_names) or a CSV file by path.
-/// CSV: a header line, then one sample per line. Columns: `time_s` (strictly increasing), exactly one of
-/// `speed_kmh` or `speed_mps` (>= 0), and at most one of `grade_pct` (percent, within +-30) or `elevation_m`
-/// (converted to grade over travelled distance). Any bad value throws InputError naming file, line, column.
+/// CSV: a header line, then one sample per line. Columns: `time_s` (increasing by 1 ms to one day per sample),
+/// exactly one of `speed_kmh` or `speed_mps` (0 to 500 km/h; at most 2 g between samples), and at most one of
+/// `grade_pct` (percent, within +-30) or `elevation_m` (converted to grade over travelled distance). Any bad
+/// value throws InputError naming file, line, column, the value and the allowed range.
 /// `option` names where the name came from in error messages (e.g. "--cycle").
 DriveCycle load_cycle(const std::string& name_or_path, const std::string& option = "--cycle");
 
@@ -54,5 +55,12 @@ DriveCycle read_cycle_csv(const std::string& path, const std::string& name);
 
 /// Largest |grade| a cycle may hold: 30 %, steeper than any public road.
 inline constexpr double kMaxCycleGrade = 0.30;
+/// Fastest a cycle may ask for [m/s]: 500 km/h, beyond any road car and any tyre's speed rating.
+inline constexpr double kMaxCycleSpeed_mps = 500.0 / 3.6;
+/// Largest |acceleration| between two samples [m/s^2]: 2 g, beyond the grip of any tyre on a road.
+inline constexpr double kMaxCycleAccel_mps2 = 19.6;
+/// Closest and farthest two samples may be [s]: 1 ms (a 1 kHz logger) and one day (a car parked overnight).
+inline constexpr double kMinCycleTimeStep_s = 1e-3;
+inline constexpr double kMaxCycleTimeStep_s = 86400.0;
 
 }  // namespace rollsim

@@ -184,20 +184,4 @@ std::string diagnosis_text(const Diagnosis& d);
 /// The vehicle file at `vehicle_path` with an `effects:` block holding the findings' fitted effects.
 std::string fitted_vehicle_yaml(const std::string& vehicle_path, const Diagnosis& d);
 
-/// Synthetic recording with a concealed effect, for the proof. The truth uses its own models (a two-node tyre
-/// thermal network with an exponential RRC law), never the catalogue's modules.
-struct SyntheticOptions {
-  std::string cycle = "wltc";
-  int repeats = 2;
-  double tyre_cold_excess = 0.0;   ///< truth's RRC excess of a cold tyre (0: null recording)
-  double rrc_level_jitter = 0.03;  ///< truth's RRC level, uniform +- (calibration, not a discovery)
-  double scale_jitter = 0.02;      ///< measured channel scale, uniform +-
-  double noise_w = 400.0;          ///< white sensor noise, standard deviation
-  double quantum_w = 100.0;        ///< logger quantisation
-  double lag_s = 1.0;              ///< channel lag
-  bool time_reversed = false;      ///< the truth's warm-up decay placed at the end of the trip (a null)
-  unsigned seed = 1;
-};
-Recording generate_recording(const Vehicle& vehicle, const SyntheticOptions& opt);
-
 }  // namespace rollsim

@@ -31,12 +31,6 @@ struct GearboxParams {
   std::vector<double> downshift_speeds_mps;  ///< speed to leave gear i+1 for i (size = gears - 1)
 };
 
-struct FuelParams {
-  double density_kg_per_m3 = 0.0;
-  double lower_heating_value_j_per_kg = 0.0;
-  double co2_kg_per_kg = 0.0;   ///< tank-to-wheel CO2 per kg of fuel burned
-};
-
 struct CombustionPowertrainParams {
   EngineParams engine;
   GearboxParams gearbox;
@@ -54,8 +48,9 @@ class CombustionPowertrain final : public Powertrain {
   std::vector<double> regime_speeds_mps() const override { return {}; }
   int num_gears() const override { return static_cast<int>(p_.gearbox.ratios.size()); }
   double max_wheel_force_n(int gear, double speed_mps, double wheel_radius_m) const override;
-  double usable_battery_energy_j() const override { return 0.0; }
-  bool is_electric() const override { return false; }
+  const FuelParams* fuel() const override { return &p_.fuel; }
+  /// From the alternator at the engine's marginal (Willans) efficiency, even in fuel cut-off.
+  void add_electric_load(double power_w, PowerFlow& flow) const override;
   const CombustionPowertrainParams& params() const { return p_; }
 
  private:

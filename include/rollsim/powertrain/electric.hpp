@@ -20,19 +20,17 @@ struct ElectricMotorParams {
   double max_torque_nm = 0.0;
   double max_power_w = 0.0;        ///< continuous-peak mechanical power, both directions
   double max_speed_radps = 0.0;
+  /// Speed limiter: over the top band of speed, [1 - band, 1] x max_speed, the controller derates the torque
+  /// limit linearly to zero at max_speed (a governor's taper). The force the motor can give is then continuous
+  /// in speed: a car at its top speed settles where force meets road load, instead of switching between full
+  /// force and none at max_speed, which no error-controlled integrator can step over.
+  double speed_limit_band_fraction = 0.03;
   MotorLossParams losses;
 };
 
 struct ReductionParams {
   double ratio = 1.0;        ///< motor speed / wheel speed
   double efficiency = 1.0;   ///< (0, 1], both directions
-};
-
-struct BatteryParams {
-  double open_circuit_voltage_v = 0.0;
-  double internal_resistance_ohm = 0.0;
-  double usable_capacity_j = 0.0;
-  double initial_soc = 1.0;  ///< fraction of usable capacity at the start
 };
 
 /// Regenerative braking and its blending with the friction brakes.
@@ -61,8 +59,10 @@ class ElectricPowertrain final : public Powertrain {
   std::vector<double> shift_speeds_mps(int) const override { return {}; }
   std::vector<double> regime_speeds_mps() const override;
   double max_wheel_force_n(int gear, double speed_mps, double wheel_radius_m) const override;
-  double usable_battery_energy_j() const override { return p_.battery.usable_capacity_j; }
-  bool is_electric() const override { return true; }
+  const BatteryParams* battery() const override { return &p_.battery; }
+  /// From the battery terminals (its own I^2 R for the extra current is neglected: under 1 % of the load at
+  /// these currents).
+  void add_electric_load(double power_w, PowerFlow& flow) const override;
   const ElectricPowertrainParams& params() const { return p_; }
 
   /// Battery current [A] (+ discharging) for a terminal power [W]; throws ModelDomainError when the battery
@@ -73,6 +73,8 @@ class ElectricPowertrain final : public Powertrain {
 
  private:
   double motor_loss_w(double torque_nm, double speed_radps) const;
+  /// The speed limiter's factor on the torque limit at this motor speed: 1 below the band, 0 at max speed.
+  double speed_limit_factor(double speed_radps) const;
   ElectricPowertrainParams p_;
 };
 

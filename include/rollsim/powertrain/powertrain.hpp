@@ -5,6 +5,21 @@
 
 namespace rollsim {
 
+/// A traction battery: an open-circuit voltage behind an internal resistance, with a usable capacity.
+struct BatteryParams {
+  double open_circuit_voltage_v = 0.0;
+  double internal_resistance_ohm = 0.0;
+  double usable_capacity_j = 0.0;
+  double initial_soc = 1.0;  ///< fraction of usable capacity at the start
+};
+
+/// The fuel a fuel converter burns.
+struct FuelParams {
+  double density_kg_per_m3 = 0.0;
+  double lower_heating_value_j_per_kg = 0.0;
+  double co2_kg_per_kg = 0.0;   ///< tank-to-wheel CO2 per kg of fuel burned
+};
+
 /// Powers at one instant, all [W], signed where noted. Everything downstream of the wheel that the energy
 /// report and the energy balance need. Fields a powertrain does not have stay zero.
 struct PowerFlow {
@@ -28,7 +43,8 @@ struct PowerFlow {
 };
 
 /// A powertrain. Implementations know their own parameters; the simulator calls only this interface, so the
-/// integrator and the vehicle dynamics stay independent of the kind of car.
+/// integrator and the vehicle dynamics stay independent of the kind of car. What a powertrain stores or burns is
+/// a capability (an optional battery, an optional fuel), not a kind: a hybrid has both.
 class Powertrain {
  public:
   virtual ~Powertrain() = default;
@@ -55,10 +71,15 @@ class Powertrain {
   /// Speeds [m/s] at which deliver() switches regime (regen fade, clutch lock-up); stop points for the integrator.
   virtual std::vector<double> regime_speeds_mps() const = 0;
 
-  /// Usable battery energy [J] (electric), 0 for combustion.
-  virtual double usable_battery_energy_j() const = 0;
+  /// The traction battery, or nullptr when the powertrain has none.
+  virtual const BatteryParams* battery() const { return nullptr; }
 
-  virtual bool is_electric() const = 0;
+  /// The fuel of the powertrain's fuel converter, or nullptr when it has none.
+  virtual const FuelParams* fuel() const { return nullptr; }
+
+  /// Adds an extra electrical load `power_w` (an effect's consumer) to `flow`, drawn where this powertrain
+  /// draws its electricity (battery terminals, or an alternator on the engine).
+  virtual void add_electric_load(double power_w, PowerFlow& flow) const = 0;
 };
 
 }  // namespace rollsim

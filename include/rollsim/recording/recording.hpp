@@ -1,6 +1,7 @@
 // Recordings of real vehicles (speed plus a measured energy channel) read from loggers' CSV files, in SI.
 #pragma once
 
+#include <cstddef>
 #include <map>
 #include <optional>
 #include <string>
@@ -46,7 +47,8 @@ struct ColumnMapping {
 /// The canonical column names, in the order above.
 const std::vector<std::string>& canonical_recording_columns();
 
-/// Adds one `--column CANONICAL=SOURCE` option to `mapping`; throws InputError naming the option.
+/// Adds one `--column CANONICAL=SOURCE` option to `mapping`; `--column CANONICAL=` (nothing after '=') drops the
+/// column (a preset's mapping included; time_s and speed_kmh cannot be dropped). Throws InputError naming the option.
 void parse_column_option(const std::string& text, ColumnMapping& mapping);
 /// Adds one `--scale CANONICAL=FACTOR` option (finite, non-zero) to `mapping`; throws InputError naming it.
 void parse_scale_option(const std::string& text, ColumnMapping& mapping);
@@ -72,13 +74,19 @@ inline constexpr double kMaxBridgedRun_s = 5.0;
 inline constexpr double kReportedGap_s = 5.0;
 /// Shortest recording accepted.
 inline constexpr double kMinRecordingDuration_s = 60.0;
+/// Most samples in one recording: a loaded sample takes about 600 bytes (channels, replay and diagnosis
+/// arrays), so this bounds one recording near 600 MB (28 h at 10 Hz); longer logs are split into trips.
+inline constexpr std::size_t kMaxRecordingSamples = 1000000;
 
 /// Reads a recording CSV (header line, RFC 4180 quoting) through `mapping`. Needs time_s, speed_kmh and at
 /// least one energy channel (battery_power_kw, battery_voltage_v with battery_current_a, soc_pct or
 /// fuel_rate_lph). Sample interval 0.01 to 1 s (1 to 100 Hz, median). Throws InputError naming file, line
 /// and column for: a missing column (found columns listed, --column suggested), text in a number column,
 /// infinite or out-of-range values, time repeating or going backwards, NaN runs longer than
-/// kMaxBridgedRun_s, a recording shorter than kMinRecordingDuration_s, no energy channel.
+/// kMaxBridgedRun_s, a recording shorter than kMinRecordingDuration_s, no energy channel, more than
+/// kMaxRecordingSamples rows (checked while reading, before anything else is allocated). GPS latitude and longitude,
+/// which the diagnosis does not need, never throw: bad cells are read as missing and a column too broken to bridge is
+/// dropped, each with a "warning:" in repairs. A canonical column mapped to "" is not read.
 Recording load_recording(const std::string& path, const ColumnMapping& mapping);
 
 }  // namespace rollsim

@@ -1,4 +1,4 @@
-// Shared helpers of tyre selection: running a car on a cycle with a given tyre, the car's figure of merit, safe file writes.
+// Shared helpers of tyre selection: running a car on a cycle with a given tyre, the car's figure of merit.
 #pragma once
 
 #include <string>
@@ -9,14 +9,14 @@
 
 namespace rollsim::selection {
 
-/// The car's headline figure: battery energy per distance for an electric car, fuel per distance otherwise.
+/// The car's headline figure: fuel per distance for a car that burns fuel, battery energy per distance otherwise.
 struct EnergyFigure {
   double value = 0.0;     ///< kWh/10 km or l/100 km
   std::string unit;       ///< "kwh_per_10km" or "l_per_100km"
   double range_km = 0.0;  ///< electric only, 0 otherwise
 };
 
-/// "kwh_per_10km" for an electric car, "l_per_100km" otherwise.
+/// "l_per_100km" for a car whose powertrain burns fuel, "kwh_per_10km" otherwise.
 std::string energy_unit(const Vehicle& vehicle);
 /// "kWh/10 km" / "l/100 km" for tables.
 std::string energy_unit_label(const std::string& unit);
@@ -26,9 +26,5 @@ EnergyFigure energy_figure(const SimulationResult& result);
 
 /// Assembles `vehicle` and runs it forward (driver + CVODE) over `cycle`.
 EnergyFigure run_forward(const Vehicle& vehicle, const DriveCycle& cycle);
-
-/// Writes `content` to a temporary file beside `path` and renames it over `path`, so readers never see a
-/// half-written file. Throws InputError naming `option` and the path if the folder is not writable.
-void write_file_atomically(const std::string& path, const std::string& content, const std::string& option);
 
 }  // namespace rollsim::selection

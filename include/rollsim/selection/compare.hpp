@@ -39,15 +39,15 @@ struct CandidateResult {
   std::string error;
   double value = 0.0;             ///< energy or fuel per distance (unit of the table)
   double diff_pct = 0.0;          ///< relative to the own tyre, + = uses more
-  double range_km = 0.0;          ///< electric only
-  double range_change_km = 0.0;   ///< electric only, + = gains range
+  double range_km = 0.0;          ///< battery-only cars
+  double range_change_km = 0.0;   ///< battery-only cars, + = gains range
 };
 
 /// One vehicle on one cycle: the fitting tyres ranked best first, then the unfit ones (unranked, same order as given).
 struct Comparison {
   std::string vehicle;
   std::string cycle;
-  bool electric = false;
+  bool shows_range = false;  ///< the figure is battery energy (no fuel burned): range columns apply
   std::string unit;
   double own_value = 0.0;
   double own_range_km = 0.0;

@@ -1,6 +1,7 @@
 // Parameter sweeps of a tyre (RRC, force, power) or of a car on a cycle (energy or fuel), one or two axes.
 #pragma once
 
+#include <cstddef>
 #include <functional>
 #include <optional>
 #include <string>
@@ -28,6 +29,11 @@ struct SweepAxis {
   int steps = 11;     ///< points including both ends, >= 2
   std::vector<double> values() const;
 };
+
+/// Most points in one sweep (the product of the axes' steps), checked before the grid is built: about 300 bytes
+/// each in memory and 100 in the CSV for the tyre alone; one forward simulation each (about 2 ms) with a car.
+inline constexpr std::size_t kMaxTyreSweepPoints = 1000000;
+inline constexpr std::size_t kMaxVehicleSweepPoints = 100000;
 
 /// Throws InputError (naming `option`) for an empty or reversed range or steps < 2.
 void check_axis(const SweepAxis& axis, const std::string& option);

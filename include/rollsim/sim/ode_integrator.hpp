@@ -20,6 +20,8 @@ class OdeSystem {
   virtual int num_quadratures() const { return 0; }
   virtual int quadrature_rhs(double /*t*/, const double* /*y*/, double* /*qdot*/) { return 0; }
   virtual int num_roots() const { return 0; }
+  /// A readable name of state component i, for solver-failure messages.
+  virtual std::string state_name(int i) const { return "y[" + std::to_string(i) + "]"; }
   virtual void roots(double /*t*/, const double* /*y*/, double* /*g*/) {}
 };
 
@@ -69,6 +71,9 @@ class CvodeIntegrator {
   std::vector<double> quadratures_at(double t) const;
   /// Restarts the method at a discontinuity with state `y` (quadratures carry on): no step straddles it.
   void restart(double t, const std::vector<double>& y);
+  /// New absolute tolerances for the quadratures (one each), from the next step on: the integral restarts at
+  /// each restart, so a caller can fit them to the energy scale of the interval ahead.
+  void set_quadrature_absolute_tolerances(const std::vector<double>& absolute);
 
   double time() const { return t_; }
   const std::vector<double>& state() const { return y_; }
@@ -87,6 +92,7 @@ class CvodeIntegrator {
   long restarts_ = 0;
   int stalls_ = 0;  // successive calls that returned without advancing
   double stop_time_ = -1e300;
+  double quadrature_relative_ = 0.0;
   OdeStats before_restarts_;  // CVodeReInit zeroes the counters; earlier runs are kept here
 };
 

@@ -1,4 +1,5 @@
-// The physical tyre rolling-resistance model (Redrouthu & Das 2014): Rhyne stiffness, n-element damping, drag.
+// The tyre rolling-resistance models: the thesis' (Redrouthu & Das 2014: Rhyne stiffness, n-element damping,
+// drag) and a measured-data hysteresis model, selected per tyre.
 #pragma once
 
 #include <string>
@@ -23,6 +24,29 @@ struct TyreModelConstants {
   int elements = 500;
 };
 
+/// Which rolling-resistance law a tyre follows. Thesis is the default, so tyre files without a choice keep
+/// reproducing the thesis' reference values and trends.
+enum class TyreModelKind { Thesis, Hysteresis };
+
+/// Constants of the hysteresis model (docs in tyres/README.md, evidence in README.md). With f = V / (2 pi R)
+/// the wheel's rotation frequency (each piece of rubber is deformed once per turn), dz = N / Kz the Rhyne
+/// deflection and the subscript ref the reference point:
+///   RRC = rrc_ref (dz / dz_ref)^n_d (N / N_ref)^n_z (1 + s_f f) + c_w f^2 (N / N_ref)^n_w.
+/// The first term is the compound's hysteresis loss (level, its scaling with deflection and load, and the rise
+/// of the loss modulus with deformation frequency); the second a speed-squared loss that does not scale with
+/// the compound's level (tread inertia and air pumping). Defaults other than the level are shared constants
+/// fitted to all nine Michelin J2452 sets (`rollsim tyre fit --evaluate-j2452`); rrc_ref is per tyre.
+struct HysteresisConstants {
+  double reference_pressure_pa = 2.1e5;  ///< P_ref, where dz_ref is taken (ISO 28580 standard load: 210 kPa)
+  double reference_load_n = 4000.0;      ///< N_ref
+  double rrc_ref = 0.010;                ///< hysteresis RRC at the reference point as f -> 0
+  double deflection_exponent = 0.54166;   ///< n_d: loss per unit load grows with deflection
+  double load_exponent = -0.58678;        ///< n_z: load dependence at fixed deflection
+  double frequency_slope_per_hz = 0.017138;   ///< s_f: relative rise of the loss modulus per Hz
+  double speed_loss_rrc_per_hz2 = 4.2285e-6;  ///< c_w: speed-squared loss [RRC / Hz^2]
+  double speed_loss_load_exponent = 0.086928;  ///< n_w
+};
+
 /// Undeformed tyre geometry.
 struct TyreGeometry {
   double outer_radius_m = 0.0;   ///< R, unloaded outer radius
@@ -35,7 +59,9 @@ struct TyreGeometry {
 struct TyreState {
   TyreGeometry geometry;
   double pressure_pa = 0.0;
-  TyreModelConstants constants;
+  TyreModelKind model = TyreModelKind::Thesis;
+  TyreModelConstants constants;      ///< thesis constants; Rhyne's stiffness is used by both models
+  HysteresisConstants hysteresis;    ///< used when model == Hysteresis
 };
 
 /// Everything the model computes at one operating point. Force/power are per tyre.
@@ -47,9 +73,11 @@ struct RollingResistance {
   double contact_length_m = 0.0;   ///< 2 R sin(theta_max)
   double offset_e_m = 0.0;         ///< forward shift of the normal-pressure centre, e = M / F
   double rrc = 0.0;                ///< rolling-resistance coefficient e / R
-  double rrc_coulomb = 0.0;        ///< part of rrc from Coulomb damping (speed independent for V > 0)
-  double rrc_viscous = 0.0;        ///< part of rrc from viscous damping (linear in V)
-  double rrc_rotational_drag = 0.0;  ///< part of rrc from rotational aerodynamic drag (quadratic in V)
+  // The three parts of rrc by speed dependence. Thesis: Coulomb damping, viscous damping, rotational drag.
+  // Hysteresis model: hysteresis at f -> 0, its rise with frequency, the speed-squared loss.
+  double rrc_coulomb = 0.0;        ///< speed-independent part (for V > 0)
+  double rrc_viscous = 0.0;        ///< part linear in V
+  double rrc_rotational_drag = 0.0;  ///< part quadratic in V
   double rr_force_n = 0.0;         ///< rrc * N
   double rr_power_w = 0.0;         ///< rr_force_n * V
 };
@@ -61,13 +89,15 @@ double vertical_stiffness_n_per_m(const TyreState& tyre);
 /// which quantity is out and what is allowed (deflection reaching the rim, non-positive pressure, ...).
 void check_operating_point(const TyreState& tyre, double load_n, double speed_mps);
 
-/// The reference computation: the n-element sum of docs/tyre-model.md, step by step. Slow (O(n)); use
-/// TyreAtLoad in simulations. Throws ModelDomainError outside the model's domain.
+/// Rolling resistance under the tyre's own model (state.model). Thesis: the reference computation, the
+/// n-element sum of docs/tyre-model.md step by step, O(n); use TyreAtLoad in simulations. Hysteresis: the
+/// closed form of HysteresisConstants. Throws ModelDomainError outside the model's domain.
 RollingResistance evaluate_rolling_resistance(const TyreState& tyre, double load_n, double speed_mps);
 
-/// A tyre prepared at a fixed load: RRC(V) = k0 + k1 V + k2 V^2 for V > 0, and 0 at V = 0, exactly the
-/// n-element sum (the Coulomb sum does not depend on wheel speed, the viscous one is linear in it, and the
-/// drag term quadratic). Preparing costs one O(n) pass; each evaluation is a few flops.
+/// A tyre prepared at a fixed load: RRC(V) = k0 + k1 V + k2 V^2 for V > 0, and 0 at V = 0. This is exactly
+/// the thesis' n-element sum (the Coulomb sum does not depend on wheel speed, the viscous one is linear in it,
+/// the drag term quadratic) and the hysteresis model's form at fixed load. Preparing costs one O(n) pass for
+/// the thesis model; each evaluation is a few flops.
 class TyreAtLoad {
  public:
   TyreAtLoad() = default;

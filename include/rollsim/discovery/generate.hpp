@@ -38,6 +38,15 @@ struct ConcealedTruthInfo {
   /// Across-trip truths (ambient temperature): concealed in several trips at different ambients (generate_trips),
   /// never in one recording.
   bool multi_trip = false;
+  /// +1: the truth's physics has a sign (a load draws power, a cold tyre rolls harder), so the expected effect
+  /// found with a negative size is a mistake, not a discovery; 0: either sign is physical (wind, grade).
+  int sign = 0;
+  /// Recorded through a real logger's artefacts (real_logger()): a lag of 0.3-1.7 s that is not a whole number of
+  /// samples, and a channel-scale jitter of +-3 %.
+  bool real_logger = false;
+  /// A null for this catalogue id (e.g. an RRC rising over the trip for tyre_warmup): catalogue_id is empty, and
+  /// any finding of this id, of either sign, is the mistake the row counts.
+  std::string never_called;
 };
 const std::vector<ConcealedTruthInfo>& concealed_truths();
 const ConcealedTruthInfo& concealed_truth(const std::string& truth);  ///< throws InputError when unknown
@@ -56,7 +65,8 @@ struct SyntheticCase {
   double scale_jitter = 0.02;      ///< measured channel scale, uniform +-
   double noise_w = 400.0;          ///< white sensor noise, standard deviation
   double quantum_w = 100.0;        ///< logger quantisation
-  double lag_s = 1.0;              ///< channel lag
+  double lag_s = 1.0;              ///< channel lag; the channel is interpolated, so it need not be whole samples
+  double lag_max_s = 0.0;          ///< above lag_s: the lag is drawn per seed, uniform in [lag_s, lag_max_s]
   SyntheticChannel channel = SyntheticChannel::battery_power;
   /// Fuel channel: white noise of the fuel power [W] (three times noise_w: at the engine's ~30 % efficiency the
   /// same road-load error is three times the chemical power) and the flow meter's quantum (0.05 l/h).
@@ -73,6 +83,10 @@ struct SyntheticCase {
 };
 Recording generate_case(const Vehicle& vehicle, const SyntheticCase& c);
 
+/// A real logger's artefacts on top of `c`'s: a lag of 0.3-1.7 s drawn per seed (not a whole number of samples)
+/// and a channel-scale jitter of +-3 %.
+SyntheticCase real_logger(SyntheticCase c);
+
 /// Several trips of one car and logger at different ambient temperatures (the across-trip truths' proof): one RRC
 /// level and one channel scale (drawn once, as SyntheticCase's jitters), a trip-to-trip RRC scatter (tyre pressure,
 /// road surface), and ambients stratified over [ambient_min_c, ambient_max_c] (one trip per equal slice, in random
@@ -86,5 +100,21 @@ struct MultiTripCase {
   unsigned seed = 1;
 };
 std::vector<Recording> generate_trips(const Vehicle& vehicle, const MultiTripCase& c);
+
+/// Synthetic recording with a concealed effect, for the proof. The truth uses its own models (a two-node tyre
+/// thermal network with an exponential RRC law), never the catalogue's modules.
+struct SyntheticOptions {
+  std::string cycle = "wltc";
+  int repeats = 2;
+  double tyre_cold_excess = 0.0;   ///< truth's RRC excess of a cold tyre (0: null recording)
+  double rrc_level_jitter = 0.03;  ///< truth's RRC level, uniform +- (calibration, not a discovery)
+  double scale_jitter = 0.02;      ///< measured channel scale, uniform +-
+  double noise_w = 400.0;          ///< white sensor noise, standard deviation
+  double quantum_w = 100.0;        ///< logger quantisation
+  double lag_s = 1.0;              ///< channel lag
+  bool time_reversed = false;      ///< the truth's warm-up decay placed at the end of the trip (a null)
+  unsigned seed = 1;
+};
+Recording generate_recording(const Vehicle& vehicle, const SyntheticOptions& opt);
 
 }  // namespace rollsim

@@ -4,7 +4,8 @@
 #include <string>
 #include <vector>
 
-#include "rollsim/diagnose/generate.hpp"
+#include "rollsim/discovery/baselines.hpp"
+#include "rollsim/discovery/generate.hpp"
 #include "rollsim/vehicle/vehicle.hpp"
 
 namespace rollsim {
@@ -20,6 +21,8 @@ struct BenchOptions {
   /// The combustion car of the fuel-channel cases (engine warm-up, fuel null), a shipped name or a path; not
   /// loaded in the quick subset, which has no fuel case.
   std::string combustion_vehicle = "ice";
+  /// Only the rows whose label contains one of these (empty: every row), e.g. {"real logger"}.
+  std::vector<std::string> only;
 };
 
 /// How one method fared on one case, over its seeds.
@@ -31,6 +34,35 @@ struct Score {
   int n() const { return named + confounded + missed + mistaken; }
 };
 
+/// One finding as the scorecard reads it: its effect (or "unexplained"), the ids it is confounded with, its size (the
+/// first parameter: the catalogue amplitude).
+struct FindingSummary {
+  std::string effect;
+  std::vector<std::string> confounded_with;
+  double size = 0.0;
+};
+
+/// What a row asks of a diagnosis. `group` as BenchRow's; `sign` +1 where the truth's physics has a sign (the
+/// expected effect with a negative size is then a mistake); `never_called` for the "reversed" rows, the effect a
+/// null of that kind must never be called (tyre_warmup for an RRC rising over the trip).
+struct RowRule {
+  std::string group;
+  std::vector<std::string> expected;
+  int sign = 0;
+  std::string never_called;
+};
+
+enum class Tally { named, confounded, missed, mistaken };
+
+/// How rollsim's column scores one diagnosis. Effect rows ("single", "pair", "trips"): by the first finding, named
+/// when it is an expected id alone, confounded when an expected id is among its confounded set, missed when there is
+/// none or it is "unexplained", mistaken otherwise, and mistaken too when it names an expected id with a size of the
+/// wrong sign. "two": named when both expected ids are among all findings, confounded when one is. "null": any
+/// finding is mistaken (a false discovery). "reversed": any finding of `never_called`, of either sign, is mistaken.
+/// `wrong_sign` (optional) is set when the tally is a mistake for the sign alone, or a never_called finding of
+/// negative size.
+Tally score_findings(const RowRule& rule, const std::vector<FindingSummary>& findings, bool* wrong_sign = nullptr);
+
 struct BenchRow {
   std::string group;       ///< "single", "pair", "two", "trips" (several recordings), "null", "reversed"
   std::string label;       ///< e.g. "aux_compressor 300 W (mean)"
@@ -40,6 +72,9 @@ struct BenchRow {
   std::vector<Score> sparse_by_threshold;  ///< per sparse_thresholds() entry
   Score sparse_bic;                        ///< at the threshold BIC picks per recording
   int rollsim_unexplained = 0;  ///< seeds whose first finding was an unexplained signature
+  /// Seeds counted mistaken for a size of the wrong sign (effect rows), or a never_called finding of negative size
+  /// ("reversed" rows; the rest of that row's mistakes had a positive size).
+  int rollsim_wrong_sign = 0;
 };
 
 /// The sparse baseline at one threshold, pooled over the scorecard: null rows, and effect rows (single, pair, two).
@@ -69,25 +104,5 @@ std::string bench_text(const BenchResult& r);
 
 /// Wilson score interval (95 %) for k successes in n trials.
 std::pair<double, double> wilson_interval(int k, int n);
-
-/// The sparse-regression baseline on one recording: sequential thresholded least squares on window integrals of
-/// {1, v, v^2, v^3, a, a v} beside the simulated energy; returns the catalogue ids its selected non-calibration
-/// terms map to, largest contribution first ("mass|rotational_inertia" for the inertial term a v). A term is dropped
-/// when its contribution is below `threshold` times the measured energy's norm. The measured channel is the
-/// recording's battery power, fuel rate (as fuel power) or SOC (window differences x capacity); `window_s` is the
-/// window length (the diagnosis lengthens it for a quantised SOC).
-std::vector<std::string> sparse_regression_discovery(const Vehicle& vehicle, const Recording& rec, double window_s = 60.0,
-                                                     double threshold = 0.01);
-
-/// The thresholds the scorecard sweeps the sparse baseline over (0.003, 0.01, 0.03, 0.1).
-const std::vector<double>& sparse_thresholds();
-
-/// The sparse baseline at every threshold of sparse_thresholds(), and at the threshold BIC picks on this recording.
-struct SparseSweep {
-  std::vector<std::vector<std::string>> by_threshold;  ///< per sparse_thresholds() entry
-  std::vector<std::string> bic;                        ///< at the BIC-chosen threshold
-  double bic_threshold = 0.0;
-};
-SparseSweep sparse_regression_sweep(const Vehicle& vehicle, const Recording& rec, double window_s = 60.0);
 
 }  // namespace rollsim

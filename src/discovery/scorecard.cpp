@@ -1,12 +1,8 @@
 // Discovery benchmark: concealed-effect cases, blind diagnosis, parameter-only and sparse-regression baselines.
-#include "rollsim/diagnose/bench.hpp"
+#include "rollsim/discovery/scorecard.hpp"
 
-#include <unistd.h>
-
-#include <Eigen/Dense>
 #include <algorithm>
 #include <filesystem>
-#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -21,7 +17,6 @@
 #include "rollsim/common/yaml_reader.hpp"
 #include "rollsim/cycle/drive_cycle.hpp"
 #include "rollsim/diagnose/diagnose.hpp"
-#include "rollsim/sim/simulation.hpp"
 
 namespace rollsim {
 
@@ -34,152 +29,6 @@ std::pair<double, double> wilson_interval(int k, int n) {
 
 namespace {
 
-constexpr int kTerms = 7;  // sim, 1, v, v^2, v^3, a, a v
-
-// Window integrals of the library terms and the measured channel's window energies, on one recording.
-struct SparseDesign {
-  Eigen::MatrixXd x;
-  Eigen::VectorXd y;
-};
-
-SparseDesign sparse_design(const Vehicle& vehicle, const Recording& rec, double window_s) {
-  // Nominal model on the recorded speed: the regression explains the measured window energy by the simulated one
-  // plus library terms, as a SINDy user without the physics catalogue would.
-  const DriveCycle c = cycle_of_recording(rec);
-  SimulationOptions so;
-  so.record_trace = true;
-  const SimulationResult sim = simulate_replay(VehicleModel::assemble(vehicle), c, so);
-  // The channel in the simulation's energy domain: battery power, fuel chemical power, or SOC x capacity.
-  double fuel_j_per_m3 = 0.0, capacity_j = 0.0;
-  if (const auto* cp = std::get_if<CombustionPowertrainParams>(&vehicle.powertrain))
-    fuel_j_per_m3 = cp->fuel.density_kg_per_m3 * cp->fuel.lower_heating_value_j_per_kg;
-  if (const auto* ep = std::get_if<ElectricPowertrainParams>(&vehicle.powertrain)) capacity_j = ep->battery.usable_capacity_j;
-  const bool soc = !rec.battery_power_w && !rec.fuel_rate_m3ps && rec.soc_fraction;
-  std::vector<double> meas(rec.time_s.size(), 0.0);
-  if (rec.battery_power_w) meas = *rec.battery_power_w;
-  else if (rec.fuel_rate_m3ps)
-    for (std::size_t i = 0; i < meas.size(); ++i) meas[i] = (*rec.fuel_rate_m3ps)[i] * fuel_j_per_m3;
-  std::vector<std::array<double, kTerms>> rows;
-  std::vector<double> y;
-  std::array<double, kTerms> acc{};
-  double yw = 0.0, w0 = rec.time_s.front();
-  for (std::size_t i = 0; i + 1 < rec.time_s.size() && i < sim.trace.size(); ++i) {
-    const double dt = rec.time_s[i + 1] - rec.time_s[i], v = rec.speed_mps[i];
-    const double a = (rec.speed_mps[i + 1] - v) / dt;
-    const double sim_w = fuel_j_per_m3 > 0.0 ? sim.trace[i].fuel_rate_m3_per_s * fuel_j_per_m3 : sim.trace[i].battery_power_w;
-    const std::array<double, kTerms> phi{sim_w, 1.0, v, v * v, v * v * v, a, a * v};
-    for (int k = 0; k < kTerms; ++k) acc[k] += phi[k] * dt;
-    // SOC is a state: a window's energy is its drop times the capacity, not an integral of samples.
-    yw += soc ? ((*rec.soc_fraction)[i] - (*rec.soc_fraction)[i + 1]) * capacity_j : meas[i] * dt;
-    if (rec.time_s[i + 1] - w0 >= window_s) {  // the diagnosis' windows
-      rows.push_back(acc);
-      y.push_back(yw);
-      acc = {};
-      yw = 0.0;
-      w0 = rec.time_s[i + 1];
-    }
-  }
-  const auto n = static_cast<Eigen::Index>(y.size());
-  SparseDesign d;
-  d.x.resize(n, kTerms);
-  d.y.resize(n);
-  for (Eigen::Index r = 0; r < n; ++r) {
-    d.y[r] = y[static_cast<std::size_t>(r)];
-    for (int k = 0; k < kTerms; ++k) d.x(r, k) = rows[static_cast<std::size_t>(r)][k];
-  }
-  return d;
-}
-
-struct SparseFit {
-  std::vector<bool> on;
-  Eigen::VectorXd coef;
-  double rss = 0.0;
-};
-
-// Sequential thresholded least squares (Brunton et al. 2016) on unit-norm columns: a term whose contribution
-// |c_k| ||x_k|| is below `lambda` ||y|| is dropped and the rest refitted, until the set stops changing. The
-// simulated energy (column 0) is always kept.
-SparseFit stlsq(const SparseDesign& d, double lambda) {
-  const Eigen::Index n = d.y.size();
-  SparseFit f;
-  f.on.assign(kTerms, true);
-  f.coef = Eigen::VectorXd::Zero(kTerms);
-  for (int iter = 0; iter < 20; ++iter) {
-    std::vector<int> idx;
-    for (int k = 0; k < kTerms; ++k)
-      if (f.on[k]) idx.push_back(k);
-    Eigen::MatrixXd xs(n, static_cast<Eigen::Index>(idx.size()));
-    for (std::size_t j = 0; j < idx.size(); ++j) xs.col(static_cast<Eigen::Index>(j)) = d.x.col(idx[j]);
-    const Eigen::VectorXd c = xs.colPivHouseholderQr().solve(d.y);
-    f.coef.setZero();
-    for (std::size_t j = 0; j < idx.size(); ++j) f.coef[idx[j]] = c[static_cast<Eigen::Index>(j)];
-    f.rss = (d.y - xs * c).squaredNorm();
-    bool changed = false;
-    for (int k = 1; k < kTerms; ++k) {
-      if (f.on[k] && std::abs(f.coef[k]) * d.x.col(k).norm() < lambda * d.y.norm()) {
-        f.on[k] = false;
-        changed = true;
-      }
-    }
-    if (!changed) break;
-  }
-  return f;
-}
-
-// Mapping of terms to catalogue signatures (power terms): 1 -> aux_load (constant power); v^2 -> wind (the
-// 2 rho CdA u v force); a -> regen_limit (the only catalogue effect that acts on the sign of a: braking losses);
-// a v -> mass or rotational_inertia (inertial power, the two cannot be told apart from it). v and v^3 are the
-// RRC level and CdA, calibration quantities, so never discoveries. Time-dependent effects (warm-ups), F^2 v
-// (slip) and trip-level terms (ambient) have no term: the library cannot name them.
-std::vector<std::string> sparse_names(const SparseDesign& d, const SparseFit& f) {
-  const char* map[kTerms] = {nullptr, "aux_load", nullptr, "wind", nullptr, "regen_limit", "mass|rotational_inertia"};
-  std::vector<std::pair<double, std::string>> found;
-  for (int k = 1; k < kTerms; ++k)
-    if (f.on[k] && map[k]) found.push_back({std::abs(f.coef[k]) * d.x.col(k).norm(), map[k]});
-  std::sort(found.begin(), found.end(), [](const auto& p, const auto& q) { return p.first > q.first; });
-  std::vector<std::string> out;
-  for (const auto& x : found) out.push_back(x.second);
-  return out;
-}
-
-}  // namespace
-
-const std::vector<double>& sparse_thresholds() {
-  static const std::vector<double> kThresholds{0.003, 0.01, 0.03, 0.1};
-  return kThresholds;
-}
-
-std::vector<std::string> sparse_regression_discovery(const Vehicle& vehicle, const Recording& rec, double window_s,
-                                                     double threshold) {
-  if (!(threshold > 0.0)) throw InputError("sparse regression threshold", "must be positive");
-  const SparseDesign d = sparse_design(vehicle, rec, window_s);
-  return sparse_names(d, stlsq(d, threshold));
-}
-
-SparseSweep sparse_regression_sweep(const Vehicle& vehicle, const Recording& rec, double window_s) {
-  const SparseDesign d = sparse_design(vehicle, rec, window_s);
-  SparseSweep out;
-  for (double t : sparse_thresholds()) out.by_threshold.push_back(sparse_names(d, stlsq(d, t)));
-  // The threshold chosen by BIC along the STLSQ path (a log grid 0.001-0.3, 13 values): each threshold gives a
-  // support; the support with the least n ln(RSS / n) + k ln n wins (ties: the sparser, i.e. larger threshold).
-  const double n = static_cast<double>(d.y.size());
-  double best = 1e300;
-  for (int i = 0; i <= 12; ++i) {
-    const double t = 0.001 * std::pow(300.0, i / 12.0);
-    const SparseFit f = stlsq(d, t);
-    const double k = static_cast<double>(std::count(f.on.begin(), f.on.end(), true));
-    const double bic = n * std::log(std::max(1e-300, f.rss / n)) + k * std::log(n);
-    if (bic <= best) {
-      best = bic;
-      out.bic_threshold = t;
-      out.bic = sparse_names(d, f);
-    }
-  }
-  return out;
-}
-
-namespace {
-
 struct Case {
   std::string group, label;
   SyntheticCase synth;
@@ -188,12 +37,12 @@ struct Case {
   unsigned seed0 = 0;
   bool combustion = false;  ///< run on the combustion car (fuel channel) instead of the bench's electric one
   std::optional<MultiTripCase> trips;  ///< several trips diagnosed together instead of `synth` alone
+  int sign = 0;                         ///< RowRule::sign
+  std::string never_called;             ///< RowRule::never_called ("reversed" rows)
 };
 
 struct Outcome {
-  std::vector<std::string> first;  ///< first finding: effect then its confounded set
-  std::vector<std::string> all;    ///< every finding's effect and confounded ids
-  double first_value = 0.0;
+  std::vector<FindingSummary> findings;
   /// The sparse baseline's mapped terms (every trip's, in order): per sparse_thresholds() entry, then at BIC's choice.
   std::vector<std::vector<std::string>> sparse;
 };
@@ -225,8 +74,17 @@ std::vector<Case> build_cases(const BenchOptions& o) {
       SyntheticCase s;
       s.effects = {{t.truth, size}};
       s.channel = t.channel;
+      if (t.real_logger) s = real_logger(s);
       const char* where = t.channel == SyntheticChannel::fuel_rate ? " (ice, fuel)" : t.channel == SyntheticChannel::soc ? " (SOC)" : "";
-      add("single", t.truth + " " + num(size) + " " + t.size_unit + where, s, {t.catalogue_id}, o.seeds, block);
+      const std::string logger = t.real_logger ? ", real logger" : "";
+      if (t.never_called.empty()) {
+        add("single", t.truth + " " + num(size) + " " + t.size_unit + where + logger, s, {t.catalogue_id}, o.seeds, block);
+      } else {
+        add("reversed", t.truth + " " + num(size) + " " + t.size_unit + where + logger + ": called " + t.never_called, s, {},
+            o.seeds, block);
+        cases.back().never_called = t.never_called;
+      }
+      cases.back().sign = t.sign;
       cases.back().combustion = t.channel == SyntheticChannel::fuel_rate;
       block += 1000;
     }
@@ -250,6 +108,15 @@ std::vector<Case> build_cases(const BenchOptions& o) {
     add("two", "wind 3 m/s + payload 150 kg", b, {"wind", "mass"}, o.seeds, 93000);
   }
   add("null", "null (calibration and noise only)", SyntheticCase{}, {}, o.null_seeds, 50000);
+  // Real loggers: a lag of 0.3-1.7 s that is not whole samples, and a channel scale within +-3 %.
+  add("null", "null, real logger (lag 0.3-1.7 s, scale +-3 %)", real_logger(SyntheticCase{}), {}, o.quick ? o.null_seeds / 3 : o.null_seeds,
+      56000);
+  if (!o.quick) {
+    SyntheticCase w = real_logger(SyntheticCase{});
+    w.effects = {{"tyre_two_node", 0.35}};
+    add("single", "tyre_two_node 0.35 1 (cold RRC excess), real logger", w, {"tyre_warmup"}, o.seeds, 57000);
+    cases.back().sign = +1;
+  }
   if (!o.quick) {
     // The fuel and SOC channels' own nulls (their artefacts differ: a flow meter's quantum and zero under fuel cut;
     // a 0.1 % SOC quantum with lengthened windows), at least 50 seeds each.
@@ -315,51 +182,81 @@ std::vector<Case> build_cases(const BenchOptions& o) {
   SyntheticCase r;
   r.effects = {{"tyre_two_node", 0.3}};
   r.time_reversed = true;
-  add("reversed", "time-reversed warm-up decay (RRC rises at the end)", r, {}, o.quick ? o.null_seeds / 2 : o.null_seeds, 60000);
+  add("reversed", "time-reversed warm-up decay (RRC rises at the end): called tyre_warmup", r, {},
+      o.quick ? o.null_seeds / 2 : o.null_seeds, 60000);
+  cases.back().never_called = "tyre_warmup";
+  for (auto& c : cases)  // every multi-trip truth is signed (a colder trip rolls harder)
+    if (c.trips && !c.expected.empty()) c.sign = +1;
+  if (!o.only.empty()) {
+    std::erase_if(cases, [&](const Case& c) {
+      return std::none_of(o.only.begin(), o.only.end(), [&](const std::string& s) { return c.label.find(s) != std::string::npos; });
+    });
+  }
   return cases;
 }
 
-// Single effects and pairs: by the first finding. Two at once: named = both expected ids among all findings (as
-// name or confounded), confounded = one of them, mistaken = a finding names neither.
-void score_one(const Case& c, const Outcome& r, BenchRow& row) {
-  auto score = [&](const std::vector<std::string>& first, const std::vector<std::string>& all, Score& s) {
-    if (c.group == "two") {
-      int hit = 0;
-      for (const auto& e : c.expected) hit += has(all, e) ? 1 : 0;
-      if (hit == 2) ++s.named;
-      else if (hit == 1) ++s.confounded;
-      else if (all.empty()) ++s.missed;
-      else ++s.mistaken;
-      return;
-    }
-    if (first.empty() || first.front() == "unexplained") {
-      ++s.missed;
-      return;
-    }
-    if (first.size() == 1 && has(c.expected, first.front())) ++s.named;
-    else if (std::any_of(c.expected.begin(), c.expected.end(), [&](const std::string& e) { return has(first, e); })) ++s.confounded;
-    else ++s.mistaken;
-  };
-  score(r.first, r.all, row.rollsim);
-  if (!r.first.empty() && r.first.front() == "unexplained") ++row.rollsim_unexplained;
-  // Parameter-only calibration fits scale, RRC level and CdA and can say nothing else: "nothing missing".
-  ++row.calibration.missed;
-  // Sparse regression, at each threshold and at BIC's: its first mapped term; the inertial term is a confounded
-  // pair by construction.
-  for (std::size_t t = 0; t < r.sparse.size(); ++t) {
-    std::vector<std::string> sf, sa;
-    for (std::size_t k = 0; k < r.sparse[t].size(); ++k) {
-      std::vector<std::string> ids;
-      std::stringstream ss(r.sparse[t][k]);
-      for (std::string id; std::getline(ss, id, '|');) ids.push_back(id);
-      if (k == 0) sf = ids;
-      sa.insert(sa.end(), ids.begin(), ids.end());
-    }
-    score(sf, sa, t < row.sparse_by_threshold.size() ? row.sparse_by_threshold[t] : row.sparse_bic);
+void count_into(Score& s, Tally t) {
+  switch (t) {
+    case Tally::named: ++s.named; break;
+    case Tally::confounded: ++s.confounded; break;
+    case Tally::missed: ++s.missed; break;
+    case Tally::mistaken: ++s.mistaken; break;
   }
 }
 
+// The sparse baseline's mapped terms as findings: "mass|rotational_inertia" (the inertial term) is a confounded pair
+// by construction; the terms carry no physical size.
+std::vector<FindingSummary> sparse_findings(const std::vector<std::string>& terms) {
+  std::vector<FindingSummary> out;
+  for (const auto& term : terms) {
+    std::vector<std::string> ids;
+    std::stringstream ss(term);
+    for (std::string id; std::getline(ss, id, '|');) ids.push_back(id);
+    out.push_back({ids.front(), std::vector<std::string>(ids.begin() + 1, ids.end()), 0.0});
+  }
+  return out;
+}
+
 }  // namespace
+
+Tally score_findings(const RowRule& rule, const std::vector<FindingSummary>& findings, bool* wrong_sign) {
+  if (wrong_sign) *wrong_sign = false;
+  auto ids_of = [](const FindingSummary& f) {
+    std::vector<std::string> ids{f.effect};
+    ids.insert(ids.end(), f.confounded_with.begin(), f.confounded_with.end());
+    return ids;
+  };
+  if (rule.group == "null") return findings.empty() ? Tally::missed : Tally::mistaken;
+  if (rule.group == "reversed") {
+    for (const auto& f : findings) {
+      if (f.effect != rule.never_called) continue;
+      if (wrong_sign) *wrong_sign = f.size < 0.0;
+      return Tally::mistaken;
+    }
+    return Tally::missed;
+  }
+  if (rule.group == "two") {
+    std::vector<std::string> all;
+    for (const auto& f : findings) merge_ids(all, ids_of(f));
+    int hit = 0;
+    for (const auto& e : rule.expected) hit += has(all, e) ? 1 : 0;
+    if (hit >= 2) return Tally::named;
+    if (hit == 1) return Tally::confounded;
+    return all.empty() ? Tally::missed : Tally::mistaken;
+  }
+  if (findings.empty() || findings.front().effect == "unexplained") return Tally::missed;
+  const FindingSummary& f = findings.front();
+  // A load that gives power back, a tyre that rolls easier cold: not the physics the name stands for.
+  if (rule.sign > 0 && f.size < 0.0 && has(rule.expected, f.effect)) {
+    if (wrong_sign) *wrong_sign = true;
+    return Tally::mistaken;
+  }
+  const std::vector<std::string> first = ids_of(f);
+  if (first.size() == 1 && has(rule.expected, f.effect)) return Tally::named;
+  for (const auto& e : rule.expected)
+    if (has(first, e)) return Tally::confounded;
+  return Tally::mistaken;
+}
 
 BenchResult run_discovery_bench(const Vehicle& vehicle, const BenchOptions& opt) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -394,14 +291,8 @@ BenchResult run_discovery_bench(const Vehicle& vehicle, const BenchOptions& opt)
       }
       const Diagnosis d = diagnose(car, recs);
       Outcome& o = out[k];
-      for (std::size_t f = 0; f < d.findings.size(); ++f) {
-        o.all.push_back(d.findings[f].effect);
-        o.all.insert(o.all.end(), d.findings[f].confounded_with.begin(), d.findings[f].confounded_with.end());
-        if (f == 0) {
-          o.first = o.all;
-          o.first_value = d.findings[f].parameters.empty() ? 0.0 : d.findings[f].parameters.front().value;
-        }
-      }
+      for (const auto& f : d.findings)
+        o.findings.push_back({f.effect, f.confounded_with, f.parameters.empty() ? 0.0 : f.parameters.front().value});
       // The sparse regression sees one trip at a time (its library has no trip-level term): every trip's terms.
       o.sparse.assign(sparse_thresholds().size() + 1, {});
       for (const auto& rec : recs) {
@@ -437,21 +328,15 @@ BenchResult run_discovery_bench(const Vehicle& vehicle, const BenchOptions& opt)
     BenchRow& row = res.rows[tasks[k].c];
     const Outcome& r = out[k];
     auto sparse_score = [&](std::size_t t) -> Score& { return t < nt ? row.sparse_by_threshold[t] : row.sparse_bic; };
-    if (c.group == "null") {
-      // Any finding (named or unexplained) is a false discovery; the baselines' too.
-      (r.first.empty() ? row.rollsim.missed : row.rollsim.mistaken)++;
-      ++row.calibration.missed;
-      for (std::size_t t = 0; t <= nt; ++t) (r.sparse[t].empty() ? sparse_score(t).missed : sparse_score(t).mistaken)++;
-    } else if (c.group == "reversed") {
-      // Only a warm-up with a positive cold excess (anywhere in the findings' first place) is calling it warm-up.
-      const bool warm = !r.first.empty() && r.first.front() == "tyre_warmup" && r.first_value > 0.0;
-      (warm ? row.rollsim.mistaken : row.rollsim.missed)++;
-      ++row.calibration.missed;
-      // The library has no time-dependent term: it cannot call anything warm-up.
-      for (std::size_t t = 0; t <= nt; ++t) ++sparse_score(t).missed;
-    } else {
-      score_one(c, r, row);
-    }
+    const RowRule rule{c.group, c.expected, c.sign, c.never_called};
+    bool wrong_sign = false;
+    count_into(row.rollsim, score_findings(rule, r.findings, &wrong_sign));
+    if (wrong_sign) ++row.rollsim_wrong_sign;
+    if (!r.findings.empty() && r.findings.front().effect == "unexplained") ++row.rollsim_unexplained;
+    // Parameter-only calibration fits scale, RRC level and CdA and can say nothing else: "nothing missing".
+    ++row.calibration.missed;
+    // Sparse regression, at each threshold and at BIC's (its library has no time term: it never calls warm-up).
+    for (std::size_t t = 0; t <= nt; ++t) count_into(sparse_score(t), score_findings(rule, sparse_findings(r.sparse[t])));
   }
   // The sparse baseline at its best threshold, chosen after scoring (an oracle choice, generous to the baseline):
   // the most effects named (alone or confounded) among thresholds whose pooled null false-discovery rate is at most
@@ -509,7 +394,9 @@ std::string bench_text(const BenchResult& r) {
         "calibration (scale, RRC level, CdA: can only say nothing missing); sparse = STLSQ on window integrals of\n"
         "{1, v, v^2, v^3, a, a v}, terms mapped 1->aux_load, v^2->wind, a->regen_limit, a v->mass|rotational_inertia,\n"
         "shown at its best threshold of the sweep (table at the end).\n"
-        "Two at once: named = both found, confounded = one found. rollsim 'missed' includes unexplained findings (unexpl.).\n\n";
+        "Two at once: named = both found, confounded = one found. rollsim 'missed' includes unexplained findings (unexpl.).\n"
+        "Where the truth's physics has a sign, the expected effect with a negative size is mistaken (neg.: how many).\n"
+        "named %: rollsim's named-alone rate with its Wilson 95 % interval.\n\n";
   const double best_threshold =
       r.sparse_summary.empty() ? 0.0 : r.sparse_summary[static_cast<std::size_t>(r.sparse_best)].threshold;
   std::string group;
@@ -523,13 +410,18 @@ std::string bench_text(const BenchResult& r) {
                                 : "Two effects at once")
          << "\n"
          << std::left << std::setw(62) << "case" << std::setw(18) << "expected" << std::right << std::setw(14) << "rollsim"
-         << std::setw(8) << "unexpl." << std::setw(12) << "calib" << std::setw(14) << ("sparse@" + num(best_threshold)) << "\n";
+         << std::setw(8) << "unexpl." << std::setw(6) << "neg." << std::setw(18) << "named % (Wilson)" << std::setw(12)
+         << "calib" << std::setw(14) << ("sparse@" + num(best_threshold)) << "\n";
     }
     std::string exp;
     for (const auto& e : row.expected) exp += (exp.empty() ? "" : "+") + e;
+    const auto [lo, hi] = wilson_interval(row.rollsim.named, row.rollsim.n());
+    std::ostringstream named;
+    named << std::fixed << std::setprecision(0) << 100.0 * row.rollsim.named / std::max(1, row.rollsim.n()) << " (" << 100 * lo
+          << "-" << 100 * hi << ")";
     os << std::left << std::setw(62) << row.label << std::setw(18) << exp << std::right << std::setw(14) << cell(row.rollsim)
-       << std::setw(8) << row.rollsim_unexplained << std::setw(12) << cell(row.calibration) << std::setw(14) << cell(row.sparse)
-       << "\n";
+       << std::setw(8) << row.rollsim_unexplained << std::setw(6) << row.rollsim_wrong_sign << std::setw(18) << named.str()
+       << std::setw(12) << cell(row.calibration) << std::setw(14) << cell(row.sparse) << "\n";
   }
   os << "\n";
   for (const auto& row : r.rows) {
@@ -541,8 +433,11 @@ std::string bench_text(const BenchResult& r) {
          << " %)\n"
          << std::defaultfloat;
     };
-    os << row.label << (row.group == "null" ? ": false discoveries\n" : ": called warm-up\n");
+    os << row.label << (row.group == "null" ? ": false discoveries\n" : " (either sign)\n");
     rate("rollsim", row.rollsim);
+    if (row.group == "reversed")
+      os << "    of which with a negative size: " << row.rollsim_wrong_sign << "; first finding unexplained: " << row.rollsim_unexplained
+         << "\n";
     rate("calib", row.calibration);
     rate("sparse", row.sparse);
   }

@@ -1,7 +1,8 @@
-#include "rollsim/common/error.hpp"
+#include "rollsim/common/format.hpp"
 
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 
 namespace rollsim {
 
@@ -11,6 +12,14 @@ std::string format_value(double value) {
   char buf[64];
   auto res = std::to_chars(buf, buf + sizeof buf, value);
   return std::string(buf, res.ptr);
+}
+
+std::string fixed(double value, int decimals) {
+  if (std::isnan(value)) return "NaN";
+  if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", decimals, value);
+  return buf;
 }
 
 }  // namespace rollsim

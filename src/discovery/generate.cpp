@@ -1,5 +1,5 @@
 // Synthetic recordings with concealed effects: each truth is a richer model than the catalogue's, on its own code.
-#include "rollsim/diagnose/generate.hpp"
+#include "rollsim/discovery/generate.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +8,7 @@
 #include "rollsim/common/error.hpp"
 #include "rollsim/common/units.hpp"
 #include "rollsim/cycle/drive_cycle.hpp"
-#include "rollsim/diagnose/diagnose.hpp"
+#include "rollsim/discovery/truths.hpp"
 #include "rollsim/sim/simulation.hpp"
 
 namespace rollsim {
@@ -230,7 +230,7 @@ std::vector<double> oil_coolant_fuel_power_w(const SimulationResult& r, double f
   std::vector<double> p(r.trace.size());
   for (std::size_t i = 0; i < r.trace.size(); ++i) {
     const double rise = oil_k < kRefK ? (std::exp(kViscosityPerK * (kRefK - oil_k)) - 1.0) / norm : 0.0;
-    p[i] = r.trace[i].fuel_rate_m3_per_s * fuel_j_per_m3 * (1.0 + cold_excess * rise);
+    p[i] = r.trace[i].segment_fuel_rate_m3_per_s * fuel_j_per_m3 * (1.0 + cold_excess * rise);
     if (i + 1 == r.trace.size()) break;
     const double dt = r.trace[i + 1].time_s - r.trace[i].time_s;
     const double loss_w = std::max(0.0, p[i] - std::max(0.0, r.trace[i].traction_power_w));
@@ -254,7 +254,7 @@ std::vector<double> soc_with_resistance(const SimulationResult& r, const Battery
     soc[i] = x;
     if (i + 1 == r.trace.size()) break;
     const double dt = r.trace[i + 1].time_s - r.trace[i].time_s;
-    const double p = r.trace[i].battery_power_w;
+    const double p = r.trace[i].segment_battery_power_w;
     const double ocv = b.open_circuit_voltage_v * (0.92 + 0.16 * std::clamp(x, 0.0, 1.0));
     const double ohm = b.internal_resistance_ohm + extra_ohm * (1.0 + 2.0 * std::pow(1.0 - std::clamp(x, 0.0, 1.0), 2));
     // Discharge root of R I^2 - OCV I + P = 0 (the smaller current); beyond the maximum power, the peak current.
@@ -295,27 +295,44 @@ double middle_stop_s(const DriveCycle& c) {
 const std::vector<ConcealedTruthInfo>& concealed_truths() {
   static const std::vector<ConcealedTruthInfo> kTruths{
       {"tyre_two_node", "tyre_warmup", "1 (cold RRC excess)",
-       "two-node (tread, carcass) heat network, convection ~ (1 + v/8)^0.8, exponential RRC law", {0.05, 0.1, 0.2, 0.3}},
-      {"aux_compressor", "aux_load", "W (mean)", "A/C compressor cycling 40 % duty (period 240-360 s) plus blower", {150, 300, 600}},
+       "two-node (tread, carcass) heat network, convection ~ (1 + v/8)^0.8, exponential RRC law", {0.05, 0.1, 0.2, 0.3},
+       SyntheticChannel::battery_power, false, +1},
+      {"aux_compressor", "aux_load", "W (mean)", "A/C compressor cycling 40 % duty (period 240-360 s) plus blower", {150, 300, 600},
+       SyntheticChannel::battery_power, false, +1},
       {"wind_gusty", "wind", "m/s (mean headwind)", "mean headwind + OU gusts (sd 1.5 m/s, 15 s) on a slowly turning road", {1.5, 3, 5}},
-      {"payload_drop", "mass", "kg (before the drop)", "payload, 60 % leaves at the mid-trip stop; rolling share ~ load^0.9", {75, 150, 300}},
-      {"rotating_parts", "rotational_inertia", "kg (equivalent)", "wheels 60 %, rotor 40 % through the reduction (gear loss both ways)", {40, 80, 160}},
-      {"magic_formula_slip", "tyre_slip", "1/kN (initial compliance)", "Pacejka sin(C atan(B s)) per tyre, saturating; braking on four tyres", {0.005, 0.01, 0.02}},
+      {"payload_drop", "mass", "kg (before the drop)", "payload, 60 % leaves at the mid-trip stop; rolling share ~ load^0.9", {75, 150, 300},
+       SyntheticChannel::battery_power, false, +1},
+      {"rotating_parts", "rotational_inertia", "kg (equivalent)", "wheels 60 %, rotor 40 % through the reduction (gear loss both ways)",
+       {40, 80, 160}, SyntheticChannel::battery_power, false, +1},
+      {"magic_formula_slip", "tyre_slip", "1/kN (initial compliance)", "Pacejka sin(C atan(B s)) per tyre, saturating; braking on four tyres",
+       {0.005, 0.01, 0.02}, SyntheticChannel::battery_power, false, +1},
       {"underinflated", "rr_speed", "bar (pressure change)", "tyre pressure lowered in the tyre model (level and speed curve change)", {-0.3, -0.6, -0.9}},
       {"regen_cap", "regen_limit", "W (regen power limit)", "the powertrain's own regen limit lowered from 20 kW", {12000, 8000, 4000}},
       {"hilly_climb", "road_grade", "1 (net grade)", "net climb plus unrecorded hills (1 % amplitude, 0.8-3 km wavelengths)", {0.002, 0.005, 0.01}},
       {"engine_oil_coolant", "engine_warmup", "1 (cold fuel excess)",
        "oil + coolant nodes heated by the fuel losses, thermostat, friction ~ exp(b (T_ref - T_oil)) (fuel channel)",
-       {0.1, 0.2, 0.4}, SyntheticChannel::fuel_rate},
+       {0.1, 0.2, 0.4}, SyntheticChannel::fuel_rate, false, +1},
       {"battery_r_of_soc", "battery_resistance", "ohm (extra at full charge)",
        "extra cell resistance rising as SOC falls, OCV(SOC), loss I^2 R (SOC channel, 0.1 % quantum)",
-       {0.05, 0.1, 0.2}, SyntheticChannel::soc},
+       {0.05, 0.1, 0.2}, SyntheticChannel::soc, false, +1},
       {"ambient_compound", "ambient_rrc", "1/K (RRC change per K at 20 degC)",
        "tyre compound law ln RRC = -c C2 dT / (C2 + dT), C2 120-180 K, c +-10 % per car, preconditioned tyres, "
-       "trips at -5..30 degC", {0.001, 0.002, 0.004, 0.008, 0.012}, SyntheticChannel::battery_power, true},
+       "trips at -5..30 degC", {0.001, 0.002, 0.004, 0.008, 0.012}, SyntheticChannel::battery_power, true, +1},
       {"ambient_cold_start", "ambient_rrc", "1/K (RRC change per K at 20 degC)",
        "the same compound law on a tyre that starts each trip at ambient and warms (one-node heat balance)",
-       {0.008}, SyntheticChannel::battery_power, true},
+       {0.008}, SyntheticChannel::battery_power, true, +1},
+      // What real roads, cars and loggers vary (issue 9), recorded through a real logger's artefacts.
+      {"rolling_hills", "road_grade", "m (hill amplitude, elevation withheld)",
+       "three hills along distance, wavelengths 0.5-3 km, amplitude ~ wavelength, peak grade <= 8 %; no elevation recorded",
+       {10, 25, 40}, SyntheticChannel::battery_power, false, 0, true},
+      {"ac_duty_cycle", "aux_load", "W (compressor on)",
+       "A/C compressor on/off, duty 0.3-0.7 and period 2-6 min per trip, each cycle +-25 %, random phase",
+       {500, 1000, 1500}, SyntheticChannel::battery_power, false, +1, true},
+      {"cabin_load", "aux_load", "W (from the start)",
+       "EV cabin conditioning: constant (half the seeds) or decaying to 30-50 % with a 5-15 min time constant",
+       {1000, 2000, 3000}, SyntheticChannel::battery_power, false, +1, true},
+      {"rising_rrc", "", "1 (RRC rise by the end)", "RRC x (1 + r (t / T)^p), p 0.7-1.5: a null for tyre warm-up",
+       {0.1, 0.2, 0.3}, SyntheticChannel::battery_power, false, 0, true, "tyre_warmup"},
   };
   return kTruths;
 }
@@ -403,6 +420,24 @@ Recording generate_case(const Vehicle& vehicle, const SyntheticCase& o) {
       auto* ep = std::get_if<ElectricPowertrainParams>(&truth_vehicle.powertrain);
       if (!ep) throw InputError("concealed truth 'regen_cap'", "needs an electric vehicle");
       ep->regen.max_power_w = std::min(ep->regen.max_power_w, e.size);
+    } else if (t == "rolling_hills") {
+      const RollingHills hills = rolling_hills(e.size, truth_rng);
+      double s = 0.0;
+      for (std::size_t i = 0; i + 1 < truth_cycle.time_s.size(); ++i) {
+        const double ds = 0.5 * (c.speed_mps[i] + c.speed_mps[i + 1]) * (c.time_s[i + 1] - c.time_s[i]);
+        truth_cycle.grade[i] += hills.grade(s + 0.5 * ds);  // the segment's grade at its middle
+        s += ds;
+      }
+    } else if (t == "ac_duty_cycle") {
+      truths.push_back(duty_cycled_ac_truth(compressor_cycles(e.size, c.duration_s(), truth_rng)));
+    } else if (t == "cabin_load") {
+      std::uniform_real_distribution<double> u01(0.0, 1.0);
+      const bool decaying = u01(truth_rng) < 0.5;
+      const double decay_s = 300.0 + 600.0 * u01(truth_rng), floor = 0.3 + 0.2 * u01(truth_rng);
+      truths.push_back(cabin_load_truth(e.size, decaying ? decay_s : 0.0, floor));
+    } else if (t == "rising_rrc") {
+      const double power = 0.7 + 0.8 * std::uniform_real_distribution<double>(0.0, 1.0)(truth_rng);
+      truths.push_back(rising_rrc_truth(e.size, c.duration_s(), power));
     } else if (t == "hilly_climb") {
       // Net grade plus three zero-mean hill components along the distance (random wavelengths and phases).
       double amp[3], len[3], ph[3];
@@ -431,7 +466,11 @@ Recording generate_case(const Vehicle& vehicle, const SyntheticCase& o) {
   Recording rec;
   rec.source = "synthetic " + c.name + " seed " + std::to_string(o.seed);
   const std::size_t n = r.trace.size();  // one point per segment start; the last sample is dropped
-  const auto lag = static_cast<std::size_t>(std::lround(std::max(0.0, o.lag_s)));
+  double lag_s = std::max(0.0, o.lag_s);
+  if (o.lag_max_s > lag_s) {
+    std::mt19937 lag_rng(o.seed * 2654435761u + 17u);  // its own stream: the noise draws stay put
+    lag_s = std::uniform_real_distribution<double>(lag_s, o.lag_max_s)(lag_rng);
+  }
   rec.time_s.assign(c.time_s.begin(), c.time_s.begin() + static_cast<long>(n));
   rec.speed_mps.assign(c.speed_mps.begin(), c.speed_mps.begin() + static_cast<long>(n));
   if (o.ambient_temp_c) {
@@ -461,13 +500,13 @@ Recording generate_case(const Vehicle& vehicle, const SyntheticCase& o) {
     const auto* cp = std::get_if<CombustionPowertrainParams>(&truth_vehicle.powertrain);
     if (!cp) throw InputError("synthetic fuel channel", "needs a combustion vehicle");
     const double j_per_m3 = cp->fuel.density_kg_per_m3 * cp->fuel.lower_heating_value_j_per_kg;
-    truth_w = oil_coolant_fuel_power_w(r, j_per_m3, engine_cold_excess);
+    truth_w = delayed(rec.time_s, oil_coolant_fuel_power_w(r, j_per_m3, engine_cold_excess), lag_s);
     std::normal_distribution<double> noise(0.0, o.fuel_noise_w);
     std::vector<double> f(n);
     for (std::size_t i = 0; i < n; ++i) {
       // Under fuel cut the injectors are shut and the ECU reports exactly zero; otherwise the reading is noisy but
       // never negative.
-      const double w = truth_w[i >= lag ? i - lag : 0];
+      const double w = truth_w[i];
       const double e = noise(rng);
       const double m3ps = w > 0.0 ? std::max(0.0, (w * scale + e) / j_per_m3) : 0.0;
       f[i] = o.fuel_quantum_m3ps > 0.0 ? o.fuel_quantum_m3ps * std::round(m3ps / o.fuel_quantum_m3ps) : m3ps;
@@ -475,14 +514,23 @@ Recording generate_case(const Vehicle& vehicle, const SyntheticCase& o) {
     rec.fuel_rate_m3ps = f;
     return rec;
   }
+  for (std::size_t i = 0; i < n; ++i) truth_w[i] = r.trace[i].segment_battery_power_w;
+  truth_w = delayed(rec.time_s, truth_w, lag_s);
   std::normal_distribution<double> noise(0.0, o.noise_w);
   std::vector<double> p(n);
   for (std::size_t i = 0; i < n; ++i) {
-    const double truth = r.trace[i >= lag ? i - lag : 0].battery_power_w * scale + noise(rng);
+    const double truth = truth_w[i] * scale + noise(rng);
     p[i] = o.quantum_w > 0.0 ? o.quantum_w * std::round(truth / o.quantum_w) : truth;
   }
   rec.battery_power_w = p;
   return rec;
+}
+
+SyntheticCase real_logger(SyntheticCase c) {
+  c.lag_s = 0.3;
+  c.lag_max_s = 1.7;
+  c.scale_jitter = 0.03;
+  return c;
 }
 
 std::vector<Recording> generate_trips(const Vehicle& vehicle, const MultiTripCase& m) {

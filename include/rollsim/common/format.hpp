@@ -1,0 +1,15 @@
+// Numbers as text: the two forms every report, table and error message uses.
+#pragma once
+
+#include <string>
+
+namespace rollsim {
+
+/// The shortest text that reads back as the same double ("0.1", "1e+308"), for input values quoted in errors
+/// and for machine-read output (CSV, JSON); "NaN", "inf", "-inf" for non-finite values.
+std::string format_value(double value);
+
+/// Fixed-point text of `value` with `decimals` digits after the point, for tables ("NaN"/"inf" for non-finite values).
+std::string fixed(double value, int decimals);
+
+}  // namespace rollsim

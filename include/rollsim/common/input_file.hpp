@@ -1,0 +1,20 @@
+// Reading an input file whole, after the checks that give each way it can be wrong its own named error.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+namespace rollsim {
+
+/// Largest YAML input (tyre, vehicle, baseline files are a few kB; the limit keeps a wrong file from
+/// filling memory inside the YAML parser).
+inline constexpr std::uintmax_t kMaxYamlFileBytes = 4u << 20;
+/// Largest CSV input (cycles, recordings). A recording takes about 600 bytes of memory per sample once
+/// loaded; recordings are also limited to kMaxRecordingSamples rows (see recording.hpp).
+inline constexpr std::uintmax_t kMaxCsvFileBytes = 256u << 20;
+
+/// The whole content of `path`. Throws InputError naming the path for each way it cannot be input: not
+/// found, a folder, not a regular file, not readable (with the system's reason), larger than `max_bytes`.
+std::string read_input_file(const std::string& path, std::uintmax_t max_bytes);
+
+}  // namespace rollsim

@@ -1,0 +1,48 @@
+// Judging tyre models on measured J2452 surfaces: one-point and full fits, baselines, leave-one-tyre-out.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "rollsim/tyre/j2452.hpp"
+#include "rollsim/tyre/tyre_model.hpp"
+
+namespace rollsim {
+
+/// How a surface's RR force scales, read from the surface: log-slopes across the grid at the reference point.
+struct SurfaceScaling {
+  double pressure_exponent = 0.0;  ///< d ln F / d ln P, 180 -> 300 kPa at 4000 N, 80 km/h
+  double load_exponent = 0.0;      ///< d ln F / d ln Z, 3 -> 6 kN at 210 kPa, 80 km/h
+  double speed_rise = 0.0;         ///< F(115 km/h) / F(15 km/h) - 1 at 210 kPa, 4000 N
+};
+
+struct TyreEvaluation {
+  std::string name;
+  // RMS (and largest) relative RRC error over the grid [-], every model scaled to the tyre at one point
+  // (210 kPa, 4000 N, 80 km/h) except the full fit.
+  double one_point_rms = 0.0;      ///< hysteresis model, shared constants fitted without this tyre
+  double one_point_max = 0.0;
+  double full_fit_rms = 0.0;       ///< hysteresis model, all six constants fitted to this tyre's grid
+  double thesis_rms = 0.0;         ///< thesis model with its constants, scaled
+  double constant_rms = 0.0;       ///< a constant RRC
+  double median_shape_rms = 0.0;   ///< median J2452 exponents and speed terms of the other tyres, scaled
+  SurfaceScaling measured, one_point, full_fit, thesis;
+  HysteresisConstants shared;      ///< the constants fitted without this tyre
+};
+
+struct J2452Evaluation {
+  std::vector<TyreEvaluation> tyres;
+  HysteresisConstants shared_all;  ///< shared constants fitted on every set (the shipped defaults)
+};
+
+/// The model tyre of a set: geometry from its size designation, thesis constants, pressure 210 kPa.
+TyreState j2452_tyre(const J2452Set& set);
+
+/// Shared constants (all but rrc_ref) minimising the one-point-fit error over `training` on the grid: each
+/// training tyre's level is set from its own reference point, as a user would with one label point.
+HysteresisConstants fit_shared_constants(const std::vector<J2452Set>& training, double drum_radius_m);
+
+/// Leave-one-tyre-out evaluation of every set, with the baselines and the all-sets shared constants.
+J2452Evaluation evaluate_j2452(const std::vector<J2452Set>& sets, double drum_radius_m);
+
+}  // namespace rollsim

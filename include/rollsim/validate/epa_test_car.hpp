@@ -1,0 +1,60 @@
+// The EPA Test Car List as rollsim reads it: one dynamometer test per row, in SI, with the test it is and what it measured.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace rollsim::validate {
+
+enum class EpaCycle { ftp75, hwfet, us06, cd_udds, cd_highway, cd_us06, sc03, cold, other };
+enum class EpaFuel { petrol, diesel, e85, electricity, hydrogen, cold_test_fuel, other };
+enum class EpaTransmission { automatic, cvt, clutch, other };
+
+/// Why a row is not simulated. `none` for a simulated row.
+enum class SkipReason {
+  none,
+  no_measured_result,     ///< RND_ADJ_FE empty
+  absurd_measured_result, ///< outside what any car of its kind achieves (e.g. 4599 mpg)
+  air_conditioning_test,  ///< SC03: no cabin or air-conditioning model
+  cold_test,              ///< Cold CO and the 20 degF charge-depleting FTP: no cold-ambient model
+  other_procedure,        ///< a test procedure rollsim does not know
+  hybrid,                 ///< hybrid or plug-in hybrid (identified by rule, see README)
+  fuel_cell,              ///< hydrogen fuel cell
+  unsupported_fuel,       ///< E85 and other fuels without properties here
+  missing_field,          ///< a field the car needs is empty or not a number
+  absurd_field,           ///< a field outside its physical range
+  simulation_failed,      ///< the model could not be evaluated (its message is the detail)
+};
+
+std::string to_string(EpaCycle c);
+std::string to_string(EpaFuel f);
+std::string to_string(SkipReason r);
+
+/// One test row, converted to SI where it is a physical quantity.
+struct EpaTestRow {
+  std::size_t line = 0;       ///< 1-based line in the file
+  std::string test_number;
+  std::string make, model, vehicle_id;
+  std::string procedure;      ///< as written
+  EpaCycle cycle = EpaCycle::other;
+  EpaFuel fuel = EpaFuel::other;
+  EpaTransmission transmission = EpaTransmission::other;
+  std::string transmission_text;
+  std::string drive_text;
+  bool all_wheel_drive = false;
+  std::optional<double> test_mass_kg;     ///< equivalent test weight
+  std::optional<double> displacement_m3;
+  std::optional<double> rated_power_w;
+  std::optional<int> gears;
+  std::optional<double> engine_radps_per_mps;  ///< N/V ratio (top gear), converted
+  std::optional<double> road_a_n, road_b_n_s_per_m, road_c_n_s2_per_m2;  ///< target coefficients
+  std::optional<double> measured;         ///< RND_ADJ_FE as published (mpg or mpge)
+  std::optional<double> bag_mpg[3];       ///< FE Bag 1..3 (FTP rows)
+};
+
+/// Reads the list (CSV with the EPA's column names). Throws InputError naming the file for a missing file or a
+/// missing column; a bad cell does not throw, it leaves the field empty so the row is skipped by name.
+std::vector<EpaTestRow> read_epa_test_car_list(const std::string& path);
+
+}  // namespace rollsim::validate

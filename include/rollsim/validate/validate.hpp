@@ -1,0 +1,64 @@
+// Every row of the EPA Test Car List simulated from its certification data and compared with its measured result.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "rollsim/validate/epa_car.hpp"
+#include "rollsim/validate/epa_test_car.hpp"
+
+namespace rollsim::validate {
+
+/// The split: a row belongs to the fitting half when the FNV-1a hash of its lower-cased "make|model" is even,
+/// so every test of one model lands on the same side and held-out rows are models the constants never saw.
+bool in_fitting_half(const EpaTestRow& row);
+
+struct RowOutcome {
+  const EpaTestRow* row = nullptr;
+  SkipReason skip = SkipReason::none;
+  std::string skip_detail;
+  bool fitting_half = false;
+  std::string powertrain;       ///< "petrol", "diesel", "E85", "electric"
+  std::string unit;             ///< "mpg" or "mpge"
+  double measured = 0.0;        ///< in `unit`
+  double predicted = 0.0;
+  /// The row's RND_ADJ_FE was read as kWh per 100 miles (electric rows below 60 "MPG", see README).
+  bool measured_from_kwh_per_100mi = false;
+  double error_pct() const { return 100.0 * (predicted / measured - 1.0); }
+};
+
+/// The constants fitted on the fitting half, with how many rows set each.
+struct FittedConstants {
+  EpaDefaults defaults;
+  std::size_t petrol_rows = 0, diesel_rows = 0, electric_rows = 0, cold_start_rows = 0;
+};
+
+struct Validation {
+  std::vector<RowOutcome> rows;   ///< one per input row, in file order
+  FittedConstants fitted;
+};
+
+/// Classifies every row (skips with reasons, hybrids by rule), simulates the rest by kinematic replay with the
+/// nominal constants, fits the four constants of EpaDefaults on the fitting half, and predicts every row with
+/// them. `threads`: 0 for the hardware's concurrency.
+Validation validate_epa_list(const std::vector<EpaTestRow>& rows, unsigned threads);
+
+/// FTP-75 fuel economy [mpg] from its bags (40 CFR 600.113): 0.43 x the cold UDDS (bags 1 + 2) and 0.57 x the hot
+/// UDDS (bags 3 + 2), weighted in gallons per mile. Bag 3 drives the same trace as bag 1.
+double ftp75_weighted_mpg(double bag1_gal, double bag2_gal, double bag3_gal, double bag1_miles, double bag2_miles);
+
+/// One line of the summary: a powertrain on a cycle, on one half (or all rows).
+struct SummaryLine {
+  std::string powertrain, cycle, half;  ///< half: "held-out", "fitting"
+  std::size_t count = 0;
+  double median_error_pct = 0.0, median_abs_error_pct = 0.0, p90_abs_error_pct = 0.0;
+};
+std::vector<SummaryLine> summarise(const Validation& v);
+
+/// Rows simulated / rows of the four simulated kinds of test (FTP-75, HWFET, US06, charge-depleting) per half.
+struct Coverage {
+  std::size_t eligible = 0, simulated = 0;
+};
+Coverage coverage(const Validation& v, bool fitting_half);
+
+}  // namespace rollsim::validate

@@ -1,0 +1,302 @@
+// `rollsim tyre fit`: a tyre's hysteresis-model constants from label points, measurements or J2452 sets.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "rollsim/common/atomic_file.hpp"
+#include "rollsim/common/csv.hpp"
+#include "rollsim/common/error.hpp"
+#include "rollsim/common/units.hpp"
+#include "rollsim/common/yaml_reader.hpp"
+#include "rollsim/report/table.hpp"
+#include "rollsim/tyre/j2452.hpp"
+#include "rollsim/tyre/j2452_evaluation.hpp"
+#include "rollsim/tyre/tyre_fit.hpp"
+#include "rollsim/tyre/tyre_spec.hpp"
+
+namespace rollsim::cli {
+namespace {
+
+struct FitOptions {
+  std::string size, label, j2452, measured, output, name, pressure_bar, free, uncertainty_pct, drum_radius_m;
+  std::vector<std::string> points;
+  std::string evaluate_j2452;
+};
+
+double number_in(const std::string& text, const std::string& where, const std::string& what) {
+  const auto v = parse_number(text);
+  if (!v || !std::isfinite(*v)) throw InputError(where, what + " '" + text + "' is not a number");
+  return *v;
+}
+
+std::vector<std::string> split(const std::string& text, char sep) {
+  std::vector<std::string> out;
+  std::stringstream ss(text);
+  for (std::string cell; std::getline(ss, cell, sep);) out.push_back(trim(cell));
+  return out;
+}
+
+// --point KPA,LOAD_N,KMH,RRC, or --point RRC at the size's ISO 28580 conditions.
+RrcPoint parse_point(const std::string& text, const TyreSize& size) {
+  const std::string where = "--point " + text;
+  const auto f = split(text, ',');
+  if (f.size() == 1) return iso28580_point(size, number_in(f[0], where, "RRC"), where);
+  if (f.size() != 4) {
+    throw InputError(where, "expected KPA,LOAD_N,KMH,RRC (e.g. 210,4000,80,0.0085) or RRC alone (ISO 28580 conditions)");
+  }
+  return {number_in(f[0], where, "pressure [kPa]") * 1e3, number_in(f[1], where, "load [N]"),
+          units::kmh_to_mps(number_in(f[2], where, "speed [km/h]")), number_in(f[3], where, "RRC"), where};
+}
+
+std::vector<RrcPoint> read_measured(const std::string& path) {
+  const CsvTable t = read_csv(path);
+  const char* kCols[] = {"pressure_kpa", "load_n", "speed_kmh", "rrc"};
+  std::size_t col[4];
+  for (int k = 0; k < 4; ++k) {
+    const auto c = t.column(kCols[k]);
+    if (!c) {
+      throw InputError(path, std::string("missing column '") + kCols[k] +
+                                 "'; expected pressure_kpa, load_n, speed_kmh, rrc; found " + t.columns_list());
+    }
+    col[k] = *c;
+  }
+  std::vector<RrcPoint> out;
+  for (std::size_t i = 0; i < t.rows.size(); ++i) {
+    double v[4];
+    for (int k = 0; k < 4; ++k) v[k] = number_in(t.rows[i][col[k]], t.where(i, col[k]), kCols[k]);
+    out.push_back({v[0] * 1e3, v[1], units::kmh_to_mps(v[2]), v[3], path + ": line " + std::to_string(t.row_line[i])});
+  }
+  if (out.empty()) throw InputError(path, "too few points for what is asked: the file has no data rows");
+  return out;
+}
+
+std::vector<HysteresisParam> parse_free(const std::string& text) {
+  std::vector<HysteresisParam> out;
+  if (text.empty()) return out;
+  for (const auto& key : split(text, ',')) {
+    const auto p = hysteresis_param_from_key(key);
+    if (!p) {
+      throw InputError("--free " + text, "'" + key + "' is not a constant of the hysteresis model; allowed: rrc_ref, "
+                                         "frequency_slope_per_hz, deflection_exponent, load_exponent, "
+                                         "speed_loss_rrc_per_hz2, speed_loss_load_exponent");
+    }
+    out.push_back(*p);
+  }
+  if (out.front() != HysteresisParam::RrcRef && std::find(out.begin(), out.end(), HysteresisParam::RrcRef) == out.end()) {
+    out.insert(out.begin(), HysteresisParam::RrcRef);  // the level is always the tyre's own
+  }
+  return out;
+}
+
+std::string pct(double x, int d = 2) { return report::fixed(x * 100.0, d); }
+
+void print_fit(const TyreFit& fit, const std::optional<LabelBand>& band, const std::optional<RrcPoint>& iso) {
+  report::TextTable t({"constant", "value", "95 % low", "95 % high", "note"});
+  t.set_left_aligned(0);
+  t.set_left_aligned(4);
+  auto g = [](double v) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%.4g", v);
+    return std::string(b);
+  };
+  for (const auto& e : fit.params) {
+    t.add_row({hysteresis_param_key(e.param), g(e.value), e.at_bound ? "-" : g(e.low95), e.at_bound ? "-" : g(e.high95),
+               e.at_bound ? "fitted below 0: held at 0" : "fitted"});
+  }
+  for (auto p : fit.held) {
+    t.add_row({hysteresis_param_key(p), g(hysteresis_param_value(fit.tyre.hysteresis, p)), "-", "-", "shared (J2452 sets)"});
+  }
+  std::cout << "Hysteresis model fitted to " << fit.residuals.size() << " point(s), " << fit.params.size()
+            << " constant(s) free; intervals from the Jacobian with " << pct(fit.sigma_relative) << " % relative scatter ("
+            << (fit.sigma_from_residuals ? "from the residuals" : "assumed: no degrees of freedom left") << ")\n"
+            << t.render();
+  std::cout << "residuals: RMS " << pct(fit.rms_relative_error) << " %";
+  double worst = 0.0;
+  std::size_t iw = 0;
+  for (std::size_t i = 0; i < fit.residuals.size(); ++i) {
+    if (std::abs(fit.residuals[i].relative_error) > worst) worst = std::abs(fit.residuals[i].relative_error), iw = i;
+  }
+  std::cout << ", largest " << pct(worst) << " % (" << fit.residuals[iw].point.where << ")\n";
+  if (fit.residuals.size() <= 12) {
+    report::TextTable r({"point", "p [kPa]", "load [N]", "speed [km/h]", "RRC x1000", "model x1000", "error %"});
+    r.set_left_aligned(0);
+    for (const auto& x : fit.residuals) {
+      r.add_row({x.point.where, report::fixed(x.point.pressure_pa / 1e3, 0), report::fixed(x.point.load_n, 0),
+                 report::fixed(units::mps_to_kmh(x.point.speed_mps), 1), report::fixed(x.point.rrc * 1e3, 3),
+                 report::fixed(x.model_rrc * 1e3, 3), pct(x.relative_error)});
+    }
+    std::cout << r.render();
+  }
+  if (band && iso) {
+    TyreState at = fit.tyre;
+    at.pressure_pa = iso->pressure_pa;
+    const double rrc = evaluate_rolling_resistance(at, iso->load_n, iso->speed_mps).rrc;
+    const bool inside = rrc >= band->rrc_min && rrc <= band->rrc_max;
+    std::cout << "EU label class " << band->label_class << " (C1, Regulation (EU) 2020/740): RRC "
+              << report::fixed(band->rrc_min * 1e3, 2) << (band->open_below ? " (open below)" : "") << " - "
+              << report::fixed(band->rrc_max * 1e3, 2) << (band->open_above ? " (open above)" : "")
+              << " kg/t; the fitted tyre at ISO 28580 conditions: " << report::fixed(rrc * 1e3, 2) << " kg/t, "
+              << (inside ? "inside" : "OUTSIDE") << " the band\n";
+  }
+}
+
+void run_evaluate(const std::string& path, const std::string& drum_text) {
+  const double drum = drum_text.empty() ? kJ2452DrumRadius_m : number_in(drum_text, "--drum-radius-m", "drum radius");
+  const auto sets = load_j2452_csv(path);
+  if (sets.size() < 3) throw InputError(path, "too few sets for leave-one-tyre-out: need 3 or more");
+  const J2452Evaluation ev = evaluate_j2452(sets, drum);
+  std::cout << "RMS relative RRC error over 180-300 kPa x 3-6 kN x 15-115 km/h (150 points), %; one point = 210 kPa, "
+               "4000 N, 80 km/h; shared constants fitted leave-one-tyre-out\n";
+  report::TextTable t({"tyre", "one-point", "max", "full fit", "thesis", "constant", "median J2452", "p exp meas",
+                       "p exp 1pt", "p exp full", "Z exp meas", "Z exp 1pt", "Z exp full", "rise meas %",
+                       "rise 1pt %", "rise full %"});
+  t.set_left_aligned(0);
+  std::vector<double> cols[6];
+  for (const auto& e : ev.tyres) {
+    t.add_row({e.name, pct(e.one_point_rms), pct(e.one_point_max), pct(e.full_fit_rms), pct(e.thesis_rms, 1),
+               pct(e.constant_rms, 1), pct(e.median_shape_rms), report::fixed(e.measured.pressure_exponent, 3),
+               report::fixed(e.one_point.pressure_exponent, 3), report::fixed(e.full_fit.pressure_exponent, 3),
+               report::fixed(e.measured.load_exponent, 3), report::fixed(e.one_point.load_exponent, 3),
+               report::fixed(e.full_fit.load_exponent, 3), pct(e.measured.speed_rise, 1), pct(e.one_point.speed_rise, 1),
+               pct(e.full_fit.speed_rise, 1)});
+    const double v[6] = {e.one_point_rms, e.one_point_max, e.full_fit_rms, e.thesis_rms, e.constant_rms, e.median_shape_rms};
+    for (int k = 0; k < 6; ++k) cols[k].push_back(v[k]);
+  }
+  auto median = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+  };
+  auto worst = [](const std::vector<double>& v) { return *std::max_element(v.begin(), v.end()); };
+  std::vector<std::string> med{"median"}, wst{"worst"};
+  for (int k = 0; k < 6; ++k) {
+    med.push_back(pct(median(cols[k]), k >= 3 && k <= 4 ? 1 : 2));
+    wst.push_back(pct(worst(cols[k]), k >= 3 && k <= 4 ? 1 : 2));
+  }
+  for (int k = 0; k < 9; ++k) med.push_back(""), wst.push_back("");
+  t.add_row(med);
+  t.add_row(wst);
+  std::cout << t.render();
+  std::cout << "thesis model's own exponents (scaled): pressure " << report::fixed(ev.tyres.front().thesis.pressure_exponent, 3)
+            << ", load " << report::fixed(ev.tyres.front().thesis.load_exponent, 3) << ", rise "
+            << pct(ev.tyres.front().thesis.speed_rise, 1) << " % (" << ev.tyres.front().name << ")\n";
+  std::cout << "\nShared constants fitted on all " << sets.size() << " sets and, leave-one-tyre-out, without each:\n";
+  report::TextTable s({"fitted without", "frequency_slope_per_hz", "deflection_exponent", "load_exponent",
+                       "speed_loss_rrc_per_hz2", "speed_loss_load_exponent"});
+  s.set_left_aligned(0);
+  auto row = [&](const std::string& name, const HysteresisConstants& c) {
+    char b[5][32];
+    std::snprintf(b[0], 32, "%.5g", c.frequency_slope_per_hz);
+    std::snprintf(b[1], 32, "%.5g", c.deflection_exponent);
+    std::snprintf(b[2], 32, "%.5g", c.load_exponent);
+    std::snprintf(b[3], 32, "%.5g", c.speed_loss_rrc_per_hz2);
+    std::snprintf(b[4], 32, "%.5g", c.speed_loss_load_exponent);
+    s.add_row({name, b[0], b[1], b[2], b[3], b[4]});
+  };
+  row("(none: all sets)", ev.shared_all);
+  for (const auto& e : ev.tyres) row(e.name, e.shared);
+  std::cout << s.render();
+}
+
+void run_fit(const FitOptions& o) {
+  if (!o.evaluate_j2452.empty()) return run_evaluate(o.evaluate_j2452, o.drum_radius_m);
+  if (o.size.empty()) throw InputError("--size", "missing: the tyre's size designation, e.g. \"205/55 R16 91V\"");
+  if (o.output.empty()) throw InputError("--output", "missing: the tyre file to write, e.g. --output my-tyre.yaml");
+  const TyreSize size = parse_tyre_size(o.size, "--size");
+  TyreState start;
+  start.geometry.outer_radius_m = size.outer_radius_m;
+  start.geometry.section_width_m = size.section_width_m;
+  start.geometry.rim_radius_m = size.rim_diameter_m / 2.0;
+
+  FitRequest request;
+  std::optional<LabelBand> band;
+  std::optional<RrcPoint> iso;  // where the label's band applies
+  if (!o.label.empty()) {
+    band = eu_label_band_c1(o.label, "--label " + o.label);
+    iso = iso28580_point(size, band->rrc_mid(), "--label " + o.label);
+  }
+  for (const auto& p : o.points) request.points.push_back(parse_point(p, size));
+  if (!o.measured.empty()) {
+    for (auto& p : read_measured(o.measured)) request.points.push_back(p);
+  }
+  if (!o.j2452.empty()) {
+    J2452Set set = parse_j2452_text(o.j2452, "--j2452 " + o.j2452);
+    set.rolling_radius_m = size.outer_radius_m;
+    const double drum = o.drum_radius_m.empty() ? kJ2452DrumRadius_m
+                                                : number_in(o.drum_radius_m, "--drum-radius-m", "drum radius");
+    if (!(drum > 0.1 && drum < 10.0)) throw InputError("--drum-radius-m", "must be in (0.1, 10) m");
+    for (auto& p : sample_j2452(set, j2452_grid(), drum, "--j2452 grid")) request.points.push_back(p);
+  }
+  // A label alone is one point at ISO conditions, at the band's middle, with the band as its uncertainty
+  // (uniform over the band: half-width / sqrt(3)).
+  if (band && request.points.empty()) {
+    request.points.push_back(*iso);
+    request.assumed_relative_uncertainty = 0.5 * (band->rrc_max - band->rrc_min) / band->rrc_mid() / std::sqrt(3.0);
+  }
+  if (!o.uncertainty_pct.empty()) {
+    const double u = number_in(o.uncertainty_pct, "--rrc-uncertainty-pct", "uncertainty");
+    if (!(u > 0.0 && u <= 50.0)) throw InputError("--rrc-uncertainty-pct " + o.uncertainty_pct, "must be in (0, 50]");
+    request.assumed_relative_uncertainty = u / 100.0;
+  }
+  request.free = parse_free(o.free);
+  const TyreFit fit = fit_hysteresis(start, request);
+
+  FittedTyreFile file;
+  file.name = o.name.empty() ? std::filesystem::path(o.output).stem().string() : o.name;
+  file.size = o.size;
+  file.pressure_pa = o.pressure_bar.empty() ? (size.extra_load ? 250e3 : 210e3)
+                                            : units::bar_to_pa(number_in(o.pressure_bar, "--pressure-bar", "pressure"));
+  if (!(file.pressure_pa >= 0.5e5 && file.pressure_pa <= 6e5)) throw InputError("--pressure-bar", "must be in [0.5, 6] bar");
+  std::string src = "rollsim tyre fit";
+  if (!o.points.empty()) src += ", " + std::to_string(o.points.size()) + " --point";
+  if (!o.measured.empty()) src += ", --measured " + o.measured;
+  if (!o.j2452.empty()) src += ", --j2452 " + o.j2452;
+  if (!o.label.empty()) src += ", --label " + o.label;
+  file.source = src;
+  print_fit(fit, band, iso);
+  write_file_atomically(o.output, "--output", [&](std::ostream& out) { write_fitted_tyre_yaml(out, file, fit); });
+  std::cout << "wrote " << o.output << "\n";
+}
+
+}  // namespace
+
+void register_tyre_fit_command(CLI::App& tyre) {
+  auto o = std::make_shared<FitOptions>();
+  CLI::App* sub = tyre.add_subcommand(
+      "fit", "Fit a tyre's hysteresis-model constants to label points, measurements or a J2452 set; write a tyre file");
+  sub->add_option("--size", o->size, "Size designation, e.g. \"205/55 R16 91V\" (load index needed for ISO points)")
+      ->type_name("SIZE");
+  sub->add_option("--point", o->points, "Measured point KPA,LOAD_N,KMH,RRC, or RRC alone at ISO 28580 conditions; "
+                                        "repeatable")
+      ->type_name("P,Z,V,RRC")
+      ->take_all();
+  sub->add_option("--measured", o->measured, "CSV with columns pressure_kpa, load_n, speed_kmh, rrc")->type_name("FILE");
+  sub->add_option("--j2452", o->j2452, "SAE J2452 set: F[N] = P[kPa]^ALPHA Z[N]^BETA (A + B V + C V^2), V in km/h, "
+                                       "on a drum; sampled on the 150-point grid, corrected to a flat road")
+      ->type_name("ALPHA,BETA,A,B,C");
+  sub->add_option("--drum-radius-m", o->drum_radius_m, "Drum radius of the J2452 test (default 0.85)")->type_name("M");
+  sub->add_option("--label", o->label, "EU tyre label fuel-efficiency class A-E (C1): its RRC band")->type_name("CLASS");
+  sub->add_option("--free", o->free, "Constants to fit (comma list; default: what the points determine)")
+      ->type_name("LIST");
+  sub->add_option("--rrc-uncertainty-pct", o->uncertainty_pct,
+                  "Relative scatter of a point for intervals when no degrees of freedom are left (default 2)")
+      ->type_name("PCT");
+  sub->add_option("--pressure-bar", o->pressure_bar, "Inflation pressure written to the file (default: ISO 28580's)")
+      ->type_name("BAR");
+  sub->add_option("--name", o->name, "Name in the tyre file (default: the output's file name)");
+  sub->add_option("--output", o->output, "Tyre file to write")->type_name("T.yaml");
+  sub->add_option("--evaluate-j2452", o->evaluate_j2452,
+                  "Instead of fitting: judge the model on a CSV of J2452 sets, leave-one-tyre-out, with baselines")
+      ->type_name("FILE");
+  sub->callback([o] { run_fit(*o); });
+}
+
+}  // namespace rollsim::cli

@@ -1,0 +1,158 @@
+// `rollsim validate`: the EPA Test Car List simulated row by row and compared with its measured results.
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <string>
+
+#include "commands.hpp"
+#include "rollsim/report/gnuplot.hpp"
+#include "rollsim/report/table.hpp"
+#include "rollsim/validate/validate.hpp"
+#include "selection_cli.hpp"
+
+namespace rollsim::cli {
+namespace {
+
+struct ValidateOptionsText {
+  std::string list, plot, threads;
+  bool json = false;
+};
+
+// Any text as a gnuplot single-quoted string: nothing expands inside single quotes; a quote is doubled and a
+// control character (which would end the command) becomes a space.
+std::string gnuplot_quoted(const std::string& text) {
+  std::string o = "'";
+  for (const char c : text) {
+    const auto u = static_cast<unsigned char>(c);
+    if (c == '\'') o += "''";
+    else if (u < 0x20 || u == 0x7f) o += ' ';
+    else o += c;
+  }
+  return o + "'";
+}
+
+report::JsonObject row_json(const validate::RowOutcome& o) {
+  const auto& r = *o.row;
+  report::JsonObject j;
+  j.add("test_number", r.test_number).add("make", r.make).add("model", r.model).add("fuel", o.powertrain);
+  j.add("cycle", validate::to_string(r.cycle)).add("procedure", r.procedure).add("line", static_cast<int>(r.line));
+  j.add("half", o.fitting_half ? "fitting" : "held-out");
+  if (o.skip != validate::SkipReason::none) {
+    j.add("skipped", validate::to_string(o.skip) + (o.skip_detail.empty() ? "" : ": " + o.skip_detail));
+    return j;
+  }
+  j.add("measured", o.measured).add("predicted", o.predicted).add("unit", o.unit).add("error_pct", o.error_pct());
+  if (o.measured_from_kwh_per_100mi) j.add("measured_read_as", "kWh/100 mi");
+  return j;
+}
+
+void print_summary(const validate::Validation& v) {
+  const auto& f = v.fitted;
+  std::cout << "EPA Test Car List: " << v.rows.size() << " rows; split by the hash of make|model: fitting half sets "
+            << "the constants, held-out half judges them\n";
+  std::cout << "fitted on the fitting half: petrol indicated efficiency " << report::fixed(f.defaults.petrol_indicated_efficiency, 3)
+            << " (" << f.petrol_rows << " rows), diesel " << report::fixed(f.defaults.diesel_indicated_efficiency, 3) << " ("
+            << f.diesel_rows << " rows), charge efficiency " << report::fixed(f.defaults.charge_efficiency, 3) << " ("
+            << f.electric_rows << " rows), cold-start fuel excess " << report::fixed(f.defaults.cold_fuel_excess, 3) << " ("
+            << f.cold_start_rows << " FTPs' bag 1 vs bag 3)\n";
+  for (const bool fitting : {false, true}) {
+    const auto c = validate::coverage(v, fitting);
+    std::cout << (fitting ? "fitting" : "held-out") << ": simulated " << c.simulated << " of " << c.eligible
+              << " FTP-75, HWFET, US06 and charge-depleting rows ("
+              << report::fixed(c.eligible ? 100.0 * static_cast<double>(c.simulated) / static_cast<double>(c.eligible) : 0.0, 1)
+              << " %)\n";
+  }
+  report::TextTable t({"powertrain", "cycle", "half", "count", "median err %", "median |err| %", "p90 |err| %"});
+  t.set_left_aligned(0);
+  t.set_left_aligned(1);
+  t.set_left_aligned(2);
+  auto lines = validate::summarise(v);
+  std::stable_sort(lines.begin(), lines.end(), [](const auto& a, const auto& b) { return a.half > b.half; });
+  for (const auto& s : lines) {
+    t.add_row({s.powertrain, s.cycle, s.half, std::to_string(s.count), report::fixed(s.median_error_pct, 1),
+               report::fixed(s.median_abs_error_pct, 1), report::fixed(s.p90_abs_error_pct, 1)});
+  }
+  std::cout << t.render();
+  std::map<std::string, std::size_t> skipped;
+  for (const auto& o : v.rows) {
+    if (o.skip != validate::SkipReason::none) ++skipped[validate::to_string(o.skip)];
+  }
+  std::cout << "skipped:\n";
+  for (const auto& [why, n] : skipped) std::cout << "  " << n << "  " << why << "\n";
+}
+
+// Predicted against measured, one series per powertrain, with the line of perfect agreement.
+void plot(const validate::Validation& v, const std::string& file) {
+  namespace fs = std::filesystem;
+  const std::string ext = fs::path(file).extension().string();
+  if (ext != ".svg") throw InputError("--plot " + file, "must end in .svg");
+  const std::string gnuplot = report::find_gnuplot();
+  if (gnuplot.empty()) throw InputError("--plot " + file, "gnuplot is not installed or not on PATH (Debian: apt-get install gnuplot-nox)");
+  const fs::path target(file);
+  const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec) || access(dir.c_str(), W_OK) != 0) throw InputError("--plot " + file, "cannot write here (folder missing or not writable)");
+  const fs::path work = fs::temp_directory_path() / ("rollsim_validate_" + std::to_string(getpid()));
+  fs::create_directories(work);
+  std::map<std::string, std::ofstream> series;
+  for (const auto& o : v.rows) {
+    if (o.skip != validate::SkipReason::none) continue;
+    const std::string name = o.powertrain + " (" + o.unit + ")";
+    if (!series.count(name)) series.emplace(name, std::ofstream(work / ("s" + std::to_string(series.size()) + ".dat")));
+    series[name] << o.measured << " " << o.predicted << "\n";
+  }
+  const fs::path tmp_out = dir / ("." + target.filename().string() + ".tmp" + std::to_string(getpid()) + ext);
+  std::ofstream gp(work / "plot.gp");
+  gp << "set terminal svg size 800,700 dynamic font 'Sans,12'\nset termoption noenhanced\n"
+     << "set output " << gnuplot_quoted(tmp_out.string()) << "\n"
+     << "set title 'EPA Test Car List 2022: rollsim from certification data against the dynamometer'\n"
+     << "set xlabel 'measured [mpg or mpge]'\nset ylabel 'predicted [mpg or mpge]'\n"
+     << "set logscale xy\nset grid\nset key top left\nset size square\n";
+  gp << "plot x title 'predicted = measured' lc rgb 'black'";
+  std::size_t i = 0;
+  for (auto& [name, out] : series) {
+    out.close();
+    gp << ", " << gnuplot_quoted((work / ("s" + std::to_string(i++) + ".dat")).string()) << " with points pt 7 ps 0.4 title "
+       << gnuplot_quoted(name);
+  }
+  gp << "\n";
+  gp.close();
+  const std::string err = report::run_gnuplot_script(gnuplot, (work / "plot.gp").string());
+  if (err.empty()) fs::rename(tmp_out, target, ec);
+  fs::remove(tmp_out);
+  fs::remove_all(work);
+  if (!err.empty()) throw InputError("--plot " + file, "gnuplot failed: " + err);
+  if (ec) throw InputError("--plot " + file, "cannot replace the file: " + ec.message());
+}
+
+void run_validate(const ValidateOptionsText& o) {
+  if (o.list.empty()) throw InputError("--epa-test-car-list", "missing: give the EPA Test Car List CSV");
+  unsigned threads = 0;
+  if (!o.threads.empty()) threads = static_cast<unsigned>(parse_option_number(o.threads, "--threads", Range::closed(1, 1024)));
+  const auto rows = validate::read_epa_test_car_list(o.list);
+  const auto v = validate::validate_epa_list(rows, threads);
+  if (!o.plot.empty()) plot(v, o.plot);
+  if (o.json) {
+    for (const auto& r : v.rows) std::cout << row_json(r).str() << "\n";
+    return;
+  }
+  print_summary(v);
+}
+
+}  // namespace
+
+void register_validate_command(CLI::App& app) {
+  auto o = std::make_shared<ValidateOptionsText>();
+  auto* sub = app.add_subcommand("validate", "Simulate every car of the EPA Test Car List from its certification data and compare with its measured result");
+  sub->add_option("--epa-test-car-list", o->list, "EPA Test Car List CSV (e.g. ../shared/data/vehicles/epa_test_car_list_2022_part.csv)")->type_name("FILE");
+  sub->add_flag("--json", o->json, "One JSON object per row instead of the summary");
+  sub->add_option("--plot", o->plot, "Draw predicted against measured (gnuplot, .svg)")->type_name("FILE");
+  sub->add_option("--threads", o->threads, "Worker threads (default: every core)")->type_name("N");
+  sub->callback([o] { run_validate(*o); });
+}
+
+}  // namespace rollsim::cli

@@ -1,0 +1,34 @@
+#include "rollsim/common/input_file.hpp"
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "rollsim/common/error.hpp"
+
+namespace rollsim {
+
+std::string read_input_file(const std::string& path, std::uintmax_t max_bytes) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::file_status st = fs::status(path, ec);
+  if (st.type() == fs::file_type::not_found) throw InputError(path, "file not found");
+  if (ec) throw InputError(path, "cannot be read: " + ec.message());
+  if (st.type() == fs::file_type::directory) throw InputError(path, "is a folder; a file is expected here");
+  if (st.type() != fs::file_type::regular) throw InputError(path, "is not a regular file (a device, pipe or socket?)");
+  const std::uintmax_t size = fs::file_size(path, ec);
+  if (!ec && size > max_bytes) {
+    throw InputError(path, "is " + std::to_string(size >> 20) + " MiB; files of this kind are limited to " +
+                               std::to_string(max_bytes >> 20) + " MiB");
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, std::string("cannot be read: ") + std::strerror(errno));
+  std::ostringstream buf;
+  buf << in.rdbuf();
+  if (in.bad()) throw InputError(path, std::string("reading failed: ") + std::strerror(errno));
+  return buf.str();
+}
+
+}  // namespace rollsim

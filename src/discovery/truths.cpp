@@ -1,0 +1,141 @@
+// Concealed truths that real roads, cars and loggers vary: rolling hills, duty-cycled and cabin loads, rising RRC, lag.
+#include "rollsim/discovery/truths.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace rollsim {
+namespace {
+
+constexpr double kTwoPi = 6.283185307179586;
+
+class DutyCycledAcTruth final : public Effect {
+ public:
+  explicit DutyCycledAcTruth(DutyCycle s) : s_(std::move(s)) {}
+  std::string id() const override { return "truth_duty_cycled_ac"; }
+  double extra_electric_power_w(const EffectInputs& in, const double*) const override { return s_.power_w(in.time_s); }
+
+ private:
+  DutyCycle s_;
+};
+
+class CabinLoadTruth final : public Effect {
+ public:
+  CabinLoadTruth(double initial_w, double decay_s, double floor) : p0_(initial_w), tau_(decay_s), floor_(floor) {}
+  std::string id() const override { return "truth_cabin_load"; }
+  double extra_electric_power_w(const EffectInputs& in, const double*) const override {
+    if (tau_ <= 0.0) return p0_;
+    return p0_ * (floor_ + (1.0 - floor_) * std::exp(-std::max(0.0, in.time_s) / tau_));
+  }
+
+ private:
+  double p0_, tau_, floor_;
+};
+
+class RisingRrcTruth final : public Effect {
+ public:
+  RisingRrcTruth(double rise, double duration_s, double power) : rise_(rise), t_(duration_s), p_(power) {}
+  std::string id() const override { return "truth_rising_rrc"; }
+  double rolling_resistance_factor(const EffectInputs& in, const double*) const override {
+    return 1.0 + rise_ * std::pow(std::clamp(in.time_s / t_, 0.0, 1.0), p_);
+  }
+
+ private:
+  double rise_, t_, p_;
+};
+
+}  // namespace
+
+double RollingHills::elevation_m(double s) const {
+  double h = 0.0;
+  for (std::size_t k = 0; k < amplitude_m.size(); ++k) h += amplitude_m[k] * std::sin(kTwoPi * s / wavelength_m[k] + phase_rad[k]);
+  return h;
+}
+
+double RollingHills::grade(double s) const {
+  double g = 0.0;
+  for (std::size_t k = 0; k < amplitude_m.size(); ++k)
+    g += amplitude_m[k] * kTwoPi / wavelength_m[k] * std::cos(kTwoPi * s / wavelength_m[k] + phase_rad[k]);
+  return g;
+}
+
+RollingHills rolling_hills(double amplitude_m, std::mt19937& rng, double max_grade) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  RollingHills h;
+  double norm2 = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    h.wavelength_m.push_back(500.0 * std::pow(6.0, u(rng)));  // log-uniform 0.5-3 km
+    h.phase_rad.push_back(kTwoPi * u(rng));
+    norm2 += h.wavelength_m.back() * h.wavelength_m.back();
+  }
+  double peak_grade = 0.0;
+  for (double l : h.wavelength_m) {
+    h.amplitude_m.push_back(amplitude_m * l / std::sqrt(norm2));
+    peak_grade += h.amplitude_m.back() * kTwoPi / l;
+  }
+  if (peak_grade > max_grade)
+    for (double& l : h.wavelength_m) l *= peak_grade / max_grade;
+  return h;
+}
+
+double DutyCycle::power_w(double t) const {
+  // The first interval ending after t; on if it has begun.
+  const auto it = std::upper_bound(on_until_s.begin(), on_until_s.end(), t);
+  if (it == on_until_s.end()) return 0.0;
+  return t >= on_from_s[static_cast<std::size_t>(it - on_until_s.begin())] ? on_power_w : 0.0;
+}
+
+double DutyCycle::mean_power_w(double duration_s) const {
+  double on = 0.0;
+  for (std::size_t k = 0; k < on_from_s.size(); ++k)
+    on += std::max(0.0, std::min(on_until_s[k], duration_s) - std::max(on_from_s[k], 0.0));
+  return duration_s > 0.0 ? on_power_w * on / duration_s : 0.0;
+}
+
+DutyCycle compressor_cycles(double on_power_w, double duration_s, std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const double duty = 0.3 + 0.4 * u(rng), period = 120.0 + 240.0 * u(rng);
+  DutyCycle d;
+  d.on_power_w = on_power_w;
+  double t = -period * u(rng);  // a random phase: the first cycle began before the trip
+  while (t < duration_s) {
+    const double p = period * (0.75 + 0.5 * u(rng));
+    d.on_from_s.push_back(t);
+    d.on_until_s.push_back(t + duty * p);
+    t += p;
+  }
+  return d;
+}
+
+std::shared_ptr<const Effect> duty_cycled_ac_truth(DutyCycle schedule) { return std::make_shared<DutyCycledAcTruth>(std::move(schedule)); }
+
+std::shared_ptr<const Effect> cabin_load_truth(double initial_w, double decay_s, double floor) {
+  return std::make_shared<CabinLoadTruth>(initial_w, decay_s, floor);
+}
+
+std::shared_ptr<const Effect> rising_rrc_truth(double rise, double duration_s, double power) {
+  return std::make_shared<RisingRrcTruth>(rise, duration_s, power);
+}
+
+std::vector<double> delayed(const std::vector<double>& time_s, const std::vector<double>& x, double lag_s) {
+  std::vector<double> out(x.size());
+  std::size_t j = 0;  // x's interval [j, j + 1] holding t - lag, advancing with i
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const double t = time_s[i] - lag_s;
+    if (t <= time_s.front()) {
+      out[i] = x.front();
+      continue;
+    }
+    while (j + 1 < x.size() && time_s[j + 1] <= t) ++j;
+    if (j + 1 >= x.size()) {
+      out[i] = x.back();
+      continue;
+    }
+    const double f = (t - time_s[j]) / (time_s[j + 1] - time_s[j]);
+    out[i] = (1.0 - f) * x[j] + f * x[j + 1];
+  }
+  return out;
+}
+
+}  // namespace rollsim

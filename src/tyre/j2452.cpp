@@ -1,0 +1,92 @@
+#include "rollsim/tyre/j2452.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include "rollsim/common/csv.hpp"
+#include "rollsim/common/error.hpp"
+#include "rollsim/common/units.hpp"
+
+namespace rollsim {
+
+double drum_to_flat_factor(double drum_radius_m, double tyre_radius_m) {
+  return std::sqrt(drum_radius_m / (drum_radius_m + tyre_radius_m));
+}
+
+double j2452_flat_rrc(const J2452Set& s, double pressure_pa, double load_n, double speed_mps, double drum_radius_m) {
+  const double p_kpa = pressure_pa / 1e3;
+  const double v_kmh = units::mps_to_kmh(speed_mps);
+  const double drum_force_n = std::pow(p_kpa, s.alpha) * std::pow(load_n, s.beta) * (s.a + v_kmh * (s.b + v_kmh * s.c));
+  return drum_force_n * drum_to_flat_factor(drum_radius_m, s.rolling_radius_m) / load_n;
+}
+
+J2452Set parse_j2452_text(const std::string& text, const std::string& where) {
+  static const char* kNames[] = {"ALPHA", "BETA", "A", "B", "C"};
+  std::vector<std::string> cells;
+  std::stringstream ss(text);
+  for (std::string cell; std::getline(ss, cell, ',');) cells.push_back(cell);
+  if (cells.size() != 5) {
+    throw InputError(where, "'" + text + "' has " + std::to_string(cells.size()) +
+                                " fields: expected ALPHA,BETA,A,B,C (P in kPa, Z in N, V in km/h, F in N)");
+  }
+  double v[5];
+  for (int i = 0; i < 5; ++i) {
+    const auto x = parse_number(cells[i]);
+    if (!x || !std::isfinite(*x)) throw InputError(where, std::string(kNames[i]) + " '" + cells[i] + "' is not a number");
+    v[i] = *x;
+  }
+  J2452Set s{"--j2452", "", v[0], v[1], v[2], v[3], v[4], 0.0};
+  if (!(s.alpha > -2.0 && s.alpha < 0.5)) throw InputError(where, "ALPHA " + cells[0] + " is not allowed: must be in (-2, 0.5)");
+  if (!(s.beta > 0.3 && s.beta < 2.0)) throw InputError(where, "BETA " + cells[1] + " is not allowed: must be in (0.3, 2)");
+  if (!(s.a > 0.0)) throw InputError(where, "A " + cells[2] + " is not allowed: must be > 0");
+  if (!(s.b >= 0.0) || !(s.c >= 0.0)) throw InputError(where, "B and C must be >= 0 (RR does not fall with speed)");
+  return s;
+}
+
+std::vector<J2452Set> load_j2452_csv(const std::string& path) {
+  const CsvTable t = read_csv(path);
+  auto col = [&](const char* name) {
+    const auto c = t.column(name);
+    if (!c) throw InputError(t.file, std::string("missing column '") + name + "'; found columns: " + t.columns_list());
+    return *c;
+  };
+  const std::size_t size = col("size"), cls = col("rr_class"), al = col("alpha"), be = col("beta"), a = col("a"),
+                    b = col("b"), c = col("c"), r = col("wh_radius_m");
+  std::vector<J2452Set> out;
+  for (std::size_t i = 0; i < t.rows.size(); ++i) {
+    auto num = [&](std::size_t k) {
+      const auto x = parse_number(t.rows[i][k]);
+      if (!x || !std::isfinite(*x)) throw InputError(t.where(i, k), "'" + t.rows[i][k] + "' is not a number");
+      return *x;
+    };
+    J2452Set s{trim(t.rows[i][size]) + " " + trim(t.rows[i][cls]), trim(t.rows[i][size]), num(al), num(be), num(a),
+               num(b), num(c), num(r)};
+    if (!(s.rolling_radius_m > 0.1 && s.rolling_radius_m < 1.0)) {
+      throw InputError(t.where(i, r), format_value(s.rolling_radius_m) + " m is not allowed: must be in (0.1, 1) m");
+    }
+    out.push_back(s);
+  }
+  if (out.empty()) throw InputError(t.file, "no coefficient sets");
+  return out;
+}
+
+OperatingGrid j2452_grid() {
+  OperatingGrid g;
+  for (double kpa = 180.0; kpa <= 300.0 + 1e-9; kpa += 30.0) g.pressures_pa.push_back(kpa * 1e3);
+  for (double n = 3000.0; n <= 6000.0 + 1e-9; n += 750.0) g.loads_n.push_back(n);
+  for (double kmh = 15.0; kmh <= 115.0 + 1e-9; kmh += 20.0) g.speeds_mps.push_back(units::kmh_to_mps(kmh));
+  return g;
+}
+
+std::vector<RrcPoint> sample_j2452(const J2452Set& s, const OperatingGrid& g, double drum_radius_m,
+                                   const std::string& where) {
+  std::vector<RrcPoint> out;
+  for (double p : g.pressures_pa) {
+    for (double z : g.loads_n) {
+      for (double v : g.speeds_mps) out.push_back({p, z, v, j2452_flat_rrc(s, p, z, v, drum_radius_m), where});
+    }
+  }
+  return out;
+}
+
+}  // namespace rollsim

@@ -1,0 +1,189 @@
+#include "rollsim/tyre/j2452_evaluation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+
+#include "rollsim/common/units.hpp"
+#include "rollsim/tyre/hysteresis_model.hpp"
+#include "rollsim/tyre/least_squares.hpp"
+#include "rollsim/tyre/tyre_fit.hpp"
+#include "rollsim/tyre/tyre_spec.hpp"
+
+namespace rollsim {
+namespace {
+
+constexpr double kRefPressure_pa = 210e3;
+constexpr double kRefLoad_n = 4000.0;
+const double kRefSpeed_mps = units::kmh_to_mps(80.0);
+
+// A model of RRC over (P, Z, V); surfaces are compared through it.
+using Surface = std::function<double(double p_pa, double z_n, double v_mps)>;
+
+Surface scaled_at_reference(const Surface& shape, double measured_ref_rrc) {
+  const double k = measured_ref_rrc / shape(kRefPressure_pa, kRefLoad_n, kRefSpeed_mps);
+  return [shape, k](double p, double z, double v) { return k * shape(p, z, v); };
+}
+
+struct ErrorStats {
+  double rms = 0.0, max = 0.0;
+};
+ErrorStats grid_error(const Surface& model, const std::vector<RrcPoint>& truth) {
+  ErrorStats s;
+  for (const auto& pt : truth) {
+    const double e = model(pt.pressure_pa, pt.load_n, pt.speed_mps) / pt.rrc - 1.0;
+    s.rms += e * e;
+    s.max = std::max(s.max, std::abs(e));
+  }
+  s.rms = std::sqrt(s.rms / truth.size());
+  return s;
+}
+
+SurfaceScaling scaling_of(const Surface& rrc) {
+  auto force = [&](double p, double z, double v) { return rrc(p, z, v) * z; };
+  const double v80 = kRefSpeed_mps;
+  SurfaceScaling s;
+  s.pressure_exponent = std::log(force(300e3, kRefLoad_n, v80) / force(180e3, kRefLoad_n, v80)) / std::log(300.0 / 180.0);
+  s.load_exponent = std::log(force(kRefPressure_pa, 6000.0, v80) / force(kRefPressure_pa, 3000.0, v80)) / std::log(2.0);
+  s.speed_rise = force(kRefPressure_pa, kRefLoad_n, units::kmh_to_mps(115.0)) /
+                     force(kRefPressure_pa, kRefLoad_n, units::kmh_to_mps(15.0)) - 1.0;
+  return s;
+}
+
+Surface hysteresis_surface(const TyreState& tyre) {
+  return [tyre](double p, double z, double v) {
+    TyreState t = tyre;
+    t.pressure_pa = p;
+    const SpeedPolynomial k = hysteresis_polynomial(t, z);
+    return k.k0 + v * (k.k1_s_per_m + v * k.k2_s2_per_m2);
+  };
+}
+
+Surface j2452_surface(const J2452Set& s, double drum_radius_m) {
+  return [s, drum_radius_m](double p, double z, double v) { return j2452_flat_rrc(s, p, z, v, drum_radius_m); };
+}
+
+// The hysteresis model with `shared` constants and its level set from the tyre's reference point. The model is
+// linear in rrc_ref, so the level is solved, not searched.
+TyreState one_point_tyre(const J2452Set& set, const HysteresisConstants& shared, double drum_radius_m) {
+  TyreState t = j2452_tyre(set);
+  t.model = TyreModelKind::Hysteresis;
+  t.hysteresis = shared;
+  t.hysteresis.rrc_ref = 0.0;
+  const double rest = hysteresis_surface(t)(kRefPressure_pa, kRefLoad_n, kRefSpeed_mps);
+  t.hysteresis.rrc_ref = 1.0;
+  const double unit = hysteresis_surface(t)(kRefPressure_pa, kRefLoad_n, kRefSpeed_mps) - rest;
+  const double measured = j2452_flat_rrc(set, kRefPressure_pa, kRefLoad_n, kRefSpeed_mps, drum_radius_m);
+  t.hysteresis.rrc_ref = (measured - rest) / unit;
+  return t;
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+Surface median_shape_of(const std::vector<J2452Set>& others) {
+  std::vector<double> al, be, b, c;
+  for (const auto& s : others) {
+    al.push_back(s.alpha);
+    be.push_back(s.beta);
+    b.push_back(s.b / s.a);
+    c.push_back(s.c / s.a);
+  }
+  J2452Set m{"median", "", median(al), median(be), 1.0, median(b), median(c), 0.3};
+  return j2452_surface(m, kJ2452DrumRadius_m);  // the drum factor is a constant: scaling removes it
+}
+
+constexpr HysteresisParam kShared[] = {HysteresisParam::FrequencySlope, HysteresisParam::DeflectionExponent,
+                                       HysteresisParam::LoadExponent, HysteresisParam::SpeedLoss,
+                                       HysteresisParam::SpeedLossLoadExponent};
+
+}  // namespace
+
+TyreState j2452_tyre(const J2452Set& set) {
+  const TyreSize size = parse_tyre_size(set.size, "J2452 set '" + set.name + "'");
+  TyreState t;
+  t.geometry.outer_radius_m = size.outer_radius_m;
+  t.geometry.section_width_m = size.section_width_m;
+  t.geometry.rim_radius_m = size.rim_diameter_m / 2.0;
+  t.pressure_pa = kRefPressure_pa;
+  return t;
+}
+
+HysteresisConstants fit_shared_constants(const std::vector<J2452Set>& training, double drum_radius_m) {
+  const OperatingGrid grid = j2452_grid();
+  std::vector<std::vector<RrcPoint>> truth;
+  for (const auto& s : training) truth.push_back(sample_j2452(s, grid, drum_radius_m, s.name));
+  const HysteresisConstants start;
+  auto constants = [&](const Eigen::VectorXd& x) {
+    HysteresisConstants c = start;
+    for (int k = 0; k < x.size(); ++k) set_hysteresis_param(c, kShared[k], x[k]);
+    return c;
+  };
+  const int m = static_cast<int>(training.size() * grid.pressures_pa.size() * grid.loads_n.size() * grid.speeds_mps.size());
+  const ResidualFunction residuals = [&](const Eigen::VectorXd& x, Eigen::VectorXd& r) {
+    const HysteresisConstants c = constants(x);
+    int i = 0;
+    for (std::size_t k = 0; k < training.size(); ++k) {
+      const Surface model = hysteresis_surface(one_point_tyre(training[k], c, drum_radius_m));
+      for (const auto& pt : truth[k]) r[i++] = model(pt.pressure_pa, pt.load_n, pt.speed_mps) / pt.rrc - 1.0;
+    }
+  };
+  Eigen::VectorXd x0(5);
+  for (int k = 0; k < 5; ++k) x0[k] = hysteresis_param_value(start, kShared[k]);
+  return constants(least_squares(residuals, m, x0).x);
+}
+
+J2452Evaluation evaluate_j2452(const std::vector<J2452Set>& sets, double drum_radius_m) {
+  J2452Evaluation out;
+  out.shared_all = fit_shared_constants(sets, drum_radius_m);
+  const OperatingGrid grid = j2452_grid();
+  for (std::size_t i = 0; i < sets.size(); ++i) {
+    const J2452Set& set = sets[i];
+    std::vector<J2452Set> others;
+    for (std::size_t j = 0; j < sets.size(); ++j) {
+      if (j != i) others.push_back(sets[j]);
+    }
+    const auto truth = sample_j2452(set, grid, drum_radius_m, set.name);
+    const double ref_rrc = j2452_flat_rrc(set, kRefPressure_pa, kRefLoad_n, kRefSpeed_mps, drum_radius_m);
+    TyreEvaluation e;
+    e.name = set.name;
+    e.shared = fit_shared_constants(others, drum_radius_m);
+    const Surface one_point = hysteresis_surface(one_point_tyre(set, e.shared, drum_radius_m));
+    const ErrorStats op = grid_error(one_point, truth);
+    e.one_point_rms = op.rms;
+    e.one_point_max = op.max;
+
+    TyreState full_start = one_point_tyre(set, out.shared_all, drum_radius_m);
+    FitRequest request;
+    request.points = truth;
+    request.free = {HysteresisParam::RrcRef,   HysteresisParam::FrequencySlope, HysteresisParam::DeflectionExponent,
+                    HysteresisParam::LoadExponent, HysteresisParam::SpeedLoss, HysteresisParam::SpeedLossLoadExponent};
+    const TyreFit full = fit_hysteresis(full_start, request);
+    const Surface full_surface = hysteresis_surface(full.tyre);
+    e.full_fit_rms = grid_error(full_surface, truth).rms;
+
+    const TyreState thesis_tyre = j2452_tyre(set);
+    const Surface thesis = scaled_at_reference(
+        [thesis_tyre](double p, double z, double v) {
+          TyreState t = thesis_tyre;
+          t.pressure_pa = p;
+          return evaluate_rolling_resistance(t, z, v).rrc;
+        },
+        ref_rrc);
+    e.thesis_rms = grid_error(thesis, truth).rms;
+    e.constant_rms = grid_error([ref_rrc](double, double, double) { return ref_rrc; }, truth).rms;
+    e.median_shape_rms = grid_error(scaled_at_reference(median_shape_of(others), ref_rrc), truth).rms;
+
+    e.measured = scaling_of(j2452_surface(set, drum_radius_m));
+    e.one_point = scaling_of(one_point);
+    e.full_fit = scaling_of(full_surface);
+    e.thesis = scaling_of(thesis);
+    out.tyres.push_back(e);
+  }
+  return out;
+}
+
+}  // namespace rollsim

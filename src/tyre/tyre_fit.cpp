@@ -1,0 +1,360 @@
+#include "rollsim/tyre/tyre_fit.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <set>
+#include <string>
+
+#include "rollsim/common/error.hpp"
+#include "rollsim/common/units.hpp"
+#include "rollsim/tyre/hysteresis_model.hpp"
+#include "rollsim/tyre/least_squares.hpp"
+
+namespace rollsim {
+namespace {
+
+constexpr HysteresisParam kAllParams[] = {HysteresisParam::RrcRef,         HysteresisParam::FrequencySlope,
+                                          HysteresisParam::DeflectionExponent, HysteresisParam::LoadExponent,
+                                          HysteresisParam::SpeedLoss,      HysteresisParam::SpeedLossLoadExponent};
+
+// The optimiser works on scaled parameters of order one; the level on its logarithm so it stays positive.
+double to_internal(HysteresisParam p, double v) {
+  switch (p) {
+    case HysteresisParam::RrcRef: return std::log(v);
+    case HysteresisParam::FrequencySlope: return v * 10.0;
+    case HysteresisParam::SpeedLoss: return v * 1e5;
+    default: return v;
+  }
+}
+double from_internal(HysteresisParam p, double x) {
+  switch (p) {
+    case HysteresisParam::RrcRef: return std::exp(x);
+    case HysteresisParam::FrequencySlope: return x / 10.0;
+    case HysteresisParam::SpeedLoss: return x / 1e5;
+    default: return x;
+  }
+}
+
+// How many distinct pressures, loads and speeds the points hold (to 0.1 % of the value).
+struct Spread {
+  std::size_t pressures = 0, loads = 0, speeds = 0;
+};
+std::size_t distinct(const std::vector<RrcPoint>& pts, double RrcPoint::*field) {
+  std::vector<double> v;
+  for (const auto& p : pts) v.push_back(p.*field);
+  std::sort(v.begin(), v.end());
+  std::size_t n = v.empty() ? 0 : 1;
+  for (std::size_t i = 1; i < v.size(); ++i) n += v[i] > v[i - 1] * 1.001;
+  return n;
+}
+Spread spread(const std::vector<RrcPoint>& pts) {
+  return {distinct(pts, &RrcPoint::pressure_pa), distinct(pts, &RrcPoint::load_n), distinct(pts, &RrcPoint::speed_mps)};
+}
+
+// Empty when the points can determine `p`, else what is missing.
+std::string missing_for(HysteresisParam p, const Spread& s) {
+  switch (p) {
+    case HysteresisParam::RrcRef: return "";
+    case HysteresisParam::FrequencySlope: return s.speeds >= 2 ? "" : "points at 2 or more speeds";
+    case HysteresisParam::DeflectionExponent: return s.pressures >= 2 ? "" : "points at 2 or more pressures";
+    case HysteresisParam::LoadExponent: return s.loads >= 2 ? "" : "points at 2 or more loads";
+    case HysteresisParam::SpeedLoss: return s.speeds >= 3 ? "" : "points at 3 or more speeds";
+    case HysteresisParam::SpeedLossLoadExponent:
+      return s.speeds >= 3 && s.loads >= 2 ? "" : "points at 3 or more speeds and 2 or more loads";
+  }
+  return "";
+}
+
+std::string list_keys(const std::vector<HysteresisParam>& ps) {
+  std::string s;
+  for (auto p : ps) s += (s.empty() ? "" : ", ") + std::string(hysteresis_param_key(p));
+  return s;
+}
+
+void check_request(const FitRequest& r, const std::vector<HysteresisParam>& free) {
+  if (r.points.empty()) {
+    throw InputError("--point", "too few points for what is asked: no measured point given (give --point, "
+                                "--measured, --j2452 or --label)");
+  }
+  std::set<HysteresisParam> seen;
+  const Spread s = spread(r.points);
+  for (auto p : free) {
+    if (!seen.insert(p).second) throw InputError("--free", std::string(hysteresis_param_key(p)) + " is listed twice");
+    const std::string need = missing_for(p, s);
+    if (!need.empty()) {
+      throw InputError("--free", std::string("too few points for what is asked: ") + hysteresis_param_key(p) +
+                                     " needs " + need + "; the " + std::to_string(r.points.size()) +
+                                     " point(s) given have " + std::to_string(s.pressures) + " pressure(s), " +
+                                     std::to_string(s.loads) + " load(s), " + std::to_string(s.speeds) + " speed(s)");
+    }
+  }
+  if (free.size() > r.points.size()) {
+    throw InputError("--free", "too few points for what is asked: " + std::to_string(r.points.size()) +
+                                   " point(s) cannot determine " + std::to_string(free.size()) + " parameters (" +
+                                   list_keys(free) + ")");
+  }
+  if (!(r.assumed_relative_uncertainty > 0.0)) {
+    throw InputError("--rrc-uncertainty-pct", "must be > 0");
+  }
+}
+
+double model_rrc(const TyreState& t, const RrcPoint& p) {
+  TyreState at = t;
+  at.pressure_pa = p.pressure_pa;
+  const SpeedPolynomial k = hysteresis_polynomial(at, p.load_n);
+  return k.k0 + p.speed_mps * (k.k1_s_per_m + p.speed_mps * k.k2_s2_per_m2);
+}
+
+// One least-squares pass over the given free parameters; fills values, intervals and residuals.
+TyreFit fit_once(const TyreState& start, const FitRequest& r, const std::vector<HysteresisParam>& free) {
+  const int m = static_cast<int>(r.points.size());
+  const int n = static_cast<int>(free.size());
+  auto apply = [&](const Eigen::VectorXd& x) {
+    TyreState t = start;
+    for (int k = 0; k < n; ++k) set_hysteresis_param(t.hysteresis, free[k], from_internal(free[k], x[k]));
+    return t;
+  };
+  const ResidualFunction residuals = [&](const Eigen::VectorXd& x, Eigen::VectorXd& out) {
+    const TyreState t = apply(x);
+    for (int i = 0; i < m; ++i) out[i] = model_rrc(t, r.points[i]) / r.points[i].rrc - 1.0;
+  };
+  Eigen::VectorXd x0(n);
+  for (int k = 0; k < n; ++k) x0[k] = to_internal(free[k], hysteresis_param_value(start.hysteresis, free[k]));
+  const LeastSquaresResult ls = least_squares(residuals, m, x0);
+
+  TyreFit fit;
+  fit.tyre = apply(ls.x);
+  fit.degrees_of_freedom = m - n;
+  const double ssr = ls.residuals.squaredNorm();
+  fit.rms_relative_error = std::sqrt(ssr / m);
+  fit.sigma_from_residuals = fit.degrees_of_freedom > 0;
+  fit.sigma_relative = fit.sigma_from_residuals ? std::sqrt(ssr / fit.degrees_of_freedom) : r.assumed_relative_uncertainty;
+  // Covariance of the scaled parameters; a pseudo-inverse keeps a degenerate direction from producing NaN.
+  const Eigen::MatrixXd jtj = ls.jacobian.transpose() * ls.jacobian;
+  const Eigen::MatrixXd cov =
+      fit.sigma_relative * fit.sigma_relative * jtj.completeOrthogonalDecomposition().pseudoInverse();
+  for (int k = 0; k < n; ++k) {
+    ParamEstimate e;
+    e.param = free[k];
+    e.value = from_internal(free[k], ls.x[k]);
+    const double sd_internal = std::sqrt(std::max(0.0, cov(k, k)));
+    e.low95 = from_internal(free[k], ls.x[k] - 1.96 * sd_internal);
+    e.high95 = from_internal(free[k], ls.x[k] + 1.96 * sd_internal);
+    e.std_error = free[k] == HysteresisParam::RrcRef ? e.value * sd_internal
+                                                     : std::abs(from_internal(free[k], sd_internal));
+    fit.params.push_back(e);
+  }
+  for (int i = 0; i < m; ++i) {
+    fit.residuals.push_back({r.points[i], model_rrc(fit.tyre, r.points[i]), ls.residuals[i]});
+  }
+  for (auto p : kAllParams) {
+    if (std::find(free.begin(), free.end(), p) == free.end()) fit.held.push_back(p);
+  }
+  return fit;
+}
+
+}  // namespace
+
+const char* hysteresis_param_key(HysteresisParam p) {
+  switch (p) {
+    case HysteresisParam::RrcRef: return "rrc_ref";
+    case HysteresisParam::FrequencySlope: return "frequency_slope_per_hz";
+    case HysteresisParam::DeflectionExponent: return "deflection_exponent";
+    case HysteresisParam::LoadExponent: return "load_exponent";
+    case HysteresisParam::SpeedLoss: return "speed_loss_rrc_per_hz2";
+    case HysteresisParam::SpeedLossLoadExponent: return "speed_loss_load_exponent";
+  }
+  return "";
+}
+
+std::optional<HysteresisParam> hysteresis_param_from_key(const std::string& key) {
+  for (auto p : kAllParams) {
+    if (key == hysteresis_param_key(p)) return p;
+  }
+  return std::nullopt;
+}
+
+double hysteresis_param_value(const HysteresisConstants& c, HysteresisParam p) {
+  switch (p) {
+    case HysteresisParam::RrcRef: return c.rrc_ref;
+    case HysteresisParam::FrequencySlope: return c.frequency_slope_per_hz;
+    case HysteresisParam::DeflectionExponent: return c.deflection_exponent;
+    case HysteresisParam::LoadExponent: return c.load_exponent;
+    case HysteresisParam::SpeedLoss: return c.speed_loss_rrc_per_hz2;
+    case HysteresisParam::SpeedLossLoadExponent: return c.speed_loss_load_exponent;
+  }
+  return 0.0;
+}
+
+void set_hysteresis_param(HysteresisConstants& c, HysteresisParam p, double value) {
+  switch (p) {
+    case HysteresisParam::RrcRef: c.rrc_ref = value; break;
+    case HysteresisParam::FrequencySlope: c.frequency_slope_per_hz = value; break;
+    case HysteresisParam::DeflectionExponent: c.deflection_exponent = value; break;
+    case HysteresisParam::LoadExponent: c.load_exponent = value; break;
+    case HysteresisParam::SpeedLoss: c.speed_loss_rrc_per_hz2 = value; break;
+    case HysteresisParam::SpeedLossLoadExponent: c.speed_loss_load_exponent = value; break;
+  }
+}
+
+void check_rrc_point(const TyreState& tyre, const RrcPoint& p) {
+  const double kpa = p.pressure_pa / 1e3;
+  if (!(kpa >= 50.0 && kpa <= 600.0)) {
+    throw InputError(p.where, "pressure " + format_value(kpa) + " kPa is outside a tyre's physical range: must be in "
+                                                                "[50, 600] kPa");
+  }
+  const double kmh = units::mps_to_kmh(p.speed_mps);
+  if (!(kmh > 0.0 && kmh <= 300.0)) {
+    throw InputError(p.where, "speed " + format_value(kmh) + " km/h is not allowed: must be in (0, 300] km/h (a "
+                                                             "rolling tyre; RRC is not defined at standstill)");
+  }
+  if (!(p.rrc >= 0.001 && p.rrc <= 0.05)) {
+    throw InputError(p.where, "RRC " + format_value(p.rrc) + " is outside a tyre's physical range: must be in "
+                                                              "[0.001, 0.05] (1-50 kg/t; car tyres measure 5-15 kg/t)");
+  }
+  TyreState at = tyre;
+  at.pressure_pa = p.pressure_pa;
+  try {
+    check_operating_point(at, p.load_n, p.speed_mps);
+  } catch (const ModelDomainError& e) {
+    throw InputError(p.where, std::string("outside the tyre's physical range: ") + e.what());
+  }
+}
+
+std::vector<HysteresisParam> identifiable_params(const std::vector<RrcPoint>& points) {
+  const Spread s = spread(points);
+  std::vector<HysteresisParam> out{HysteresisParam::RrcRef};
+  for (auto p : kAllParams) {
+    if (p == HysteresisParam::RrcRef || out.size() >= points.size()) continue;
+    if (missing_for(p, s).empty()) out.push_back(p);
+  }
+  return out;
+}
+
+TyreFit fit_hysteresis(const TyreState& start_in, const FitRequest& r) {
+  std::vector<HysteresisParam> free = r.free.empty() ? identifiable_params(r.points) : r.free;
+  check_request(r, free);
+  TyreState start = start_in;
+  start.model = TyreModelKind::Hysteresis;
+  for (const auto& p : r.points) check_rrc_point(start, p);
+  // Start the level where the first point says, so the optimiser begins near the answer.
+  start.hysteresis.rrc_ref = 0.01;
+  start.hysteresis.rrc_ref *= r.points.front().rrc / model_rrc(start, r.points.front());
+
+  // A slope or speed loss cannot be negative (RRC would reach 0 at some speed): one that fits below 0 is held
+  // at 0 and the rest refitted.
+  std::vector<HysteresisParam> at_bound;
+  while (true) {
+    TyreFit fit = fit_once(start, r, free);
+    bool changed = false;
+    for (const auto& e : fit.params) {
+      const bool nonneg = e.param == HysteresisParam::FrequencySlope || e.param == HysteresisParam::SpeedLoss;
+      if (nonneg && e.value < 0.0) {
+        set_hysteresis_param(start.hysteresis, e.param, 0.0);
+        free.erase(std::find(free.begin(), free.end(), e.param));
+        at_bound.push_back(e.param);
+        changed = true;
+      }
+    }
+    if (!changed) {
+      for (auto p : at_bound) {
+        fit.params.push_back({p, 0.0, 0.0, 0.0, 0.0, true});
+        fit.held.erase(std::find(fit.held.begin(), fit.held.end(), p));
+      }
+      return fit;
+    }
+  }
+}
+
+LabelBand eu_label_band_c1(const std::string& label_class, const std::string& where) {
+  // Regulation (EU) 2020/740, Annex I, Part A, table for C1 tyres (RRC in kg/t = 1e-3):
+  // A: RRC <= 6.5; B: 6.6-7.7; C: 7.8-9.4; D: 9.5-10.5; E: RRC >= 10.6 (https://eur-lex.europa.eu/eli/reg/2020/740/oj).
+  // Values are declared to 0.1 kg/t, so a band's edges are half a digit outside its printed limits. A and E are
+  // open-ended in the regulation; we close them with the width of the neighbouring band (our assumption).
+  static const LabelBand kBands[] = {{'A', 5.45e-3, 6.55e-3, true, false},
+                                     {'B', 6.55e-3, 7.75e-3, false, false},
+                                     {'C', 7.75e-3, 9.45e-3, false, false},
+                                     {'D', 9.45e-3, 10.55e-3, false, false},
+                                     {'E', 10.55e-3, 11.65e-3, false, true}};
+  if (label_class.size() == 1) {
+    const char c = static_cast<char>(std::toupper(static_cast<unsigned char>(label_class[0])));
+    for (const auto& b : kBands) {
+      if (b.label_class == c) return b;
+    }
+  }
+  throw InputError(where, "'" + label_class + "' is not an EU tyre label fuel-efficiency class: allowed A, B, C, D, E "
+                          "(Regulation (EU) 2020/740; its classes F and G of Regulation (EC) 1222/2009 no longer exist)");
+}
+
+RrcPoint iso28580_point(const TyreSize& size, double rrc, const std::string& where) {
+  if (!size.load_index) {
+    throw InputError(where, "the size '" + size.designation + "' has no load index, so the ISO 28580 load (80 % of "
+                            "the load index's load) is unknown; give the size with its load index, e.g. '205/55 R16 91V'");
+  }
+  RrcPoint p;
+  p.pressure_pa = size.extra_load ? 250e3 : 210e3;
+  p.load_n = 0.8 * *load_index_max_load_kg(*size.load_index) * units::kStandardGravity_mps2;
+  p.speed_mps = units::kmh_to_mps(80.0);
+  p.rrc = rrc;
+  p.where = where;
+  return p;
+}
+
+}  // namespace rollsim
+
+namespace rollsim {
+namespace {
+
+std::string num(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.9g", v);
+  return buf;
+}
+
+std::string yaml_quoted(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out + "\"";
+}
+
+}  // namespace
+
+void write_fitted_tyre_yaml(std::ostream& out, const FittedTyreFile& file, const TyreFit& fit) {
+  const HysteresisConstants& h = fit.tyre.hysteresis;
+  out << "# Written by 'rollsim tyre fit': hysteresis model fitted to " << fit.residuals.size()
+      << " point(s), RMS relative error " << num(fit.rms_relative_error * 100.0) << " %.\n";
+  out << "# 95 % intervals (Jacobian covariance, relative scatter " << num(fit.sigma_relative * 100.0) << " % "
+      << (fit.sigma_from_residuals ? "from the residuals" : "assumed: no degrees of freedom left") << "):\n";
+  for (const auto& e : fit.params) {
+    out << "#   " << hysteresis_param_key(e.param) << " " << num(e.value);
+    if (e.at_bound) out << " (held at its bound 0)\n";
+    else out << " [" << num(e.low95) << ", " << num(e.high95) << "]\n";
+  }
+  if (!fit.held.empty()) {
+    out << "# held at the shared values (fitted to the nine Michelin J2452 sets):";
+    for (auto p : fit.held) out << " " << hysteresis_param_key(p);
+    out << "\n";
+  }
+  out << "name: " << yaml_quoted(file.name) << "\n";
+  out << "size: " << yaml_quoted(file.size) << "\n";
+  out << "pressure_bar: " << num(file.pressure_pa / 1e5) << "\n";
+  out << "source: " << yaml_quoted(file.source) << "\n";
+  out << "model:\n  kind: hysteresis\n";
+  out << "  reference_pressure_bar: " << num(h.reference_pressure_pa / 1e5) << "\n";
+  out << "  reference_load_n: " << num(h.reference_load_n) << "\n";
+  for (auto p : kAllParams) out << "  " << hysteresis_param_key(p) << ": " << num(hysteresis_param_value(h, p)) << "\n";
+  const TyreModelConstants defaults;
+  if (fit.tyre.constants.stiffness_pressure_coeff != defaults.stiffness_pressure_coeff) {
+    out << "  stiffness_pressure_coeff: " << num(fit.tyre.constants.stiffness_pressure_coeff) << "\n";
+  }
+  if (fit.tyre.constants.stiffness_offset_kgf_per_mm != defaults.stiffness_offset_kgf_per_mm) {
+    out << "  stiffness_offset_kgf_per_mm: " << num(fit.tyre.constants.stiffness_offset_kgf_per_mm) << "\n";
+  }
+}
+
+}  // namespace rollsim

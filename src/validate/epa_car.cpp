@@ -1,0 +1,239 @@
+#include "rollsim/validate/epa_car.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "rollsim/common/error.hpp"
+#include "rollsim/common/units.hpp"
+#include "rollsim/effects/catalogue.hpp"
+#include "rollsim/vehicle/vehicle.hpp"
+
+namespace rollsim::validate {
+
+namespace {
+
+constexpr double kRadpsPerRpm = 2.0 * std::numbers::pi / 60.0;
+constexpr double kFourStroke = 4.0 * std::numbers::pi;
+// The wheel radius only converts between wheel force and torque: the N/V ratio fixes engine speed per road
+// speed, so any radius gives the same car.
+constexpr double kWheelRadius_m = 0.33;
+
+// Rotating inertia on the dynamometer: the rolls simulate the equivalent test weight; the driven axle's wheels,
+// driveline and engine spin on the rolls and add their own inertia; the other axle stands still on a
+// two-wheel-drive dynamometer. 40 CFR 1066.310 lets coast-down analysis take a vehicle's rotating mass as
+// 1.5 % of its test mass; half of it (one axle) turns on a 2WD dynamometer, all of it on a 4WD one.
+constexpr double kRotatingMassShare = 0.015;
+
+// Ratio spread (first / top gear) by number of gears, from the published ratio sets of common 2015-2022
+// transmissions: Aisin and GM 6-speeds ~6.0, ZF 8HP 7.07, Aisin 8-speeds ~7.0, ZF 9HP 9.8, GM/Ford 10-speed 7.4,
+// dual-clutch 7-speeds ~6.5, manual 5/6-speeds 4.5/5.5. A CVT: 7.0 (Jatco CVT8 7.3, Toyota Direct Shift 7.5).
+double ratio_spread(int gears, TransmissionKind kind) {
+  if (kind == TransmissionKind::cvt) return 7.0;
+  switch (gears) {
+    case 1: return 1.0;
+    case 2: return 2.0;
+    case 3: return 2.7;
+    case 4: return 4.0;
+    case 5: return 4.5;
+    case 6: return kind == TransmissionKind::clutch ? 5.5 : 6.0;
+    case 7: return 6.5;
+    case 8: return 7.0;
+    case 9: return 9.0;
+    default: return 7.4;
+  }
+}
+
+bool liquid(EpaFuel f) { return f == EpaFuel::petrol || f == EpaFuel::diesel || f == EpaFuel::e85; }
+
+SkipReason missing(std::string& detail, const std::string& field) {
+  detail = field + " is empty or not a number";
+  return SkipReason::missing_field;
+}
+SkipReason absurd(std::string& detail, const std::string& field, double value, const std::string& allowed) {
+  detail = field + " = " + format_value(value) + " (allowed " + allowed + ")";
+  return SkipReason::absurd_field;
+}
+
+EngineMapParams engine_of(const EpaTestRow& row, const EpaDefaults& d) {
+  const bool diesel = row.fuel == EpaFuel::diesel;
+  EngineMapParams e;
+  e.displacement_m3 = *row.displacement_m3;
+  e.max_power_w = *row.rated_power_w;
+  // Rated speed: 6000 rpm for petrol engines, 4000 rpm for diesels (the middle of 2022 engines' ratings).
+  e.rated_speed_radps = (diesel ? 4000.0 : 6000.0) * kRadpsPerRpm;
+  e.max_speed_radps = 1.12 * e.rated_speed_radps;
+  e.idle_speed_radps = (diesel ? 750.0 : 700.0) * kRadpsPerRpm;
+  // Full-load torque: the larger of a naturally aspirated plateau (bmep 12 bar petrol, 18 bar for a turbodiesel)
+  // and 1.1 x the torque at rated power (a boosted engine's plateau is flat up to near its rated speed).
+  const double bmep_pa = diesel ? 18e5 : 12e5;
+  e.max_torque_nm = std::max(bmep_pa * e.displacement_m3 / kFourStroke, 1.1 * e.max_power_w / e.rated_speed_radps);
+  e.indicated_efficiency = diesel ? d.diesel_indicated_efficiency : d.petrol_indicated_efficiency;
+  // Friction mean effective pressure, Heywood (1988) eq. 13.19 for spark-ignition engines:
+  // 0.97 + 0.15 (N/1000) + 0.05 (N/1000)^2 bar, N in rpm; a diesel's is higher by ~0.2 bar (heavier rings and
+  // bearings, Heywood fig. 13-13).
+  const double per_krpm = 1000.0 * kRadpsPerRpm;
+  e.friction_mep0_pa = (diesel ? 1.17 : 0.97) * 1e5;
+  e.friction_mep1_pa_s_per_rad = 0.15e5 / per_krpm;
+  e.friction_mep2_pa_s2_per_rad2 = 0.05e5 / (per_krpm * per_krpm);
+  // Throttling: ~0.9 bar pumping mep at closed throttle (manifold ~0.2-0.3 bar), none at wide-open throttle
+  // (gross imep ~11 bar unboosted). A diesel is unthrottled.
+  e.pumping_mep_closed_pa = diesel ? 0.0 : 0.9e5;
+  e.unthrottled_imep_pa = 11e5;
+  // Enrichment for component protection above 90 % load, up to 15 % more fuel (lambda ~0.87); none for a diesel.
+  e.enrichment_start_fraction = 0.9;
+  e.enrichment_max = diesel ? 0.0 : 0.15;
+  e.fuel_cut_min_speed_radps = 1100.0 * kRadpsPerRpm;
+  return e;
+}
+
+TransmissionParams transmission_of(const EpaTestRow& row, double top_ratio, const EngineMapParams& engine) {
+  const double max_torque_nm = engine.max_torque_nm;
+  TransmissionParams t;
+  t.kind = row.transmission == EpaTransmission::cvt      ? TransmissionKind::cvt
+           : row.transmission == EpaTransmission::clutch ? TransmissionKind::clutch
+                                                         : TransmissionKind::automatic;
+  const int gears = t.kind == TransmissionKind::cvt ? 2 : std::max(1, *row.gears);
+  const double spread = ratio_spread(gears, t.kind);
+  for (int g = 1; g <= gears; ++g) {
+    // Geometric steps from first to top (real sets close up towards the top; the fuel figures hardly notice).
+    t.ratios.push_back(top_ratio * std::pow(spread, static_cast<double>(gears - g) / std::max(1, gears - 1)));
+  }
+  // Mesh, final drive and joints: 0.96 for stepped gears, 0.93 for a belt CVT (pump and clamping), 0.98 for an
+  // extra transfer case and axle on an all-wheel-drive car. Drag at the input: pump and clutch packs.
+  t.efficiency = (t.kind == TransmissionKind::cvt ? 0.93 : 0.96) * (row.all_wheel_drive ? 0.98 : 1.0);
+  t.spin_loss_nm = t.kind == TransmissionKind::clutch ? 2.0 : 4.0;
+  t.min_engine_speed_radps = (t.kind == TransmissionKind::clutch ? 1400.0 : 1250.0) * kRadpsPerRpm;
+  t.max_torque_fraction = 0.75;
+  // Torque converter: stall at 2400 rpm against full-load torque; stall torque ratio 2.0, coupling at 0.85;
+  // lock-up in every gear of a 6-or-more-speed automatic (third up for 4- and 5-speeds) above 1000 rpm turbine
+  // speed, as 2015-2022 automatics do for economy (ZF 8HP: lock-up in all gears shortly after launch).
+  t.converter.k_factor_radps_per_sqrt_nm = 2400.0 * kRadpsPerRpm / std::sqrt(max_torque_nm);
+  t.converter.stall_torque_ratio = 2.0;
+  t.converter.coupling_speed_ratio = 0.85;
+  t.converter.lockup_min_gear = t.kind == TransmissionKind::cvt || gears >= 6 ? 1 : 3;
+  t.converter.lockup_min_speed_radps = 1000.0 * kRadpsPerRpm;
+  return t;
+}
+
+std::shared_ptr<const Powertrain> conventional_of(const EpaTestRow& row, const EpaDefaults& d) {
+  ConventionalPowertrainParams p;
+  p.engine = engine_of(row, d);
+  const double top_ratio = *row.engine_radps_per_mps * kWheelRadius_m;
+  p.transmission = transmission_of(row, top_ratio, p.engine);
+  p.fuel = test_fuel(row.fuel);
+  // On the dynamometer: no air conditioning, lights off; engine electronics, fuel pump and fans (~300 W) from
+  // an alternator of ~60 % efficiency.
+  p.aux_power_w = 300.0;
+  p.alternator_efficiency = 0.6;
+  return std::make_shared<ConventionalPowertrain>(p);
+}
+
+std::shared_ptr<const Powertrain> electric_of(const EpaTestRow& row) {
+  const double power_w = *row.rated_power_w;
+  ElectricPowertrainParams p;
+  // Reduction from the N/V ratio; top motor speed at 200 km/h and base speed a third of it.
+  p.reduction.ratio = *row.engine_radps_per_mps * kWheelRadius_m;
+  p.reduction.efficiency = 0.96;
+  p.motor.max_power_w = power_w;
+  p.motor.max_speed_radps = *row.engine_radps_per_mps * units::kmh_to_mps(200.0);
+  p.motor.max_torque_nm = 3.0 * power_w / p.motor.max_speed_radps;
+  // The shipped 80 kW machine's loss model (vehicles/ev.yaml: copper 4 % of rated power at peak torque, iron
+  // 2.5 % at top speed, windage 0.16 %) scaled to the row's rating; the standing loss (inverter, pumps) grows
+  // less than the rating: 400 W + 0.5 %.
+  p.motor.losses.copper_w_per_nm2 = 0.04 * power_w / (p.motor.max_torque_nm * p.motor.max_torque_nm);
+  p.motor.losses.iron_w_s_per_rad = 0.01 * power_w / p.motor.max_speed_radps;
+  p.motor.losses.windage_w_s3_per_rad3 = 0.0016 * power_w / std::pow(p.motor.max_speed_radps, 3);
+  p.motor.losses.constant_w = 150.0;
+  // A 400 V class pack whose I^2 R is 4 % of rated power at rated power (R = 0.04 V^2 / P).
+  p.battery.open_circuit_voltage_v = 360.0;
+  p.battery.internal_resistance_ohm = 0.04 * 360.0 * 360.0 / power_w;
+  p.battery.usable_capacity_j = units::kwh_to_j(100.0);
+  p.battery.initial_soc = 0.9;
+  // Blended regeneration on the dynamometer: 90 % of the braking force on a two-wheel-drive car, all of it with
+  // motors on both axles, down to 3 km/h (full from 10 km/h), at up to the rated power.
+  p.regen.max_power_w = power_w;
+  p.regen.driven_axle_brake_fraction = row.all_wheel_drive ? 1.0 : 0.9;
+  p.regen.min_speed_mps = units::kmh_to_mps(3.0);
+  p.regen.fade_speed_mps = units::kmh_to_mps(10.0);
+  p.aux_power_w = 300.0;  // 12 V loads, coolant pumps; no cabin heating or cooling on these tests
+  return std::make_shared<ElectricPowertrain>(p);
+}
+
+}  // namespace
+
+FuelParams test_fuel(EpaFuel fuel) {
+  // Certification fuels (40 CFR 1065.710 ranges): Tier 2 gasoline (indolene, no ethanol) specific gravity
+  // ~0.743, net heating value ~18,450 BTU/lb = 42.9 MJ/kg; ultra-low-sulphur certification diesel ~0.852 and
+  // 42.8 MJ/kg; E85 ~0.781 and ~29.5 MJ/kg. CO2 from carbon mass fractions 0.866, 0.870, 0.584 (x 44/12).
+  switch (fuel) {
+    case EpaFuel::diesel: return {852.0, 42.8e6, 0.870 * 44.0 / 12.0};
+    case EpaFuel::e85: return {781.0, 29.5e6, 0.584 * 44.0 / 12.0};
+    default: return {743.0, 42.9e6, 0.866 * 44.0 / 12.0};
+  }
+}
+
+SkipReason check_car_fields(const EpaTestRow& r, std::string& detail) {
+  if (!r.test_mass_kg) return missing(detail, "Equivalent Test Weight (lbs.)");
+  if (*r.test_mass_kg < 450.0 || *r.test_mass_kg > 9000.0) return absurd(detail, "test mass [kg]", *r.test_mass_kg, "450-9000 kg");
+  if (!r.road_a_n) return missing(detail, "Target Coef A (lbf)");
+  if (!r.road_b_n_s_per_m) return missing(detail, "Target Coef B (lbf/mph)");
+  if (!r.road_c_n_s2_per_m2) return missing(detail, "Target Coef C (lbf/mph**2)");
+  if (*r.road_c_n_s2_per_m2 <= 0.0 || *r.road_c_n_s2_per_m2 > 4.0)
+    return absurd(detail, "target C [N s^2/m^2]", *r.road_c_n_s2_per_m2, "0-4");
+  for (double v_mps : {2.0, 10.0, 20.0, 30.0, 40.0}) {
+    const double f_n = *r.road_a_n + v_mps * (*r.road_b_n_s_per_m + v_mps * *r.road_c_n_s2_per_m2);
+    if (f_n <= 0.0 || f_n > 5000.0) return absurd(detail, "target road load at " + format_value(v_mps * 3.6) + " km/h [N]", f_n, "0-5000 N");
+  }
+  if (!r.rated_power_w) return missing(detail, "Rated Horsepower");
+  if (*r.rated_power_w < 30e3 || *r.rated_power_w > 1.5e6) return absurd(detail, "rated power [W]", *r.rated_power_w, "30-1500 kW");
+  if (!r.engine_radps_per_mps) return missing(detail, "N/V Ratio");
+  const double nv_rpm_per_mph = *r.engine_radps_per_mps / 0.2341889;
+  if (nv_rpm_per_mph < 12.0 || nv_rpm_per_mph > 250.0) return absurd(detail, "N/V ratio [rpm/mph]", nv_rpm_per_mph, "12-250");
+  if (!liquid(r.fuel)) return SkipReason::none;
+  if (!r.displacement_m3) return missing(detail, "Test Veh Displacement (L)");
+  if (*r.displacement_m3 < 0.6e-3 || *r.displacement_m3 > 9e-3) return absurd(detail, "displacement [l]", *r.displacement_m3 * 1e3, "0.6-9 l");
+  if (r.transmission == EpaTransmission::other) {
+    detail = "Tested Transmission Type '" + r.transmission_text + "' (automatic, CVT, manual or automated manual)";
+    return SkipReason::absurd_field;
+  }
+  if (r.transmission != EpaTransmission::cvt) {
+    if (!r.gears) return missing(detail, "# of Gears");
+    if (*r.gears < 2 || *r.gears > 10) return absurd(detail, "# of Gears of a stepped transmission", *r.gears, "2-10");
+  }
+  return SkipReason::none;
+}
+
+VehicleModel car_from_row(const EpaTestRow& row, const EpaDefaults& d) {
+  Vehicle v;
+  v.name = row.make + " " + row.model;
+  v.body.test_mass_kg = *row.test_mass_kg;
+  v.body.wheel_radius_m = kWheelRadius_m;
+  v.coastdown = CoastdownParams{*row.road_a_n, *row.road_b_n_s_per_m, *row.road_c_n_s2_per_m2};
+  VehicleModel m;
+  m.name = v.name;
+  m.mass_kg = *row.test_mass_kg;
+  m.rotating_mass_kg = kRotatingMassShare * m.mass_kg * (row.all_wheel_drive ? 1.0 : 0.5);
+  m.wheel_radius_m = kWheelRadius_m;
+  m.road_load = make_road_load(v);
+  m.road_load_description = m.road_load->describe();
+  m.flat_road_load = m.road_load->at_grade(0.0);
+  m.powertrain = row.fuel == EpaFuel::electricity ? electric_of(row) : conventional_of(row, d);
+  return m;
+}
+
+std::shared_ptr<const Effect> cold_start_effect(const EpaTestRow& row, double cold_fuel_excess) {
+  // The catalogue's engine warm-up (effects/catalogue.cpp): oil and block heated from the test's 20-30 degC to
+  // 60 K above it. Heat capacity ~40 kJ/K per litre of displacement (block, head and fluids of a 2 l engine weigh
+  // ~120 kg at ~0.6 kJ/(kg K)); heat reaching them at idle ~1 kW per litre plus 60 % of the wheel work.
+  const double litres = *row.displacement_m3 * 1e3;
+  EffectParameters p{{"cold_fuel_excess", cold_fuel_excess},
+                     {"heat_capacity_j_per_k", 40e3 * litres},
+                     {"idle_heat_w", 1000.0 * litres},
+                     {"heat_per_wheel_work", 0.6},
+                     {"heat_loss_w_per_k", 40.0},
+                     {"warm_excess_k", 60.0}};
+  return make_effect("engine_warmup", p, EffectContext{*row.test_mass_kg, 0.0});
+}
+
+}  // namespace rollsim::validate

@@ -1,0 +1,161 @@
+#include "rollsim/validate/epa_test_car.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <numbers>
+
+#include "rollsim/common/csv.hpp"
+#include "rollsim/common/error.hpp"
+#include "rollsim/common/units.hpp"
+
+namespace rollsim::validate {
+
+namespace {
+
+constexpr double kKgPerLb = 0.45359237;
+constexpr double kNPerLbf = 4.4482216152605;
+constexpr double kWPerHp = 745.69987158;  // mechanical horsepower
+constexpr double kMpsPerMph = units::kMPerMile / 3600.0;
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return s;
+}
+bool has(const std::string& text, const char* part) { return text.find(part) != std::string::npos; }
+
+EpaCycle cycle_of(const std::string& procedure) {
+  const std::string p = lower(procedure);
+  if (has(p, "20 degree") || has(p, "cold co")) return EpaCycle::cold;
+  if (has(p, "charge depleting udds")) return EpaCycle::cd_udds;
+  if (has(p, "charge depleting highway")) return EpaCycle::cd_highway;
+  if (has(p, "charge depleting us06")) return EpaCycle::cd_us06;
+  if (has(p, "sc03")) return EpaCycle::sc03;
+  if (has(p, "us06")) return EpaCycle::us06;
+  if (p == "hwfe") return EpaCycle::hwfet;
+  if (has(p, "federal fuel") || has(p, "cvs 75")) return EpaCycle::ftp75;
+  return EpaCycle::other;
+}
+
+EpaFuel fuel_of(const std::string& text) {
+  const std::string f = lower(text);
+  if (has(f, "cold co")) return EpaFuel::cold_test_fuel;
+  if (f == "electricity") return EpaFuel::electricity;
+  if (has(f, "hydrogen")) return EpaFuel::hydrogen;
+  if (has(f, "e85")) return EpaFuel::e85;
+  if (has(f, "diesel")) return EpaFuel::diesel;
+  if (has(f, "gasoline")) return EpaFuel::petrol;
+  return EpaFuel::other;
+}
+
+EpaTransmission transmission_of(const std::string& text) {
+  const std::string t = lower(text);
+  if (has(t, "continuously variable")) return EpaTransmission::cvt;
+  if (has(t, "manual")) return EpaTransmission::clutch;  // manual, automated manual (incl. dual clutch)
+  if (has(t, "automatic")) return EpaTransmission::automatic;  // incl. semi-automatic (with a manual mode)
+  return EpaTransmission::other;
+}
+
+}  // namespace
+
+std::string to_string(EpaCycle c) {
+  switch (c) {
+    case EpaCycle::ftp75: return "FTP-75";
+    case EpaCycle::hwfet: return "HWFET";
+    case EpaCycle::us06: return "US06";
+    case EpaCycle::cd_udds: return "CD UDDS";
+    case EpaCycle::cd_highway: return "CD HWFET";
+    case EpaCycle::cd_us06: return "CD US06";
+    case EpaCycle::sc03: return "SC03";
+    case EpaCycle::cold: return "cold";
+    case EpaCycle::other: return "other";
+  }
+  return "other";
+}
+
+std::string to_string(EpaFuel f) {
+  switch (f) {
+    case EpaFuel::petrol: return "petrol";
+    case EpaFuel::diesel: return "diesel";
+    case EpaFuel::e85: return "E85";
+    case EpaFuel::electricity: return "electric";
+    case EpaFuel::hydrogen: return "hydrogen";
+    case EpaFuel::cold_test_fuel: return "cold-test fuel";
+    case EpaFuel::other: return "other";
+  }
+  return "other";
+}
+
+std::string to_string(SkipReason r) {
+  switch (r) {
+    case SkipReason::none: return "";
+    case SkipReason::no_measured_result: return "no measured result";
+    case SkipReason::absurd_measured_result: return "measured result outside any car of its kind";
+    case SkipReason::air_conditioning_test: return "SC03 air-conditioning test: no cabin or air-conditioning model";
+    case SkipReason::cold_test: return "cold-ambient test (-7 degC): no cold-ambient model";
+    case SkipReason::other_procedure: return "test procedure not simulated";
+    case SkipReason::hybrid: return "hybrid or plug-in hybrid: no hybrid model";
+    case SkipReason::fuel_cell: return "hydrogen fuel cell: no fuel-cell model";
+    case SkipReason::unsupported_fuel: return "fuel without properties here";
+    case SkipReason::missing_field: return "missing field";
+    case SkipReason::absurd_field: return "field outside its physical range";
+    case SkipReason::simulation_failed: return "simulation failed";
+  }
+  return "";
+}
+
+std::vector<EpaTestRow> read_epa_test_car_list(const std::string& path) {
+  const CsvTable t = read_csv(path);
+  auto col = [&](const std::string& name) {
+    const auto c = t.column(name);
+    if (!c) throw InputError(path, "no column '" + name + "' (an EPA Test Car List file has it); found: " + t.columns_list());
+    return *c;
+  };
+  const std::size_t c_test = col("Test Number"), c_make = col("Represented Test Veh Make"),
+                    c_model = col("Represented Test Veh Model"), c_id = col("Test Vehicle ID"),
+                    c_proc = col("Test Procedure Description"), c_fuel = col("Test Fuel Type Description"),
+                    c_trans = col("Tested Transmission Type"), c_drive = col("Drive System Description"),
+                    c_etw = col("Equivalent Test Weight (lbs.)"), c_disp = col("Test Veh Displacement (L)"),
+                    c_hp = col("Rated Horsepower"), c_gears = col("# of Gears"), c_nv = col("N/V Ratio"),
+                    c_a = col("Target Coef A (lbf)"), c_b = col("Target Coef B (lbf/mph)"),
+                    c_c = col("Target Coef C (lbf/mph**2)"), c_fe = col("RND_ADJ_FE");
+  const std::size_t c_bag[3] = {col("FE Bag 1"), col("FE Bag 2"), col("FE Bag 3")};
+  std::vector<EpaTestRow> rows;
+  rows.reserve(t.rows.size());
+  for (std::size_t i = 0; i < t.rows.size(); ++i) {
+    const auto& cells = t.rows[i];
+    auto number = [&](std::size_t c) -> std::optional<double> {
+      const auto v = parse_number(cells[c]);
+      if (!v || !std::isfinite(*v)) return std::nullopt;
+      return v;
+    };
+    EpaTestRow r;
+    r.line = t.row_line[i];
+    r.test_number = trim(cells[c_test]);
+    r.make = trim(cells[c_make]);
+    r.model = trim(cells[c_model]);
+    r.vehicle_id = trim(cells[c_id]);
+    r.procedure = trim(cells[c_proc]);
+    r.cycle = cycle_of(r.procedure);
+    r.fuel = fuel_of(trim(cells[c_fuel]));
+    r.transmission_text = trim(cells[c_trans]);
+    r.transmission = transmission_of(r.transmission_text);
+    r.drive_text = trim(cells[c_drive]);
+    const std::string d = lower(r.drive_text);
+    r.all_wheel_drive = has(d, "all wheel") || has(d, "4-wheel");
+    if (const auto v = number(c_etw)) r.test_mass_kg = *v * kKgPerLb;
+    if (const auto v = number(c_disp)) r.displacement_m3 = *v * units::kM3PerLitre;
+    if (const auto v = number(c_hp)) r.rated_power_w = *v * kWPerHp;
+    if (const auto v = number(c_gears); v && *v == std::floor(*v) && *v >= 0 && *v < 100) r.gears = static_cast<int>(*v);
+    if (const auto v = number(c_nv)) r.engine_radps_per_mps = *v * 2.0 * std::numbers::pi / 60.0 / kMpsPerMph;
+    if (const auto v = number(c_a)) r.road_a_n = *v * kNPerLbf;
+    if (const auto v = number(c_b)) r.road_b_n_s_per_m = *v * kNPerLbf / kMpsPerMph;
+    if (const auto v = number(c_c)) r.road_c_n_s2_per_m2 = *v * kNPerLbf / (kMpsPerMph * kMpsPerMph);
+    r.measured = number(c_fe);
+    for (int b = 0; b < 3; ++b) r.bag_mpg[b] = number(c_bag[b]);
+    rows.push_back(std::move(r));
+  }
+  return rows;
+}
+
+}  // namespace rollsim::validate

@@ -1,0 +1,314 @@
+#include "rollsim/validate/validate.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdint>
+#include <map>
+#include <tuple>
+
+#include "rollsim/common/error.hpp"
+#include "rollsim/common/parallel.hpp"
+#include "rollsim/common/units.hpp"
+#include "rollsim/cycle/drive_cycle.hpp"
+
+namespace rollsim::validate {
+
+namespace {
+
+constexpr double kM3PerGallon = 3.785411784e-3;
+constexpr double kKwhPerGallonEquivalent = 33.705;  // EPA's energy content of a gallon of gasoline for MPGe
+// FTP-75 weighting of the cold-start (bags 1+2) and hot-start (bags 3+2) UDDS, 40 CFR 600.113.
+constexpr double kColdWeight = 0.43, kHotWeight = 0.57;
+constexpr std::uint64_t kFnvOffset = 0xcbf29ce484222325ULL, kFnvPrime = 0x100000001b3ULL;
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return s;
+}
+
+bool liquid(EpaFuel f) { return f == EpaFuel::petrol || f == EpaFuel::diesel || f == EpaFuel::e85; }
+bool charge_depleting(EpaCycle c) { return c == EpaCycle::cd_udds || c == EpaCycle::cd_highway || c == EpaCycle::cd_us06; }
+bool simulated_kind(EpaCycle c) { return c == EpaCycle::ftp75 || c == EpaCycle::hwfet || c == EpaCycle::us06 || charge_depleting(c); }
+
+// The FTP's bags cut from the UDDS: bag 1 (cold, and again hot as bag 3) is 0-505 s, bag 2 505-1369 s.
+DriveCycle slice(const DriveCycle& c, double t0_s, double t1_s, const std::string& name) {
+  DriveCycle s;
+  s.name = name;
+  s.source = c.source;
+  for (std::size_t i = 0; i < c.time_s.size(); ++i) {
+    if (c.time_s[i] < t0_s || c.time_s[i] > t1_s) continue;
+    s.time_s.push_back(c.time_s[i]);
+    s.speed_mps.push_back(c.speed_mps[i]);
+    s.grade.push_back(c.grade.empty() ? 0.0 : c.grade[i]);
+  }
+  return s;
+}
+
+struct Cycles {
+  DriveCycle bag1, bag2, udds, hwfet, us06;
+};
+Cycles shipped_cycles() {
+  Cycles c;
+  c.udds = load_cycle("udds");
+  c.bag1 = slice(c.udds, 0.0, 505.0, "ftp75_bag1");
+  c.bag2 = slice(c.udds, 505.0, c.udds.time_s.back(), "ftp75_bag2");
+  c.hwfet = load_cycle("hwfet");
+  c.us06 = load_cycle("us06");
+  return c;
+}
+
+// ---- hybrids: the list does not flag them, so three rules (README) ----
+std::string vehicle_key(const EpaTestRow& r) { return lower(r.make) + "|" + lower(r.model) + "|" + r.vehicle_id; }
+
+bool name_says_hybrid(const EpaTestRow& r) {
+  const std::string m = lower(r.model);
+  for (const char* word : {"hybrid", "plug-in", "prime", "4xe", "recharge", "tfsie"}) {
+    if (m.find(word) != std::string::npos) return true;
+  }
+  // Whole tokens: HEV, FHEV, PHEV, MHEV, and Volvo's T8 (its plug-in).
+  std::string token;
+  for (std::size_t i = 0; i <= m.size(); ++i) {
+    if (i < m.size() && std::isalnum(static_cast<unsigned char>(m[i]))) {
+      token += m[i];
+      continue;
+    }
+    if (token == "t8" || (token.size() >= 3 && token.compare(token.size() - 3, 3, "hev") == 0)) return true;
+    token.clear();
+  }
+  return false;
+}
+
+struct VehicleFacts {
+  bool charge_depleting_on_fuel = false;
+  double ftp_mpg = 0.0, hwfet_mpg = 0.0;
+};
+
+std::map<std::string, VehicleFacts> vehicle_facts(const std::vector<EpaTestRow>& rows) {
+  std::map<std::string, VehicleFacts> f;
+  for (const auto& r : rows) {
+    auto& v = f[vehicle_key(r)];
+    if (charge_depleting(r.cycle) && liquid(r.fuel)) v.charge_depleting_on_fuel = true;
+    if (!r.measured || *r.measured <= 0.0 || *r.measured > 150.0 || !liquid(r.fuel)) continue;
+    if (r.cycle == EpaCycle::ftp75) v.ftp_mpg = *r.measured;
+    if (r.cycle == EpaCycle::hwfet) v.hwfet_mpg = *r.measured;
+  }
+  return f;
+}
+
+// A conventional car's highway economy beats its city economy by 25-50 %; regenerative braking and engine-off
+// stops bring a hybrid's city figure up to its highway one.
+constexpr double kHybridHighwayOverCity = 1.10;
+
+// ---- what each row is and whether it runs ----
+void classify(const EpaTestRow& r, const std::map<std::string, VehicleFacts>& facts, RowOutcome& o) {
+  o.row = &r;
+  o.fitting_half = in_fitting_half(r);
+  o.powertrain = to_string(r.fuel);
+  o.unit = r.fuel == EpaFuel::electricity ? "mpge" : "mpg";
+  auto skip = [&](SkipReason why, std::string detail = "") {
+    o.skip = why;
+    o.skip_detail = std::move(detail);
+  };
+  if (r.cycle == EpaCycle::sc03) return skip(SkipReason::air_conditioning_test);
+  if (r.cycle == EpaCycle::cold || r.fuel == EpaFuel::cold_test_fuel) return skip(SkipReason::cold_test);
+  if (r.cycle == EpaCycle::other) return skip(SkipReason::other_procedure, "'" + r.procedure + "'");
+  if (r.fuel == EpaFuel::hydrogen) return skip(SkipReason::fuel_cell);
+  if (r.fuel == EpaFuel::other) return skip(SkipReason::unsupported_fuel);
+  if (liquid(r.fuel)) {
+    const VehicleFacts& v = facts.at(vehicle_key(r));
+    if (charge_depleting(r.cycle) || v.charge_depleting_on_fuel)
+      return skip(SkipReason::hybrid, "plug-in: charge-depleting tests on a liquid fuel");
+    if (name_says_hybrid(r)) return skip(SkipReason::hybrid, "named so: '" + r.model + "'");
+    if (v.ftp_mpg > 0.0 && v.hwfet_mpg > 0.0 && v.hwfet_mpg < kHybridHighwayOverCity * v.ftp_mpg)
+      return skip(SkipReason::hybrid, "city economy as good as highway: HWFET " + format_value(v.hwfet_mpg) +
+                                          " mpg < 1.1 x FTP " + format_value(v.ftp_mpg) + " mpg");
+  } else if (!charge_depleting(r.cycle)) {
+    return skip(SkipReason::other_procedure, "electric car on '" + r.procedure + "' (not a charge-depleting test)");
+  }
+  if (!r.measured) return skip(SkipReason::no_measured_result);
+  o.measured = *r.measured;
+  if (r.fuel == EpaFuel::electricity && o.measured >= 8.0 && o.measured < 60.0) {
+    // See the data's SOURCES.md: some electric rows give 17-35 "MPG"; read as kWh per 100 miles.
+    o.measured = 100.0 * kKwhPerGallonEquivalent / o.measured;
+    o.measured_from_kwh_per_100mi = true;
+  }
+  const bool plausible = r.fuel == EpaFuel::electricity ? o.measured >= 60.0 && o.measured <= 250.0
+                                                        : o.measured >= 5.0 && o.measured <= 100.0;
+  if (!plausible) return skip(SkipReason::absurd_measured_result, format_value(*r.measured) + " " + o.unit);
+  std::string detail;
+  if (const SkipReason why = check_car_fields(r, detail); why != SkipReason::none) return skip(why, detail);
+}
+
+// ---- simulation with the nominal constants; everything the fit needs is linear in what it scales ----
+struct Raw {
+  double mpg_or_mpge = 0.0;        // non-FTP rows: the prediction with the nominal constants
+  double bag1_hot_m3 = 0.0, bag2_m3 = 0.0, cold_extra_per_k_m3 = 0.0;  // FTP rows
+  double bag1_m = 0.0, bag2_m = 0.0;
+};
+
+double miles(double m) { return m / units::kMPerMile; }
+double gallons(double m3) { return m3 / kM3PerGallon; }
+
+double ftp_composite_mpg(const Raw& w, double cold_fuel_excess) {
+  const double bag1_cold_m3 = w.bag1_hot_m3 + cold_fuel_excess * w.cold_extra_per_k_m3;
+  return ftp75_weighted_mpg(gallons(bag1_cold_m3), gallons(w.bag2_m3), gallons(w.bag1_hot_m3), miles(w.bag1_m), miles(w.bag2_m));
+}
+
+Raw simulate_row(const EpaTestRow& r, const Cycles& c, const EpaDefaults& d) {
+  const VehicleModel car = car_from_row(r, d);
+  Raw w;
+  if (r.fuel == EpaFuel::electricity) {
+    const DriveCycle& cycle = r.cycle == EpaCycle::cd_highway ? c.hwfet : r.cycle == EpaCycle::cd_us06 ? c.us06 : c.udds;
+    const SimulationResult s = simulate_replay(car, cycle);
+    // SAE J1634 / 40 CFR 600.116: the result is the AC recharge energy from the wall after the depletion test,
+    // over the distance driven: battery energy out (terminals + internal loss) over the charge efficiency.
+    const double wall_kwh = units::j_to_kwh(s.energy.battery_terminal_j + s.energy.battery_loss_j) / d.charge_efficiency;
+    w.mpg_or_mpge = kKwhPerGallonEquivalent / (wall_kwh / miles(s.distance_m));
+    return w;
+  }
+  auto fuel_m3 = [](const SimulationResult& s) { return s.fuel ? s.fuel->volume_m3 : 0.0; };
+  if (r.cycle == EpaCycle::ftp75) {
+    const SimulationResult hot = simulate_replay(car, c.bag1);
+    const SimulationResult stabilised = simulate_replay(car, c.bag2);
+    VehicleModel cold_car = car;
+    cold_car.effects.push_back(cold_start_effect(r, 1.0));
+    const SimulationResult cold = simulate_replay(cold_car, c.bag1);
+    w.bag1_hot_m3 = fuel_m3(hot);
+    w.bag2_m3 = fuel_m3(stabilised);
+    w.cold_extra_per_k_m3 = fuel_m3(cold) - w.bag1_hot_m3;
+    w.bag1_m = hot.distance_m;
+    w.bag2_m = stabilised.distance_m;
+    return w;
+  }
+  const SimulationResult s = simulate_replay(car, r.cycle == EpaCycle::hwfet ? c.hwfet : c.us06);
+  w.mpg_or_mpge = miles(s.distance_m) / gallons(fuel_m3(s));
+  return w;
+}
+
+double median(std::vector<double> x) {
+  if (x.empty()) return std::nan("");
+  const std::size_t n = x.size() / 2;
+  std::nth_element(x.begin(), x.begin() + static_cast<std::ptrdiff_t>(n), x.end());
+  const double hi = x[n];
+  if (x.size() % 2) return hi;
+  return 0.5 * (hi + *std::max_element(x.begin(), x.begin() + static_cast<std::ptrdiff_t>(n)));
+}
+
+// Nearest-rank percentile.
+double percentile(std::vector<double> x, double p) {
+  if (x.empty()) return std::nan("");
+  std::sort(x.begin(), x.end());
+  const auto rank = static_cast<std::size_t>(std::ceil(p / 100.0 * static_cast<double>(x.size())));
+  return x[std::clamp<std::size_t>(rank, 1, x.size()) - 1];
+}
+
+}  // namespace
+
+double ftp75_weighted_mpg(double bag1_gal, double bag2_gal, double bag3_gal, double bag1_miles, double bag2_miles) {
+  const double d = bag1_miles + bag2_miles;
+  return 1.0 / (kColdWeight * (bag1_gal + bag2_gal) / d + kHotWeight * (bag3_gal + bag2_gal) / d);
+}
+
+bool in_fitting_half(const EpaTestRow& row) {
+  std::uint64_t h = kFnvOffset;
+  for (const char c : lower(row.make) + "|" + lower(row.model)) h = (h ^ static_cast<unsigned char>(c)) * kFnvPrime;
+  return h % 2 == 0;
+}
+
+Validation validate_epa_list(const std::vector<EpaTestRow>& rows, unsigned threads) {
+  Validation v;
+  v.rows.resize(rows.size());
+  const auto facts = vehicle_facts(rows);
+  for (std::size_t i = 0; i < rows.size(); ++i) classify(rows[i], facts, v.rows[i]);
+
+  const Cycles cycles = shipped_cycles();
+  const EpaDefaults nominal;
+  std::vector<Raw> raw(rows.size());
+  parallel_for(rows.size(), threads, [&](std::size_t i) {
+    if (v.rows[i].skip != SkipReason::none) return;
+    try {
+      raw[i] = simulate_row(rows[i], cycles, nominal);
+    } catch (const std::exception& e) {  // a row's model outside its domain is that row's skip, not the run's end
+      v.rows[i].skip = SkipReason::simulation_failed;
+      v.rows[i].skip_detail = e.what();
+    }
+  });
+
+  // Fit 1: the cold-start excess, from bag 1 against bag 3 (same trace, cold and hot) of the fitting half's
+  // petrol FTPs: measured fuel ratio - 1 = k x (extra fuel per unit k) / hot bag-1 fuel.
+  FittedConstants& f = v.fitted;
+  f.defaults = nominal;
+  std::vector<double> ks;
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const auto& o = v.rows[i];
+    const auto& r = rows[i];
+    if (o.skip != SkipReason::none || !o.fitting_half || r.fuel != EpaFuel::petrol || r.cycle != EpaCycle::ftp75) continue;
+    if (!r.bag_mpg[0] || !r.bag_mpg[2] || *r.bag_mpg[0] <= 0.0 || raw[i].cold_extra_per_k_m3 <= 0.0) continue;
+    ks.push_back((*r.bag_mpg[2] / *r.bag_mpg[0] - 1.0) * raw[i].bag1_hot_m3 / raw[i].cold_extra_per_k_m3);
+  }
+  f.cold_start_rows = ks.size();
+  if (!ks.empty()) f.defaults.cold_fuel_excess = median(ks);
+
+  auto nominal_prediction = [&](std::size_t i) {
+    return rows[i].cycle == EpaCycle::ftp75 ? ftp_composite_mpg(raw[i], f.defaults.cold_fuel_excess) : raw[i].mpg_or_mpge;
+  };
+  // Fit 2: one scale per energy source. Fuel power is proportional to 1 / indicated efficiency, and the wall
+  // energy to 1 / charge efficiency, so the median measured / predicted ratio of the fitting half scales them.
+  auto fitted_scale = [&](EpaFuel fuel, std::size_t& count) {
+    std::vector<double> ratios;
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      if (v.rows[i].skip == SkipReason::none && v.rows[i].fitting_half && rows[i].fuel == fuel)
+        ratios.push_back(v.rows[i].measured / nominal_prediction(i));
+    }
+    count = ratios.size();
+    return ratios.empty() ? 1.0 : median(ratios);
+  };
+  const double petrol_scale = fitted_scale(EpaFuel::petrol, f.petrol_rows);
+  const double diesel_scale = fitted_scale(EpaFuel::diesel, f.diesel_rows);
+  const double electric_scale = fitted_scale(EpaFuel::electricity, f.electric_rows);
+  f.defaults.petrol_indicated_efficiency *= petrol_scale;
+  f.defaults.diesel_indicated_efficiency *= diesel_scale;
+  f.defaults.charge_efficiency *= electric_scale;
+
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    if (v.rows[i].skip != SkipReason::none) continue;
+    const EpaFuel fuel = rows[i].fuel;
+    const double scale = fuel == EpaFuel::electricity ? electric_scale : fuel == EpaFuel::diesel ? diesel_scale : petrol_scale;
+    v.rows[i].predicted = nominal_prediction(i) * scale;
+  }
+  return v;
+}
+
+std::vector<SummaryLine> summarise(const Validation& v) {
+  std::map<std::tuple<std::string, std::string, std::string>, std::vector<double>> errors;
+  for (const auto& o : v.rows) {
+    if (o.skip != SkipReason::none) continue;
+    errors[{o.powertrain, to_string(o.row->cycle), o.fitting_half ? "fitting" : "held-out"}].push_back(o.error_pct());
+  }
+  std::vector<SummaryLine> out;
+  for (const auto& [key, e] : errors) {
+    SummaryLine s;
+    std::tie(s.powertrain, s.cycle, s.half) = key;
+    s.count = e.size();
+    s.median_error_pct = median(e);
+    std::vector<double> a(e.size());
+    std::transform(e.begin(), e.end(), a.begin(), [](double x) { return std::abs(x); });
+    s.median_abs_error_pct = median(a);
+    s.p90_abs_error_pct = percentile(a, 90.0);
+    out.push_back(s);
+  }
+  return out;
+}
+
+Coverage coverage(const Validation& v, bool fitting_half) {
+  Coverage c;
+  for (const auto& o : v.rows) {
+    if (o.fitting_half != fitting_half || !simulated_kind(o.row->cycle)) continue;
+    ++c.eligible;
+    if (o.skip == SkipReason::none) ++c.simulated;
+  }
+  return c;
+}
+
+}  // namespace rollsim::validate

@@ -1,0 +1,69 @@
+// Vehicle files written back: tyre files resolved to absolute paths, so a file written elsewhere still loads.
+#include "rollsim/vehicle/vehicle_file.hpp"
+
+#include <filesystem>
+#include <sstream>
+#include <vector>
+
+#include "rollsim/common/error.hpp"
+#include "rollsim/common/yaml_reader.hpp"
+
+namespace rollsim {
+
+std::string resolve_tyre_path(const std::string& name, const std::string& vehicle_file, const std::string& where) {
+  namespace fs = std::filesystem;
+  const fs::path beside = fs::path(vehicle_file).parent_path() / name;
+  for (const fs::path& p : {beside, fs::path(beside.string() + ".yaml")})
+    if (fs::is_regular_file(p)) return p.string();
+  try {
+    return resolve_data_file(name, "tyres", ".yaml", where);
+  } catch (const InputError&) {
+    throw InputError(where, "tyre file '" + name + "' not found beside the vehicle file or in the shipped tyres/");
+  }
+}
+
+std::string portable_vehicle_yaml(const std::string& text, const std::string& vehicle_path, const std::string& tyre_override) {
+  namespace fs = std::filesystem;
+  auto quoted = [](const std::string& path) { return "\"" + fs::absolute(path).lexically_normal().string() + "\""; };
+  // The tyres the file names, resolved as load_vehicle_file resolves them.
+  std::vector<std::pair<std::string, std::string>> tyres;  // key, absolute path
+  if (!tyre_override.empty()) {
+    tyres.emplace_back("all", quoted(tyre_override));
+  } else {
+    YamlMap root = YamlMap::load_file(vehicle_path);
+    auto t = root.optional_map("tyres");
+    if (!t) return text;  // coast-down only: nothing to resolve
+    for (const char* key : {"all", "front", "rear"})
+      if (t->has(key)) tyres.emplace_back(key, quoted(resolve_tyre_path(t->string(key), vehicle_path, t->where(key))));
+  }
+  // Replace the top-level tyres: block (its line and the indented or blank lines under it) by the resolved one.
+  std::istringstream in(text);
+  std::ostringstream out;
+  bool in_block = false, written = false;
+  auto write_block = [&] {
+    out << "tyres:  # resolved to absolute paths when this file was written\n";
+    for (const auto& [key, path] : tyres) out << "  " << key << ": " << path << "\n";
+    written = true;
+  };
+  for (std::string line; std::getline(in, line);) {
+    const bool top_level = !line.empty() && line[0] != ' ' && line[0] != '\t' && line[0] != '#';
+    if (in_block && top_level) in_block = false;
+    if (in_block) continue;
+    if (line.rfind("tyres:", 0) == 0) {
+      in_block = true;
+      write_block();
+      continue;
+    }
+    out << line << "\n";
+  }
+  if (!written) {
+    std::string s = out.str();
+    std::ostringstream o2;
+    o2 << s;
+    out.swap(o2);
+    write_block();  // a --tyre on a coast-down vehicle file: the tyres join it
+  }
+  return out.str();
+}
+
+}  // namespace rollsim

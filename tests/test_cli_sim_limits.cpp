@@ -1,0 +1,122 @@
+// `rollsim simulate` at the edges, through the binary: an empty battery, a trace that never moves, values beyond
+// physical bounds in cycle and vehicle files.
+#include <gtest/gtest.h>
+
+#include "test_support.hpp"
+
+#include <fstream>
+#include <string>
+
+namespace {
+
+using rollsim::test::run_rollsim;
+
+class SimLimitsCli : public rollsim::test::FileFixture {
+ protected:
+  // NEDC repeated `times` times, written as a cycle CSV.
+  std::string repeated_nedc(int times) {
+    std::ifstream in(std::string(ROLLSIM_SOURCE_DIR) + "/cycles/nedc.csv");
+    std::string header, line;
+    std::getline(in, header);
+    std::vector<std::pair<double, std::string>> rows;
+    while (std::getline(in, line)) {
+      const auto comma = line.find(',');
+      rows.emplace_back(std::stod(line.substr(0, comma)), line.substr(comma));
+    }
+    std::string text = header + "\n";
+    const double lap_s = rows.back().first - rows.front().first;
+    for (int k = 0; k < times; ++k) {
+      for (std::size_t i = k == 0 ? 0 : 1; i < rows.size(); ++i) text += std::to_string(rows[i].first + k * lap_s) + rows[i].second + "\n";
+    }
+    return write("nedc_many.csv", text);
+  }
+};
+
+bool has(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+}  // namespace
+
+// 24 h of NEDC empties the battery: the text says when and where, and no negative state of charge is printed as
+// a result; --json carries the same as fields.
+TEST_F(SimLimitsCli, EmptyBatteryIsReportedWithTimeAndDistance) {
+  const std::string cycle = repeated_nedc(73);
+  const auto text = run_rollsim("simulate --vehicle ev --cycle " + cycle);
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_TRUE(has(text.out, "WARNING: the usable battery ran empty at t = ")) << text.out;
+  EXPECT_FALSE(has(text.out, "% -> -")) << text.out;
+  const auto json = run_rollsim("simulate --vehicle ev --json --cycle " + cycle);
+  ASSERT_EQ(json.exit_code, 0) << json.err;
+  EXPECT_TRUE(has(json.out, "\"battery_empty\":true")) << json.out;
+  EXPECT_TRUE(has(json.out, "\"battery_empty_at_s\":")) << json.out;
+  EXPECT_TRUE(has(json.out, "\"battery_empty_at_km\":")) << json.out;
+  const auto nedc = run_rollsim("simulate --vehicle ev --json");
+  EXPECT_TRUE(has(nedc.out, "\"battery_empty\":false")) << nedc.out;
+}
+
+// A standstill-only trace: the car did not move, so per-distance figures are undefined and said to be, never
+// inf or NaN; the JSON has null for them.
+TEST_F(SimLimitsCli, StandstillOnlyTraceSaysPerDistanceFiguresAreUndefined) {
+  const std::string cycle = write("stand.csv", "time_s,speed_kmh\n0,0\n600,0\n");
+  for (const char* car : {"ev", "ice"}) {
+    for (const char* mode : {"", " --replay"}) {
+      const auto out = run_rollsim(std::string("simulate --vehicle ") + car + mode + " --cycle " + cycle);
+      SCOPED_TRACE(std::string(car) + mode);
+      ASSERT_EQ(out.exit_code, 0) << out.err;
+      EXPECT_TRUE(has(out.out, "did not move")) << out.out;
+      EXPECT_FALSE(has(out.out, "inf")) << out.out;
+      EXPECT_FALSE(has(out.out, "nan")) << out.out;
+      const auto json = run_rollsim(std::string("simulate --json --vehicle ") + car + mode + " --cycle " + cycle);
+      EXPECT_TRUE(has(json.out, "\"moved\":false")) << json.out;
+      EXPECT_FALSE(has(json.out, "inf")) << json.out;
+      EXPECT_FALSE(has(json.out, "nan")) << json.out;
+    }
+  }
+}
+
+// Values beyond physical bounds: one error naming the file, the line or key, the value and what is allowed;
+// exit 2, nothing on stdout (they printed inf or NaN with exit 0, or failed inside CVODES).
+TEST_F(SimLimitsCli, CycleValuesBeyondPhysicalBoundsAreNamedErrors) {
+  struct Case {
+    std::string csv, expect_value, expect_allowed;
+  };
+  for (const Case& c : {Case{"time_s,speed_kmh\n0,0\n10,1e300\n", "1e+300", "[0, 500] km/h"},
+                        Case{"time_s,speed_mps\n0,0\n10,1000\n", "1000", "[0, 138.889] m/s"},
+                        Case{"time_s,speed_kmh\n0,0\n1e300,50\n", "1e+300", "0.001 to 86400 s"},
+                        Case{"time_s,speed_kmh\n0,0\n1e-300,0\n2,10\n", "1e-300", "0.001 to 86400 s"},
+                        Case{"time_s,speed_kmh\n0,0\n1,100\n", "27.7", "19.6 m/s^2"}}) {
+    const std::string path = write("bounds.csv", c.csv);
+    const auto out = run_rollsim("simulate --vehicle ev --cycle " + path);
+    SCOPED_TRACE(c.csv);
+    EXPECT_EQ(out.exit_code, 2) << out.out << out.err;
+    EXPECT_TRUE(out.out.empty()) << out.out;
+    EXPECT_TRUE(has(out.err, path)) << out.err;
+    EXPECT_TRUE(has(out.err, "line ")) << out.err;
+    EXPECT_TRUE(has(out.err, c.expect_value)) << out.err;
+    EXPECT_TRUE(has(out.err, c.expect_allowed)) << out.err;
+  }
+}
+
+TEST_F(SimLimitsCli, VehicleValuesBeyondPhysicalBoundsAreNamedErrors) {
+  std::ifstream in(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/ev.yaml");
+  const std::string good((std::istreambuf_iterator<char>(in)), {});
+  struct Case {
+    std::string from, to, key;
+  };
+  for (const Case& c : {Case{"ratio: 7.94", "ratio: 1e-300", "reduction.ratio"},
+                        Case{"test_mass_kg: 1631", "test_mass_kg: 1e308", "body.test_mass_kg"},
+                        Case{"rotating_mass_kg: 45", "rotating_mass_kg: 5000", "body.rotating_mass_kg"},
+                        Case{"max_power_kw: 80", "max_power_kw: 1e300", "motor.max_power_kw"},
+                        Case{"usable_capacity_kwh: 21.3", "usable_capacity_kwh: 1e300", "battery.usable_capacity_kwh"}}) {
+    std::string text = good;
+    text.replace(text.find(c.from), c.from.size(), c.to);
+    text.replace(text.find("all: nominal.yaml"), 17, "all: " + std::string(ROLLSIM_SOURCE_DIR) + "/tyres/nominal.yaml");
+    const std::string path = write("bounds.yaml", text);
+    const auto out = run_rollsim("simulate --vehicle " + path);
+    SCOPED_TRACE(c.to);
+    EXPECT_EQ(out.exit_code, 2) << out.out << out.err;
+    EXPECT_TRUE(out.out.empty()) << out.out;
+    EXPECT_TRUE(has(out.err, path)) << out.err;
+    EXPECT_TRUE(has(out.err, c.key)) << out.err;
+    EXPECT_TRUE(has(out.err, "must be in")) << out.err;
+  }
+}

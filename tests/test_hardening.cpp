@@ -1,0 +1,246 @@
+// Hostile and careless input (issue 11): shell text in names, duplicate keys, misleading or unnamed errors,
+// outputs left behind on failure. Each test failed before its fix.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "test_support.hpp"
+
+namespace rollsim::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+bool has(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+bool have_gnuplot() { return std::system("command -v gnuplot > /dev/null 2>&1") == 0; }
+
+class Hardening : public FileFixture {};
+
+// A tyre's name reaches gnuplot as a title and key: a double quote, a single quote, a line break or a
+// backquote in it must neither run a command nor break the figure, and it renders as written.
+TEST_F(Hardening, TyreNameCannotRunCommandsThroughGnuplot) {
+  if (!have_gnuplot()) GTEST_SKIP() << "gnuplot not installed";
+  const std::string pwned = (dir_ / "PWNED").string();
+  const std::vector<std::string> names{
+      "'x\" ; system \"touch " + pwned + "\" ; #'",
+      "\"x' ; system 'touch " + pwned + "' ; #\"",
+      "\"x\\nsystem 'touch " + pwned + "'\\n#\"",
+      "'x`touch " + pwned + "` fuel_rate'",
+  };
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    const std::string tyre = write("evil" + std::to_string(i) + ".yaml", "name: " + names[i] + "\nsize: \"175/70 R14 84T\"\npressure_bar: 2.1\n");
+    const fs::path svg = dir_ / ("p" + std::to_string(i) + ".svg");
+    const CmdResult r = run_rollsim("sweep --tyre '" + tyre + "' --param pressure --from 2 --to 3 --steps 3 --plot '" +
+                                    svg.string() + "' --output '" + (dir_ / "s.csv").string() + "'");
+    EXPECT_EQ(r.exit_code, 0) << names[i] << "\n" << r.err;
+    EXPECT_FALSE(fs::exists(pwned)) << "gnuplot ran a command from the name " << names[i];
+    const std::string figure = slurp(svg);
+    EXPECT_TRUE(has(figure, "<svg")) << names[i];
+    EXPECT_TRUE(has(figure, "touch")) << "the name is drawn: " << names[i];
+  }
+  // Enhanced text is off: an underscore is drawn, not turned into a subscript.
+  EXPECT_TRUE(has(slurp(dir_ / "p3.svg"), "fuel_rate"));
+}
+
+
+std::string shipped(const std::string& rel) { return slurp(fs::path(ROLLSIM_SOURCE_DIR) / rel); }
+
+// The 1-based line of the n-th (1-based) line of `text` that contains `part`.
+int line_of(const std::string& text, const std::string& part, int n) {
+  const auto ls = std::string("\n") + text;
+  int line = 0, found = 0;
+  std::istringstream in(text);
+  for (std::string l; std::getline(in, l);) {
+    ++line;
+    if (has(l, part) && ++found == n) return line;
+  }
+  return -1;
+}
+
+// A key given twice: the second is reported at its line, whichever file and depth it is in.
+TEST_F(Hardening, DuplicateKeysAreRejectedAtTheSecondOccurrence) {
+  const std::string tyre = write("dup.yaml", "name: d\nsize: \"175/70 R14 84T\"\npressure_bar: 2.1\npressure_bar: 5\n");
+  CmdResult r = run_rollsim("tyre '" + tyre + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, tyre + ": line 4: key 'pressure_bar'")) << r.err;
+
+  std::string ev = shipped("vehicles/ev.yaml");
+  const std::string mass = "  test_mass_kg: 1631";
+  ASSERT_TRUE(has(ev, mass));
+  ev.replace(ev.find(mass), mass.size(), mass + "\n  test_mass_kg: 40000");
+  const std::string car = write("car.yaml", ev);
+  r = run_rollsim("simulate --vehicle '" + car + "' --replay");
+  EXPECT_EQ(r.exit_code, 2) << r.out;
+  EXPECT_TRUE(has(r.err, car + ": line " + std::to_string(line_of(ev, "test_mass_kg", 2)) + ": key 'test_mass_kg'")) << r.err;
+
+  const std::string base = write("base.yaml", "cases:\n  - {name: a, vehicle: ev, tyre: nominal, cycle: nedc, unit: kwh_per_10km, "
+                                               "expected: 1.6, tolerance_pct: 1}\ncases: []\n");
+  r = run_rollsim("regress '" + base + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, base + ": line 3: key 'cases'")) << r.err;
+}
+
+// Errors that came from the generic exception path without a file name now name file and key or line.
+TEST_F(Hardening, ErrorsDeepInParsingNameFileAndPlace) {
+  const std::string list_key = write("listkey.yaml", "name: x\n[a, b]: 1\n");
+  CmdResult r = run_rollsim("tyre '" + list_key + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, list_key + ": line 2")) << r.err;
+
+  const std::string word = write("word.yaml", "cases:\n  - foo\n");
+  r = run_rollsim("regress '" + word + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, word + ": line 2: cases[0]")) << r.err;
+
+  const std::string rim = write("rim.yaml", "size: \"175/70 R" + std::string(400, '1') + "\"\npressure_bar: 2\n");
+  r = run_rollsim("tyre '" + rim + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, rim + ": key 'size'")) << r.err;
+
+  r = run_rollsim("regress '" + dir_.string() + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, dir_.string() + ": is a folder")) << r.err;
+
+  // Found by fuzz_tyre in the duplicate-key walk: an alias inside its own anchor is an endless tree.
+  const std::string loop = write("loop.yaml", "a: &x [1, *x, *x]\nsize: \"175/70 R14 84T\"\n");
+  r = run_rollsim("tyre '" + loop + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, loop + ": line 1: nested more than 64 levels")) << r.err;
+
+  // A list item's key is written item.key.
+  const std::string neg = write("neg.yaml", "cases:\n  - {name: a, vehicle: ev, tyre: nominal, cycle: nedc, unit: kwh_per_10km, "
+                                             "expected: -1, tolerance_pct: 1}\n");
+  r = run_rollsim("regress '" + neg + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, "key 'cases[0].expected'")) << r.err;
+}
+
+TEST_F(Hardening, MessagesSayWhatIsWrong) {
+  // A folder where a file is expected is a folder, not a missing file.
+  CmdResult r = run_rollsim("tyre '" + dir_.string() + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, "is a folder")) << r.err;
+  r = run_rollsim("simulate --vehicle ev --tyre '" + dir_.string() + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, "is a folder")) << r.err;
+  r = run_rollsim("simulate --vehicle ev --cycle '" + dir_.string() + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, "is a folder")) << r.err;
+
+  // A huge mass is too large, not "must be > 0".
+  std::string ev = shipped("vehicles/ev.yaml");
+  const std::string mass = "test_mass_kg: 1631";
+  ev.replace(ev.find(mass), mass.size(), "test_mass_kg: 1e308");
+  r = run_rollsim("simulate --vehicle '" + write("heavy.yaml", ev) + "' --replay");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, "1e+308 is not allowed")) << r.err;
+  EXPECT_TRUE(has(r.err, "at most")) << r.err;
+
+  // An unknown subcommand is named, with the known ones.
+  r = run_rollsim("frobnicate --x 1");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, "'frobnicate'")) << r.err;
+  EXPECT_TRUE(has(r.err, "simulate")) << r.err;
+
+  // An empty item in a list of speeds is a typo, not a shorter list.
+  r = run_rollsim("tyre 175-70R14 --speed-kmh '1,,2'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, "--speed-kmh '1,,2'")) << r.err;
+  r = run_rollsim("tyre 175-70R14 --speed-kmh '50,80' --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(lines(r.out).size(), 2u);
+}
+
+// As root every file is readable, so the unreadable case runs as the unprivileged user `nobody`.
+TEST_F(Hardening, UnreadableFileSaysSo) {
+  const std::string tyre = write("secret.yaml", "size: \"175/70 R14 84T\"\npressure_bar: 2.1\n");
+  fs::permissions(tyre, fs::perms::none);
+  fs::permissions(dir_, fs::perms::all);
+  std::string as_user;
+  if (::geteuid() == 0) {
+    if (std::system("command -v setpriv > /dev/null 2>&1") != 0) GTEST_SKIP() << "root without setpriv";
+    as_user = "setpriv --reuid=65534 --regid=65534 --clear-groups";
+  }
+  const CmdResult r = run_rollsim("tyre '" + tyre + "'", as_user);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_TRUE(has(r.err, tyre + ": cannot be read: Permission denied")) << r.err;
+}
+
+// A recording is bounded before it is loaded: by its size in bytes and by its number of samples.
+TEST_F(Hardening, OversizedRecordingIsRejectedEarly) {
+  const std::string big = write("big.csv", "time_s,speed_kmh,battery_power_kw\n");
+  fs::resize_file(big, 300u << 20);  // sparse: no disk used
+  CmdResult r = run_rollsim("diagnose --vehicle ev --recording '" + big + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, big + ": is 300 MiB")) << r.err;
+
+  std::string rows = "time_s,speed_kmh,battery_power_kw\n";
+  rows.reserve(20u << 20);
+  for (int i = 0; i <= 1000000; ++i) rows += std::to_string(i) + ",0,1\n";
+  const std::string many = write("many.csv", rows);
+  r = run_rollsim("diagnose --vehicle ev --recording '" + many + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, many + ": line 1000002: more than 1000000 samples")) << r.err;
+}
+
+
+// Address space bound for a command that should fail before allocating much (not under ASan, whose shadow
+// memory needs terabytes of address space).
+std::string memory_bound() {
+#if defined(__SANITIZE_ADDRESS__)
+  return "";
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+  return "";
+#endif
+#endif
+  return "ulimit -v 1500000 && ";
+}
+
+// A grid is bounded before it is built: 10^6 x 10^6 points used to take 4.5 GB and then fail without a word.
+TEST_F(Hardening, HugeSweepGridIsRefusedBeforeAllocating) {
+  const CmdResult r = run_rollsim("sweep --tyre 175-70R14 --param pressure --from 1 --to 3 --steps 1000000 "
+                                  "--param speed --from 0 --to 100 --steps 1000000",
+                                  memory_bound());
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_TRUE(has(r.err, "--steps: 1000000 x 1000000 points is more than the 1000000 allowed")) << r.err;
+  EXPECT_TRUE(r.out.empty());
+}
+
+// Every destination is checked before the work and all outputs are written after it: a bad one writes none.
+TEST_F(Hardening, NoOutputIsLeftBehindWhenAnotherFails) {
+  const fs::path csv = dir_ / "s.csv";
+  CmdResult r = run_rollsim("sweep --tyre 175-70R14 --param pressure --from 2 --to 3 --steps 3 --output '" +
+                            csv.string() + "' --plot '" + (dir_ / "nodir" / "p.svg").string() + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, "--plot")) << r.err;
+  EXPECT_FALSE(fs::exists(csv));
+
+  const fs::path report = dir_ / "newrep";
+  r = run_rollsim("diagnose --vehicle ev --recording '" + (dir_ / "missing.csv").string() + "' --report '" +
+                  report.string() + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_FALSE(fs::exists(report)) << "the report folder was created before the recording was read";
+
+  const fs::path json = dir_ / "d.json";
+  const std::string rec = std::string(ROLLSIM_SHARED_DIR) + "/data/recordings/anl_d3_2018_toyota_camry/61811012_test_data.csv";
+  r = run_rollsim("diagnose --vehicle camry_2018 --preset anl_d3 --recording '" + rec + "' --json '" + json.string() +
+                  "' --write-vehicle '" + (dir_ / "nodir" / "f.yaml").string() + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, "--write-vehicle")) << r.err;
+  EXPECT_FALSE(fs::exists(json));
+  EXPECT_TRUE(r.out.empty()) << "the diagnosis ran before the outputs were checked";
+
+  r = run_rollsim("simulate --vehicle ev --trace '" + dir_.string() + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, "is a folder")) << r.err;
+  EXPECT_TRUE(r.out.empty());
+  // Nothing but the test's own files: no temporaries either.
+  for (const auto& e : fs::directory_iterator(dir_)) EXPECT_FALSE(has(e.path().filename().string(), ".tmp")) << e.path();
+}
+
+}  // namespace
+}  // namespace rollsim::test

@@ -1,0 +1,357 @@
+// The hysteresis model, `rollsim tyre fit` and its evidence: analytic limits, synthetic truths, the measured
+// Michelin J2452 surfaces held out tyre by tyre, and bad input.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "rollsim/common/error.hpp"
+#include "rollsim/common/units.hpp"
+#include "rollsim/tyre/j2452.hpp"
+#include "rollsim/tyre/j2452_evaluation.hpp"
+#include "rollsim/tyre/tyre_fit.hpp"
+#include "rollsim/tyre/tyre_model.hpp"
+#include "rollsim/tyre/tyre_spec.hpp"
+#include "test_support.hpp"
+
+using namespace rollsim;
+using rollsim::test::CmdResult;
+using rollsim::test::lines;
+using rollsim::test::temp_dir;
+
+namespace {
+
+const std::string kJ2452Csv = std::string(ROLLSIM_SHARED_DIR) + "/data/tyres/j2452_michelin_part.csv";
+
+TyreState hysteresis_tyre() {
+  TyreState t;
+  t.geometry = {0.3159, 0.205, 0.2032};
+  t.pressure_pa = 2.1e5;
+  t.model = TyreModelKind::Hysteresis;
+  t.hysteresis.rrc_ref = 0.009;
+  return t;
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+}
+
+// The evaluation is deterministic and takes ~0.2 s; computed once for the tests that read it.
+const J2452Evaluation& evaluation() {
+  static const J2452Evaluation ev = evaluate_j2452(load_j2452_csv(kJ2452Csv), kJ2452DrumRadius_m);
+  return ev;
+}
+
+CmdResult fit(const std::string& args) { return rollsim::test::run_rollsim("tyre fit " + args); }
+
+bool has(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+
+double json_number(const std::string& line, const std::string& key) {
+  const auto pos = line.find("\"" + key + "\": ");
+  if (pos == std::string::npos) return std::nan("");
+  return std::strtod(line.c_str() + pos + key.size() + 4, nullptr);
+}
+
+}  // namespace
+
+// --- the model: analytic limits and invariants ---
+
+TEST(HysteresisModel, WithoutSpeedAndScalingTermsRrcIsItsLevel) {
+  TyreState t = hysteresis_tyre();
+  t.hysteresis.deflection_exponent = t.hysteresis.load_exponent = 0.0;
+  t.hysteresis.frequency_slope_per_hz = t.hysteresis.speed_loss_rrc_per_hz2 = 0.0;
+  for (double z : {2000.0, 4000.0, 7000.0}) {
+    EXPECT_NEAR(evaluate_rolling_resistance(t, z, 30.0).rrc, 0.009, 1e-15);
+  }
+  EXPECT_EQ(evaluate_rolling_resistance(t, 4000.0, 0.0).rrc, 0.0);  // standstill: no rolling loss
+}
+
+TEST(HysteresisModel, LoadScalingFollowsItsExponentsExactly) {
+  // Rhyne's stiffness does not depend on load, so deflection is proportional to load and the hysteresis part
+  // scales as Z^(n_d + n_z); the speed-squared part as Z^n_w.
+  TyreState t = hysteresis_tyre();
+  const auto a = TyreAtLoad::prepare(t, 3000.0), b = TyreAtLoad::prepare(t, 6000.0);
+  const auto& h = t.hysteresis;
+  EXPECT_NEAR(b.k0() / a.k0(), std::pow(2.0, h.deflection_exponent + h.load_exponent), 1e-12);
+  EXPECT_NEAR(b.k2_s2_per_m2() / a.k2_s2_per_m2(), std::pow(2.0, h.speed_loss_load_exponent), 1e-12);
+  // The frequency rise: k1 / k0 = s_f / (2 pi R).
+  EXPECT_NEAR(a.k1_s_per_m() / a.k0(), h.frequency_slope_per_hz / (2 * std::numbers::pi * 0.3159), 1e-12);
+}
+
+TEST(HysteresisModel, PreparedTyreEqualsTheDirectEvaluation) {
+  const TyreState t = hysteresis_tyre();
+  const auto prepared = TyreAtLoad::prepare(t, 4321.0);
+  for (double kmh = 1.0; kmh <= 250.0; kmh += 7.0) {
+    const auto r = evaluate_rolling_resistance(t, 4321.0, kmh / 3.6);
+    EXPECT_NEAR(prepared.rrc(kmh / 3.6), r.rrc, 1e-15);
+    EXPECT_NEAR(r.rrc_coulomb + r.rrc_viscous + r.rrc_rotational_drag, r.rrc, 1e-15);
+  }
+}
+
+TEST(HysteresisModel, RrcFallsWithPressureAndRisesWithSpeed) {
+  TyreState t = hysteresis_tyre();
+  const double low = evaluate_rolling_resistance(t, 4000.0, 22.0).rrc;
+  t.pressure_pa = 2.8e5;
+  EXPECT_LT(evaluate_rolling_resistance(t, 4000.0, 22.0).rrc, low);
+  EXPECT_GT(evaluate_rolling_resistance(t, 4000.0, 30.0).rrc, evaluate_rolling_resistance(t, 4000.0, 22.0).rrc);
+}
+
+// --- fitting: known truths ---
+
+TEST(TyreFit, RecoversEveryConstantFromASurfaceItGenerated) {
+  TyreState truth = hysteresis_tyre();
+  auto& h = truth.hysteresis;
+  h.rrc_ref = 0.0072, h.deflection_exponent = 0.8, h.load_exponent = -0.3, h.frequency_slope_per_hz = 0.03;
+  h.speed_loss_rrc_per_hz2 = 8e-6, h.speed_loss_load_exponent = -0.5;
+  FitRequest req;
+  const OperatingGrid g = j2452_grid();
+  for (double p : g.pressures_pa)
+    for (double z : g.loads_n)
+      for (double v : g.speeds_mps) {
+        TyreState at = truth;
+        at.pressure_pa = p;
+        req.points.push_back({p, z, v, evaluate_rolling_resistance(at, z, v).rrc, "synthetic"});
+      }
+  TyreState start = truth;
+  start.hysteresis = HysteresisConstants{};
+  const TyreFit f = fit_hysteresis(start, req);
+  ASSERT_EQ(f.params.size(), 6u);
+  for (const auto& e : f.params) {
+    const double want = hysteresis_param_value(h, e.param);
+    EXPECT_NEAR(e.value, want, 1e-6 * std::max(1.0, std::abs(want))) << hysteresis_param_key(e.param);
+  }
+  EXPECT_LT(f.rms_relative_error, 1e-9);
+}
+
+TEST(TyreFit, OnePointReproducesItWithTheAssumedUncertaintyAsInterval) {
+  FitRequest req;
+  req.points = {{2.1e5, 4825.0, 80 / 3.6, 0.0085, "p"}};
+  const TyreFit f = fit_hysteresis(hysteresis_tyre(), req);
+  ASSERT_EQ(f.params.size(), 1u);
+  EXPECT_EQ(f.params[0].param, HysteresisParam::RrcRef);
+  EXPECT_NEAR(f.residuals[0].model_rrc, 0.0085, 1e-12);
+  EXPECT_FALSE(f.sigma_from_residuals);
+  // One parameter, one point, relative residual r: d r / d ln(rrc_ref) is the hysteresis share of RRC (the
+  // speed-squared loss does not scale with the level), so the log-interval is +-1.96 sigma / share.
+  const auto k = TyreAtLoad::prepare(f.tyre, 4825.0);
+  const double v_mps = 80 / 3.6;
+  const double share = (k.k0() + k.k1_s_per_m() * v_mps) / k.rrc(v_mps);
+  const double v = f.params[0].value;
+  EXPECT_NEAR(std::log(f.params[0].high95 / v), 1.96 * 0.02 / share, 1e-6);
+  EXPECT_NEAR(std::log(v / f.params[0].low95), 1.96 * 0.02 / share, 1e-6);
+}
+
+TEST(TyreFit, ChoosesOnlyWhatThePointsDetermine) {
+  auto pt = [](double kpa, double z, double kmh) { return RrcPoint{kpa * 1e3, z, kmh / 3.6, 0.009, "p"}; };
+  EXPECT_EQ(identifiable_params({pt(210, 4000, 80)}).size(), 1u);
+  const auto two_speeds = identifiable_params({pt(210, 4000, 50), pt(210, 4000, 100)});
+  ASSERT_EQ(two_speeds.size(), 2u);
+  EXPECT_EQ(two_speeds[1], HysteresisParam::FrequencySlope);
+  const auto pressures = identifiable_params({pt(180, 4000, 80), pt(240, 4000, 80), pt(300, 4000, 80)});
+  EXPECT_EQ(pressures.size(), 2u);  // level and deflection exponent; no speed or load information
+}
+
+// --- measured data: the nine J2452 sets, each held out ---
+
+TEST(J2452, DrumToFlatFactorIsTheStatedRelation) {
+  EXPECT_NEAR(drum_to_flat_factor(0.85, 0.3), std::sqrt(0.85 / 1.15), 1e-15);
+  EXPECT_LT(drum_to_flat_factor(0.85, 0.3), 1.0);                  // a drum reads high
+  EXPECT_NEAR(drum_to_flat_factor(1e9, 0.3), 1.0, 1e-9);           // an infinite drum is a flat road
+  const auto sets = load_j2452_csv(kJ2452Csv);
+  ASSERT_EQ(sets.size(), 9u);
+  // P205/60R15 HI at 210 kPa, 4000 N, 80 km/h, from the CSV's coefficients by hand.
+  const double f = std::pow(210.0, -0.4243) * std::pow(4000.0, 0.9568) * (0.159 + 3.44e-4 * 80 + 1.25e-6 * 6400);
+  EXPECT_NEAR(j2452_flat_rrc(sets[0], 2.1e5, 4000.0, 80 / 3.6, 0.85), f * std::sqrt(0.85 / 1.154) / 4000.0, 1e-12);
+}
+
+TEST(J2452, OneLabelPointPredictsHeldOutTyresBetterThanEveryBaseline) {
+  const auto& ev = evaluation();
+  ASSERT_EQ(ev.tyres.size(), 9u);
+  std::vector<double> one, shape, thesis, constant;
+  for (const auto& e : ev.tyres) {
+    one.push_back(e.one_point_rms);
+    shape.push_back(e.median_shape_rms);
+    thesis.push_back(e.thesis_rms);
+    constant.push_back(e.constant_rms);
+  }
+  EXPECT_LE(median(one), 0.025);  // the issue's target, leave-one-tyre-out
+  EXPECT_LT(median(one), median(shape));
+  EXPECT_LT(median(one), 0.25 * median(thesis));
+  EXPECT_LT(median(one), 0.25 * median(constant));
+  // The issue's baselines on this grid: thesis scaled 14-20 %, constant 19 %, as it measured them.
+  EXPECT_GT(median(thesis), 0.10);
+  EXPECT_LT(median(thesis), 0.20);
+  EXPECT_NEAR(median(constant), 0.19, 0.02);
+  // Eight of nine within 5 %; the ninth (P225/60R16 HI: pressure exponent -0.59, speed rise 20 %) is unlike
+  // every other tyre and no one-point method here reaches 5 % on it.
+  EXPECT_EQ(std::count_if(one.begin(), one.end(), [](double e) { return e <= 0.05; }), 8);
+}
+
+TEST(J2452, FullFitFollowsEachSurfaceAndItsMeasuredExponents) {
+  for (const auto& e : evaluation().tyres) {
+    EXPECT_LT(e.full_fit_rms, 0.01) << e.name;
+    EXPECT_NEAR(e.full_fit.pressure_exponent, e.measured.pressure_exponent, 0.02) << e.name;
+    EXPECT_NEAR(e.full_fit.load_exponent, e.measured.load_exponent, 0.02) << e.name;
+    EXPECT_NEAR(e.full_fit.speed_rise, e.measured.speed_rise, 0.02) << e.name;
+  }
+}
+
+TEST(J2452, OnePointModelHasTheMeasuredScalingsTheThesisMisses) {
+  // The issue: measured pressure exponent about -0.4, load about 0.95, speed rise 30-54 %; the thesis model
+  // grows as Z^0.44 and rises 18 %.
+  for (const auto& e : evaluation().tyres) {
+    EXPECT_NEAR(e.one_point.pressure_exponent, -0.43, 0.05) << e.name;
+    EXPECT_NEAR(e.one_point.load_exponent, 0.95, 0.05) << e.name;
+    EXPECT_GT(e.one_point.speed_rise, 0.30) << e.name;
+    EXPECT_LT(e.one_point.speed_rise, 0.54) << e.name;
+    EXPECT_LT(e.thesis.load_exponent, 0.6) << e.name;
+    EXPECT_LT(e.thesis.speed_rise, 0.25) << e.name;
+  }
+}
+
+TEST(J2452, ShippedSharedConstantsAreTheFitToAllNineSets) {
+  const HysteresisConstants shipped;
+  const HysteresisConstants& fitted = evaluation().shared_all;
+  for (auto p : {HysteresisParam::FrequencySlope, HysteresisParam::DeflectionExponent, HysteresisParam::LoadExponent,
+                 HysteresisParam::SpeedLoss, HysteresisParam::SpeedLossLoadExponent}) {
+    const double want = hysteresis_param_value(fitted, p);
+    EXPECT_NEAR(hysteresis_param_value(shipped, p), want, 2e-3 * std::abs(want) + 1e-9) << hysteresis_param_key(p);
+  }
+}
+
+// --- label and ISO conditions ---
+
+TEST(TyreLabel, ClassBandsOfRegulation2020_740ForC1) {
+  // Annex I Part A: A <= 6.5, B 6.6-7.7, C 7.8-9.4, D 9.5-10.5, E >= 10.6 kg/t (declared to 0.1 kg/t).
+  EXPECT_NEAR(eu_label_band_c1("A", "x").rrc_max, 6.55e-3, 1e-12);
+  EXPECT_NEAR(eu_label_band_c1("b", "x").rrc_min, 6.55e-3, 1e-12);
+  EXPECT_NEAR(eu_label_band_c1("C", "x").rrc_max, 9.45e-3, 1e-12);
+  EXPECT_NEAR(eu_label_band_c1("D", "x").rrc_max, 10.55e-3, 1e-12);
+  EXPECT_TRUE(eu_label_band_c1("E", "x").open_above);
+  EXPECT_THROW(eu_label_band_c1("F", "--label F"), InputError);
+  EXPECT_THROW(eu_label_band_c1("AB", "--label AB"), InputError);
+}
+
+TEST(TyreLabel, Iso28580ConditionsFollowTheLoadIndexAndLoadVersion) {
+  const RrcPoint std_load = iso28580_point(parse_tyre_size("205/55 R16 91V", "s"), 0.008, "w");
+  EXPECT_NEAR(std_load.load_n, 0.8 * 615 * 9.80665, 1e-9);
+  EXPECT_NEAR(std_load.pressure_pa, 210e3, 1e-9);
+  EXPECT_NEAR(std_load.speed_mps, 80 / 3.6, 1e-12);
+  EXPECT_NEAR(iso28580_point(parse_tyre_size("205/55 R16 94V XL", "s"), 0.008, "w").pressure_pa, 250e3, 1e-9);
+  EXPECT_THROW(iso28580_point(parse_tyre_size("205/55 R16", "s"), 0.008, "w"), InputError);
+}
+
+// --- the command ---
+
+TEST(CliTyreFit, OnePointFileIsANormalTyreFileThatReproducesThePoint) {
+  const auto out = temp_dir() / "fit_one.yaml";
+  const CmdResult r = fit("--size '205/55 R16 91V' --point 210,4500,80,0.0085 --output '" + out.string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(has(r.out, "rrc_ref"));
+  const TyreSpec spec = load_tyre_file(out.string());
+  EXPECT_EQ(spec.state.model, TyreModelKind::Hysteresis);
+  const CmdResult t = rollsim::test::run_rollsim("tyre '" + out.string() +
+                                                 "' --pressure-bar 2.1 --load-n 4500 --speed-kmh 80 --json");
+  ASSERT_EQ(t.exit_code, 0) << t.err;
+  EXPECT_NEAR(json_number(t.out, "rrc"), 0.0085, 0.0085 * 1e-7);
+  EXPECT_TRUE(has(t.out, "\"model\": \"hysteresis\""));
+  // The thesis' mechanisms do not describe this model: --explain says so instead of printing them.
+  const CmdResult x = rollsim::test::run_rollsim("tyre '" + out.string() + "' --explain");
+  EXPECT_EQ(x.exit_code, 2);
+  EXPECT_TRUE(has(x.err, "hysteresis model")) << x.err;
+}
+
+TEST(CliTyreFit, J2452SetAndLabelGiveFittedConstantsWithIntervals) {
+  const auto out = temp_dir() / "fit_j2452.yaml";
+  const CmdResult r = fit("--size 'P205/60R15 91H' --j2452 -0.4815,1.0051,0.0682,2.32E-04,1.20E-06 --label B "
+                          "--output '" + out.string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(has(r.out, "150 point(s), 6 constant(s) free"));
+  EXPECT_TRUE(has(r.out, "EU label class B"));
+  EXPECT_TRUE(has(r.out, "from the residuals"));
+  const TyreSpec spec = load_tyre_file(out.string());
+  // The measured exponents of this set (P205/60R15 LO): the fit's load scaling at fixed pressure.
+  const auto a = TyreAtLoad::prepare(spec.state, 3000.0), b = TyreAtLoad::prepare(spec.state, 6000.0);
+  EXPECT_NEAR(std::log(b.rr_force_n(80 / 3.6) / a.rr_force_n(80 / 3.6)) / std::log(2.0), 1.0051, 0.02);
+}
+
+TEST(CliTyreFit, MeasuredCsvFitsAndTooFewPointsIsNamed) {
+  const auto csv = temp_dir() / "measured.csv";
+  {
+    std::ofstream f(csv);
+    f << "pressure_kpa,load_n,speed_kmh,rrc\n210,4000,50,0.0090\n210,4000,80,0.0095\n210,4000,110,0.0102\n";
+  }
+  const auto out = temp_dir() / "fit_csv.yaml";
+  const CmdResult r = fit("--size '205/55 R16 91V' --measured '" + csv.string() + "' --output '" + out.string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(has(r.out, "3 point(s), 3 constant(s) free"));  // level, frequency slope, speed loss
+  const CmdResult few = fit("--size '205/55 R16 91V' --measured '" + csv.string() +
+                            "' --free rrc_ref,load_exponent --output '" + out.string() + "'");
+  EXPECT_EQ(few.exit_code, 2);
+  EXPECT_TRUE(has(few.err, "too few points")) << few.err;
+  EXPECT_TRUE(has(few.err, "2 or more loads")) << few.err;
+}
+
+TEST(CliTyreFit, BadInputGetsOneNamedErrorAndNoFile) {
+  const auto out = temp_dir() / "never.yaml";
+  const std::string o = " --output '" + out.string() + "'";
+  struct Case {
+    std::string args;
+    std::vector<std::string> mentions;
+  };
+  const std::vector<Case> cases = {
+      {"--size '205/55 R16 91V' --point 0,4000,80,0.009", {"--point 0,4000,80,0.009", "pressure 0 kPa", "[50, 600]"}},
+      {"--size '205/55 R16 91V' --point 210,4000,80,0.5", {"--point", "RRC 0.5", "[0.001, 0.05]"}},
+      {"--size '205/55 R16 91V' --label F", {"--label F", "A, B, C, D, E"}},
+      {"--size '205/55 R16 91V' --point 210,60000,80,0.009", {"--point", "physical range", "rim"}},
+      {"--size '205/55 R16 91V' --point 0.009 --free rrc_ref,frequency_slope_per_hz", {"--free", "too few points"}},
+      {"--size '205/55 R16 91V'", {"too few points", "no measured point"}},
+      {"--size '205/55 R16' --label B", {"--label B", "load index"}},
+      {"--size '205/55 R16 91V' --j2452 -0.4,0.9,0.1", {"--j2452", "expected ALPHA,BETA,A,B,C"}},
+      {"--size '205/55 R16 91V' --point 210,4000,0,0.009", {"--point", "speed 0 km/h"}},
+      {"--size '205/55 R16 91V' --point 0.009 --free rrc_ref,bogus", {"--free", "bogus"}},
+  };
+  for (const auto& c : cases) {
+    const CmdResult r = fit(c.args + o);
+    EXPECT_EQ(r.exit_code, 2) << c.args << "\n" << r.err;
+    EXPECT_TRUE(r.out.empty()) << c.args << "\n" << r.out;
+    EXPECT_EQ(lines(r.err).size(), 1u) << c.args << "\n" << r.err;
+    for (const auto& m : c.mentions) EXPECT_TRUE(has(r.err, m)) << c.args << ": should mention '" << m << "'\n" << r.err;
+    EXPECT_FALSE(std::filesystem::exists(out)) << c.args;
+  }
+}
+
+TEST(CliTyreFit, EvaluationTablePrintsEveryTyreAndTheSharedConstants) {
+  const CmdResult r = fit("--evaluate-j2452 '" + kJ2452Csv + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const auto& e : evaluation().tyres) EXPECT_TRUE(has(r.out, e.name)) << e.name;
+  EXPECT_TRUE(has(r.out, "median"));
+  EXPECT_TRUE(has(r.out, "(none: all sets)"));
+}
+
+// --- tyre files choose their model ---
+
+TEST(TyreFileModel, ThesisIsTheDefaultAndHysteresisNeedsItsLevel) {
+  const auto dir = temp_dir();
+  auto write = [&](const std::string& name, const std::string& text) {
+    std::ofstream(dir / name) << text;
+    return (dir / name).string();
+  };
+  const std::string base = "size: \"205/55 R16 91V\"\npressure_bar: 2.1\n";
+  EXPECT_EQ(load_tyre_file(write("d.yaml", base)).state.model, TyreModelKind::Thesis);
+  EXPECT_EQ(load_tyre_file(write("t.yaml", base + "model: thesis\n")).state.model, TyreModelKind::Thesis);
+  const auto h = load_tyre_file(write("h.yaml", base + "model:\n  kind: hysteresis\n  rrc_ref: 0.008\n"));
+  EXPECT_EQ(h.state.model, TyreModelKind::Hysteresis);
+  EXPECT_DOUBLE_EQ(h.state.hysteresis.rrc_ref, 0.008);
+  EXPECT_THROW(load_tyre_file(write("m.yaml", base + "model: hysteresis\n")), InputError);  // no level
+  EXPECT_THROW(load_tyre_file(write("x.yaml", base + "model:\n  kind: hysteresis\n  rrc_ref: 0.008\n  coulomb_damping_n: 10\n")),
+               InputError);
+  EXPECT_THROW(load_tyre_file(write("y.yaml", base + "model:\n  rrc_ref: 0.008\n")), InputError);  // thesis kind
+  EXPECT_THROW(load_tyre_file(write("z.yaml", base + "model: magic\n")), InputError);
+}

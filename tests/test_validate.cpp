@@ -1,0 +1,289 @@
+// rollsim validate: the fuel map's analytic limits, the transmission's energy balance, the EPA list's units and
+// FTP weighting against the list's own published bags, hybrid rules, bad rows, and the held-out agreement.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <numbers>
+
+#include "rollsim/powertrain/conventional.hpp"
+#include "rollsim/powertrain/electric.hpp"
+#include "rollsim/sim/simulation.hpp"
+#include "rollsim/validate/validate.hpp"
+#include "test_support.hpp"
+
+namespace rollsim {
+namespace {
+
+const std::string kList = std::string(ROLLSIM_SOURCE_DIR) + "/../shared/data/vehicles/epa_test_car_list_2022_part.csv";
+
+EngineMapParams petrol_map() {
+  EngineMapParams e;
+  e.displacement_m3 = 2.0e-3;
+  e.indicated_efficiency = 0.4;
+  e.friction_mep0_pa = 0.97e5;
+  e.friction_mep1_pa_s_per_rad = 143.0;
+  e.friction_mep2_pa_s2_per_rad2 = 0.456;
+  e.pumping_mep_closed_pa = 0.9e5;
+  e.unthrottled_imep_pa = 11e5;
+  e.enrichment_start_fraction = 0.9;
+  e.enrichment_max = 0.15;
+  e.idle_speed_radps = 73.3;
+  e.rated_speed_radps = 628.3;
+  e.max_speed_radps = 700.0;
+  e.max_torque_nm = 200.0;
+  e.max_power_w = 110e3;
+  e.fuel_cut_min_speed_radps = 115.0;
+  return e;
+}
+
+TEST(EngineMap, WithoutPumpingOrEnrichmentItIsAWillansLine) {
+  EngineMapParams p = petrol_map();
+  p.pumping_mep_closed_pa = 0.0;
+  p.enrichment_max = 0.0;
+  const EngineMap m(p);
+  for (double w : {100.0, 250.0, 400.0}) {
+    for (double t : {0.0, 50.0, 120.0}) {
+      const double expected = (t * w + m.friction_power_w(w)) / p.indicated_efficiency;
+      EXPECT_NEAR(m.fuel_power_w(w, t), expected, 1e-9 * expected) << w << " " << t;
+    }
+  }
+}
+
+TEST(EngineMap, PumpingVanishesAtTheUnthrottledLoadAndEnrichmentAtFullLoad) {
+  const EngineMapParams p = petrol_map();
+  const EngineMap m(p);
+  const double w = 300.0;
+  const double fmep = p.friction_mep0_pa + w * (p.friction_mep1_pa_s_per_rad + w * p.friction_mep2_pa_s2_per_rad2);
+  const double four_pi = 4.0 * std::numbers::pi;
+  // Brake torque at which the gross imep reaches the unthrottled one: no pumping there, continuous on both sides.
+  const double t_wot = (p.unthrottled_imep_pa - fmep) * p.displacement_m3 / four_pi;
+  const double willans_w = p.unthrottled_imep_pa * p.displacement_m3 * w / four_pi / p.indicated_efficiency;
+  EXPECT_NEAR(m.fuel_power_w(w, t_wot), willans_w, 1e-6 * willans_w);
+  EXPECT_NEAR(m.fuel_power_w(w, t_wot - 1e-6), m.fuel_power_w(w, t_wot + 1e-6), 1e-2);  // slope ~750 W/(N m)
+  // At light load the throttle costs fuel beyond the Willans line.
+  EngineMapParams open = p;
+  open.pumping_mep_closed_pa = 0.0;
+  EXPECT_GT(m.fuel_power_w(w, 20.0), EngineMap(open).fuel_power_w(w, 20.0) * 1.05);
+  // Full load is run 15 % rich.
+  EngineMapParams lean = p;
+  lean.enrichment_max = 0.0;
+  const double full = m.max_torque_nm(w);
+  EXPECT_NEAR(m.fuel_power_w(w, full) / EngineMap(lean).fuel_power_w(w, full), 1.15, 1e-12);
+}
+
+ConventionalPowertrainParams car(TransmissionKind kind) {
+  ConventionalPowertrainParams p;
+  p.engine = petrol_map();
+  p.transmission.kind = kind;
+  p.transmission.ratios = kind == TransmissionKind::cvt ? std::vector<double>{17.0, 2.4} : std::vector<double>{15.0, 9.0, 6.0, 4.5, 3.5, 2.6};
+  p.transmission.efficiency = 0.96;
+  p.transmission.spin_loss_nm = 4.0;
+  p.transmission.min_engine_speed_radps = 131.0;
+  p.transmission.max_torque_fraction = 0.75;
+  p.transmission.converter.k_factor_radps_per_sqrt_nm = 251.3 / std::sqrt(200.0);
+  p.transmission.converter.lockup_min_gear = 2;
+  p.transmission.converter.lockup_min_speed_radps = 104.7;
+  p.fuel = {743.0, 42.9e6, 3.17};
+  p.aux_power_w = 300.0;
+  p.alternator_efficiency = 0.6;
+  return p;
+}
+
+TEST(ConventionalPowertrain, EveryPointClosesItsEnergyBalance) {
+  for (const auto kind : {TransmissionKind::automatic, TransmissionKind::cvt, TransmissionKind::clutch}) {
+    const ConventionalPowertrain pt(car(kind));
+    for (double v : {0.0, 1.0, 3.0, 8.0, 15.0, 30.0}) {
+      for (double f : {-2000.0, 0.0, 100.0, 800.0, 3000.0}) {
+        const PowerFlow p = pt.deliver(f, v, 0, 0.33);
+        const double uses = p.engine_loss_w + p.traction_power_w + p.gearbox_loss_w + p.clutch_loss_w + p.aux_power_w;
+        EXPECT_NEAR(p.fuel_power_w, uses, 1e-9 * std::max(1.0, p.fuel_power_w)) << static_cast<int>(kind) << " " << v << " " << f;
+        EXPECT_GE(p.gearbox_loss_w, 0.0);
+        EXPECT_GE(p.clutch_loss_w, -1e-9);
+        EXPECT_GE(p.engine_loss_w, 0.0);
+      }
+    }
+  }
+}
+
+TEST(ConventionalPowertrain, ConverterSlipsAtLaunchAndLocksUpAtSpeed) {
+  const ConventionalPowertrain at(car(TransmissionKind::automatic));
+  // Pulling away at 1 m/s the converter slips (engine above the turbine); cruising at 20 m/s it is locked.
+  const PowerFlow launch = at.deliver(2500.0, 1.0, 0, 0.33);
+  EXPECT_GT(launch.clutch_loss_w, 0.1 * launch.traction_power_w);
+  const PowerFlow cruise = at.deliver(400.0, 20.0, 0, 0.33);
+  EXPECT_NEAR(cruise.clutch_loss_w, 0.0, 1e-9);
+  // Overrun above the cut-off speed burns nothing; standing still it idles.
+  EXPECT_EQ(at.deliver(-500.0, 20.0, 0, 0.33).fuel_power_w, 0.0);
+  EXPECT_GT(at.deliver(0.0, 0.0, 0, 0.33).fuel_power_w, 0.0);
+  // Standing in Drive the stalled converter absorbs (w_idle / K)^2 at idle speed; a declutched manual does not.
+  const PowerFlow stand = at.deliver(0.0, 0.0, 0, 0.33);
+  const auto& p = at.params();
+  const double q = p.engine.idle_speed_radps / p.transmission.converter.k_factor_radps_per_sqrt_nm;
+  EXPECT_NEAR(stand.clutch_loss_w, q * q * p.engine.idle_speed_radps, 1e-9);
+  EXPECT_EQ(ConventionalPowertrain(car(TransmissionKind::clutch)).deliver(0.0, 0.0, 0, 0.33).clutch_loss_w, 0.0);
+}
+
+// A powertrain with both capabilities (the shape of a hybrid): results carry both figures and one balance holds.
+class BothSources final : public Powertrain {
+ public:
+  PowerFlow deliver(double f, double v, int, double) const override {
+    PowerFlow p;
+    p.wheel_force_n = f;
+    if (f >= 0.0) {
+      p.traction_power_w = f * v;
+      p.battery_terminal_power_w = 0.5 * f * v;
+      p.fuel_power_w = 0.5 * f * v / 0.3;
+      p.engine_loss_w = p.fuel_power_w - 0.5 * f * v;
+      p.fuel_rate_m3_per_s = p.fuel_power_w / (743.0 * 42.9e6);
+    } else {
+      p.friction_brake_power_w = -f * v;
+    }
+    return p;
+  }
+  int select_gear(double, int) const override { return 0; }
+  double max_wheel_force_n(int, double, double) const override { return 1e9; }
+  std::vector<double> shift_speeds_mps(int) const override { return {}; }
+  std::vector<double> regime_speeds_mps() const override { return {}; }
+  const BatteryParams* battery() const override { return &battery_; }
+  const FuelParams* fuel() const override { return &fuel_; }
+  void add_electric_load(double w, PowerFlow& p) const override {
+    p.aux_power_w += w;
+    p.battery_terminal_power_w += w;
+  }
+
+ private:
+  BatteryParams battery_{360.0, 0.1, 3.6e7, 0.8};
+  FuelParams fuel_{743.0, 42.9e6, 3.17};
+};
+
+TEST(PowertrainCapabilities, ABatteryAndAFuelTogetherGiveBothFiguresAndOneBalance) {
+  validate::EpaTestRow row;
+  row.test_mass_kg = 1500.0;
+  row.road_a_n = 150.0;
+  row.road_b_n_s_per_m = 2.0;
+  row.road_c_n_s2_per_m2 = 0.4;
+  row.rated_power_w = 100e3;
+  row.engine_radps_per_mps = 30.0;
+  row.fuel = validate::EpaFuel::electricity;
+  VehicleModel m = validate::car_from_row(row, validate::EpaDefaults{});
+  m.powertrain = std::make_shared<BothSources>();
+  const SimulationResult r = simulate_replay(m, load_cycle("udds"));
+  ASSERT_TRUE(r.battery.has_value());
+  ASSERT_TRUE(r.fuel.has_value());
+  EXPECT_GT(r.fuel->volume_m3, 0.0);
+  EXPECT_LT(r.battery->final_soc, r.battery->initial_soc);
+  EXPECT_NEAR(r.energy.powertrain_residual_j(), 0.0, 1e-9 * r.source_energy_j());
+  EXPECT_NEAR(r.energy.battery_terminal_j, 0.5 * r.energy.traction_j, 1e-6 * r.energy.traction_j);
+}
+
+TEST(EpaList, ReadsUnitsAsPublished) {
+  const auto rows = validate::read_epa_test_car_list(kList);
+  ASSERT_EQ(rows.size(), 3114u);
+  // First row: Aston Martin DBS, 4500 lb, A 40.94 lbf, B 0.0169 lbf/mph, C 0.0271 lbf/mph^2, N/V 23.0, 715 hp.
+  const auto& r = rows.front();
+  EXPECT_EQ(r.make, "Aston Martin");
+  EXPECT_EQ(r.cycle, validate::EpaCycle::ftp75);
+  EXPECT_NEAR(*r.test_mass_kg, 4500 * 0.45359237, 1e-9);
+  EXPECT_NEAR(*r.road_a_n, 40.94 * 4.4482216152605, 1e-9);
+  EXPECT_NEAR(*r.road_b_n_s_per_m, 0.0169 * 4.4482216152605 / 0.44704, 1e-9);
+  EXPECT_NEAR(*r.road_c_n_s2_per_m2, 0.0271 * 4.4482216152605 / (0.44704 * 0.44704), 1e-9);
+  EXPECT_NEAR(*r.engine_radps_per_mps * 0.44704 * 60.0 / (2.0 * std::numbers::pi), 23.0, 1e-9);
+  EXPECT_NEAR(*r.rated_power_w / 745.69987158, 715.0, 1e-9);
+}
+
+// The regulation's weighting reproduces the list's own composite from its own bags (UDDS bag distances from the
+// shipped trace). The published composite uses each test's measured distances and carbon balance, so agreement is
+// to a fraction of a per cent, not exact; a 0.5/0.5 weighting would shift the median by about 1 %.
+TEST(EpaList, FtpWeightingReproducesThePublishedCompositeFromTheBags) {
+  const auto rows = validate::read_epa_test_car_list(kList);
+  const DriveCycle udds = load_cycle("udds");
+  double d1 = 0.0, d2 = 0.0;
+  for (std::size_t i = 0; i + 1 < udds.time_s.size(); ++i) {
+    const double d = 0.5 * (udds.speed_mps[i] + udds.speed_mps[i + 1]) * (udds.time_s[i + 1] - udds.time_s[i]) / 1609.344;
+    (udds.time_s[i] < 505.0 ? d1 : d2) += d;
+  }
+  std::vector<double> dev;
+  for (const auto& r : rows) {
+    if (r.cycle != validate::EpaCycle::ftp75 || r.fuel != validate::EpaFuel::petrol || !r.measured || *r.measured <= 0.0) continue;
+    if (!r.bag_mpg[0] || !r.bag_mpg[1] || !r.bag_mpg[2] || *r.bag_mpg[0] <= 0.0 || *r.bag_mpg[1] <= 0.0 || *r.bag_mpg[2] <= 0.0) continue;
+    const double mpg = validate::ftp75_weighted_mpg(d1 / *r.bag_mpg[0], d2 / *r.bag_mpg[1], d1 / *r.bag_mpg[2], d1, d2);
+    dev.push_back(std::abs(mpg / *r.measured - 1.0));
+  }
+  ASSERT_GT(dev.size(), 500u);
+  std::sort(dev.begin(), dev.end());
+  EXPECT_LT(dev[dev.size() / 2], 0.003);
+  EXPECT_LT(dev[dev.size() * 9 / 10], 0.01);
+}
+
+// One validation of the whole list, shared by the tests that judge it (a few seconds).
+const validate::Validation& whole_list() {
+  static const auto rows = validate::read_epa_test_car_list(kList);
+  static const auto v = validate::validate_epa_list(rows, 2);
+  return v;
+}
+
+TEST(EpaList, HybridsAndBadRowsAreSkippedByName) {
+  const auto& v = whole_list();
+  int hybrids = 0, absurd = 0;
+  for (const auto& o : v.rows) {
+    const std::string m = o.row->model;
+    if (m.find("HYBRID") != std::string::npos || m.find("FHEV") != std::string::npos || m.find("PHEV") != std::string::npos) {
+      const bool other_reason = o.row->cycle == validate::EpaCycle::sc03 || o.row->cycle == validate::EpaCycle::cold;
+      if (!other_reason) {
+        EXPECT_EQ(o.skip, validate::SkipReason::hybrid) << m;
+        ++hybrids;
+      }
+    }
+    // The list's RC F FTP of 4599 "mpg" and McLaren Artura's 9999.9: named, not simulated.
+    if (o.row->measured && *o.row->measured > 1000.0 && o.row->cycle == validate::EpaCycle::ftp75) {
+      EXPECT_EQ(o.skip, validate::SkipReason::absurd_measured_result) << m;
+      ++absurd;
+    }
+    if (o.row->cycle == validate::EpaCycle::sc03) EXPECT_EQ(o.skip, validate::SkipReason::air_conditioning_test);
+    if (o.skip == validate::SkipReason::none) {
+      EXPECT_TRUE(std::isfinite(o.predicted) && o.predicted > 0.0) << o.row->test_number;
+    }
+  }
+  EXPECT_GT(hybrids, 10);
+  EXPECT_GE(absurd, 1);
+  // The split keeps every test of a model on one side.
+  for (const auto& o : v.rows) EXPECT_EQ(o.fitting_half, validate::in_fitting_half(*o.row));
+}
+
+// Judged on the half the constants were not fitted on (README, "Validation"): what the model does today, as a
+// floor that catches a regression, not the targets (which it does not all meet; see README).
+TEST(EpaList, HeldOutRowsAgreeAsReported) {
+  const auto& v = whole_list();
+  const auto c = validate::coverage(v, false);
+  EXPECT_GE(c.simulated, 0.8 * c.eligible);
+  for (const auto& s : validate::summarise(v)) {
+    if (s.half != "held-out" || s.count < 30) continue;
+    if (s.powertrain == "petrol") EXPECT_LT(s.median_abs_error_pct, 10.0) << s.cycle;
+    if (s.powertrain == "electric") EXPECT_LT(s.median_abs_error_pct, 13.0) << s.cycle;
+  }
+  // The fitted constants stay physical: gross indicated efficiency 0.3-0.5, charge efficiency below 1.
+  EXPECT_GT(v.fitted.defaults.petrol_indicated_efficiency, 0.3);
+  EXPECT_LT(v.fitted.defaults.petrol_indicated_efficiency, 0.5);
+  EXPECT_LT(v.fitted.defaults.charge_efficiency, 1.0);
+}
+
+TEST(CliValidate, JsonRowsAndANamedErrorForAFileWithoutTheColumns) {
+  const auto dir = test::temp_dir();
+  const auto bad = dir / "not_epa.csv";
+  std::ofstream(bad) << "time_s,speed_kmh\n0,0\n";
+  const auto r = test::run_rollsim("validate --epa-test-car-list " + bad.string());
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("not_epa.csv"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("Test Number"), std::string::npos) << r.err;
+  const auto j = test::run_rollsim("validate --json --threads 2 --epa-test-car-list " + kList);
+  ASSERT_EQ(j.exit_code, 0) << j.err;
+  const auto rows = test::lines(j.out);
+  EXPECT_EQ(rows.size(), 3114u);
+  EXPECT_NE(rows.front().find("\"test_number\": \"KASX10055440\""), std::string::npos) << rows.front();
+  EXPECT_NE(rows.front().find("\"error_pct\": "), std::string::npos);
+}
+
+}  // namespace
+}  // namespace rollsim
