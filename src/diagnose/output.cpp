@@ -27,7 +27,8 @@ std::string diagnosis_json(const Diagnosis& d) {
   os << "  \"windows\": " << d.windows << ",\n  \"effective_windows\": " << num(d.effective_windows) << ",\n";
   os << "  \"calibration\": {\"channel_scale\": " << num(d.channel_scale) << ", \"rrc_level_change\": " << num(d.rrc_level_change)
      << ", \"drag_change\": " << num(d.drag_change) << ", \"channel_scale_prior\": {\"low\": " << num(d.channel_scale_prior_low)
-     << ", \"high\": " << num(d.channel_scale_prior_high) << "}, \"channel_scale_free\": " << num(d.channel_scale_free)
+     << ", \"high\": " << num(d.channel_scale_prior_high) << "}, \"channel_scale_free\": " << num(d.channel_scale_free) << ", \"rrc_level_change_free\": " << num(d.rrc_level_change_free)
+     << ", \"drag_change_free\": " << num(d.drag_change_free) << ", \"delta_bic_leaving_prior\": " << num(d.calibration_delta_bic_leaving_prior)
      << ", \"channel_scale_outside_prior\": " << (d.channel_scale_outside_prior ? "true" : "false")
      << ", \"scale_absorbed_energy_pct\": " << num(d.scale_absorbed_energy_pct) << "},\n";
   os << "  \"adequacy\": {\"noise_floor_j\": " << num(d.noise_floor_j) << ", \"residual_to_noise_ratio\": "
@@ -98,8 +99,9 @@ std::string diagnosis_text(const Diagnosis& d) {
   os << "calibration: channel scale " << d.channel_scale << " (prior [" << d.channel_scale_prior_low << ", "
      << d.channel_scale_prior_high << "]), RRC level " << 100 * d.rrc_level_change << " %, aero C " << 100 * d.drag_change << " %\n";
   if (d.channel_scale_outside_prior)
-    os << "  the data alone wanted a channel scale of " << d.channel_scale_free << ", outside its prior: held at the bound, it leaves "
-       << d.scale_absorbed_energy_pct << " % of the measured energy for the effects to explain\n";
+    os << "  outside its prior (Delta BIC " << d.calibration_delta_bic_leaving_prior << "): the data alone wanted scale "
+       << d.channel_scale_free << ", RRC level " << 100 * d.rrc_level_change_free << " %, aero C " << 100 * d.drag_change_free
+       << " %; held in the prior, it leaves " << d.scale_absorbed_energy_pct << " % of the measured energy for the effects\n";
   os << "noise floor: " << d.noise_floor_j / 1e3 << " kJ per noise window; calibrated residual " << d.residual_to_noise_ratio
      << " x the floor (z " << d.residual_to_noise_z << ", " << d.adequacy_scale_s << " s blocks), after the findings "
      << d.final_residual_to_noise_ratio << " x (z " << d.final_residual_to_noise_z << ")\n";

@@ -65,8 +65,8 @@ TripLevel trip_level_ambient(const SelectionContext& sc, const Model& m) {
   xt.col(0) = xm.col(0);
   for (Eigen::Index w = 0; w < n; ++w) xt(w, 1 + static_cast<Eigen::Index>(o.windows[static_cast<std::size_t>(w)].rec)) = xm(w, 1);
   xt.rightCols(xm.cols() - 2) = xm.rightCols(xm.cols() - 2);
-  Prior pt = m.prior;
-  pt.rows.clear();
+  Prior pt;
+  pt.boxes = {m.prior.boxes.front()};  // the scale's (the RRC column is split per trip here)
   for (Eigen::Index r = 0; r < nr; ++r) pt.rows.push_back({1 + r, m.prior.rows[0].weight, 0.0});
   pt.rows.push_back({1 + nr, m.prior.rows[1].weight, 0.0});
   const Fit f = least_squares(xt, o.measured_j, pt);

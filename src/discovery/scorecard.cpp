@@ -398,6 +398,9 @@ std::string bench_text(const BenchResult& r) {
         "named %: rollsim's named-alone rate with its Wilson 95 % interval.\n\n";
   const double best_threshold =
       r.sparse_summary.empty() ? 0.0 : r.sparse_summary[static_cast<std::size_t>(r.sparse_best)].threshold;
+  std::size_t label_w = 62;  // the case column fits the longest label
+  for (const auto& row : r.rows) label_w = std::max(label_w, row.label.size() + 2);
+  const int lw = static_cast<int>(label_w);
   std::string group;
   for (const auto& row : r.rows) {
     if (row.group == "null" || row.group == "reversed") continue;
@@ -408,7 +411,7 @@ std::string bench_text(const BenchResult& r) {
              : group == "trips" ? "Across trips: ambient temperature on RRC (4 trips diagnosed together, held out by trip)"
                                 : "Two effects at once")
          << "\n"
-         << std::left << std::setw(62) << "case" << std::setw(18) << "expected" << std::right << std::setw(14) << "rollsim"
+         << std::left << std::setw(lw) << "case" << std::setw(18) << "expected" << std::right << std::setw(14) << "rollsim"
          << std::setw(8) << "unexpl." << std::setw(6) << "neg." << std::setw(18) << "named % (Wilson)" << std::setw(12)
          << "calib" << std::setw(14) << ("sparse@" + num(best_threshold)) << "\n";
     }
@@ -418,7 +421,7 @@ std::string bench_text(const BenchResult& r) {
     std::ostringstream named;
     named << std::fixed << std::setprecision(0) << 100.0 * row.rollsim.named / std::max(1, row.rollsim.n()) << " (" << 100 * lo
           << "-" << 100 * hi << ")";
-    os << std::left << std::setw(62) << row.label << std::setw(18) << exp << std::right << std::setw(14) << cell(row.rollsim)
+    os << std::left << std::setw(lw) << row.label << std::setw(18) << exp << std::right << std::setw(14) << cell(row.rollsim)
        << std::setw(8) << row.rollsim_unexplained << std::setw(6) << row.rollsim_wrong_sign << std::setw(18) << named.str()
        << std::setw(12) << cell(row.calibration) << std::setw(14) << cell(row.sparse) << "\n";
   }

@@ -102,16 +102,22 @@ void check_operating_point(const TyreState& tyre, double load_n, double speed_mp
 
 namespace {
 
-RollingResistance evaluate_hysteresis(const TyreState& tyre, double load_n, double speed_mps) {
-  const Patch p = loaded_patch(tyre, load_n);
-  const SpeedPolynomial k = hysteresis_polynomial(tyre, load_n);
-  const double r = tyre.geometry.outer_radius_m;
+// The loaded-patch figures both models report.
+RollingResistance patch_result(const Patch& p, double outer_radius_m) {
   RollingResistance out;
   out.stiffness_n_per_m = p.stiffness_n_per_m;
   out.deflection_m = p.deflection_m;
   out.loaded_radius_m = p.loaded_radius_m;
   out.half_angle_rad = p.half_angle_rad;
-  out.contact_length_m = 2.0 * r * std::sin(p.half_angle_rad);
+  out.contact_length_m = 2.0 * outer_radius_m * std::sin(p.half_angle_rad);
+  return out;
+}
+
+RollingResistance evaluate_hysteresis(const TyreState& tyre, double load_n, double speed_mps) {
+  const Patch p = loaded_patch(tyre, load_n);
+  const SpeedPolynomial k = hysteresis_polynomial(tyre, load_n);
+  const double r = tyre.geometry.outer_radius_m;
+  RollingResistance out = patch_result(p, r);
   if (speed_mps > 0.0) {  // standstill: no rolling loss, as in the thesis model
     out.rrc_coulomb = k.k0;
     out.rrc_viscous = k.k1_s_per_m * speed_mps;
@@ -155,12 +161,7 @@ RollingResistance evaluate_rolling_resistance(const TyreState& tyre, double load
                         c.rotational_drag_kg_per_m2;
   const double f_total = f_sum + load_n;
 
-  RollingResistance out;
-  out.stiffness_n_per_m = p.stiffness_n_per_m;
-  out.deflection_m = p.deflection_m;
-  out.loaded_radius_m = p.loaded_radius_m;
-  out.half_angle_rad = p.half_angle_rad;
-  out.contact_length_m = 2.0 * r * std::sin(p.half_angle_rad);
+  RollingResistance out = patch_result(p, r);
   out.offset_e_m = (m_coulomb + m_viscous + m_drag) / f_total;
   out.rrc = out.offset_e_m / r;
   out.rrc_coulomb = m_coulomb / f_total / r;
