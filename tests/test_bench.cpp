@@ -43,10 +43,9 @@ TEST(Bench, QuickSubsetMeetsTheIssuesBars) {
   EXPECT_LT(r.sparse_best, static_cast<int>(sparse_thresholds().size()));
 }
 
-// Issue 9's bar for the engine: an RRC rising over the trip (a null for warm-up) is never called tyre_warmup, of
-// either sign. Today's engine calls it a warm-up with a negative cold excess in 19 of 20 seeds (docs/diagnose.md);
-// enable this when the effects' signs are enforced.
-TEST(Bench, DISABLED_RisingRrcIsNeverCalledWarmup) {
+// Issue 9's bar: an RRC rising over the trip (a null for warm-up) is never called tyre_warmup, of either sign. The
+// engine before the pipeline called it a warm-up with a negative cold excess in 19 of 20 seeds (docs/diagnose.md).
+TEST(Bench, RisingRrcIsNeverCalledWarmup) {
   const Vehicle v = load_vehicle_file(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/ev.yaml");
   BenchOptions o;
   o.seeds = 20;

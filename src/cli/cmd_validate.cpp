@@ -22,19 +22,6 @@ struct ValidateOptionsText {
   bool json = false;
 };
 
-// Any text as a gnuplot single-quoted string: nothing expands inside single quotes; a quote is doubled and a
-// control character (which would end the command) becomes a space.
-std::string gnuplot_quoted(const std::string& text) {
-  std::string o = "'";
-  for (const char c : text) {
-    const auto u = static_cast<unsigned char>(c);
-    if (c == '\'') o += "''";
-    else if (u < 0x20 || u == 0x7f) o += ' ';
-    else o += c;
-  }
-  return o + "'";
-}
-
 report::JsonObject row_json(const validate::RowOutcome& o) {
   const auto& r = *o.row;
   report::JsonObject j;
@@ -107,8 +94,8 @@ void plot(const validate::Validation& v, const std::string& file) {
   }
   const fs::path tmp_out = dir / ("." + target.filename().string() + ".tmp" + std::to_string(getpid()) + ext);
   std::ofstream gp(work / "plot.gp");
-  gp << "set terminal svg size 800,700 dynamic font 'Sans,12'\nset termoption noenhanced\n"
-     << "set output " << gnuplot_quoted(tmp_out.string()) << "\n"
+  gp << report::gnuplot_terminal("svg size 800,700 dynamic font 'Sans,12'")
+     << "set output " << report::gnuplot_string(tmp_out.string()) << "\n"
      << "set title 'EPA Test Car List 2022: rollsim from certification data against the dynamometer'\n"
      << "set xlabel 'measured [mpg or mpge]'\nset ylabel 'predicted [mpg or mpge]'\n"
      << "set logscale xy\nset grid\nset key top left\nset size square\n";
@@ -116,8 +103,8 @@ void plot(const validate::Validation& v, const std::string& file) {
   std::size_t i = 0;
   for (auto& [name, out] : series) {
     out.close();
-    gp << ", " << gnuplot_quoted((work / ("s" + std::to_string(i++) + ".dat")).string()) << " with points pt 7 ps 0.4 title "
-       << gnuplot_quoted(name);
+    gp << ", " << report::gnuplot_string((work / ("s" + std::to_string(i++) + ".dat")).string()) << " with points pt 7 ps 0.4 title "
+       << report::gnuplot_string(name);
   }
   gp << "\n";
   gp.close();

@@ -1,7 +1,7 @@
-// Diagnosis stage 7: adequacy against the recording's own noise. The noise floor comes from short windows'
-// successive differences (a slowly varying model error cancels in them, noise does not); the residual, aggregated
-// over longer blocks, is compared with the floor scaled to each block's duration (white at the short scale). Noise
-// correlated over a few samples (lag jitter, a SOC quantum) telescopes in longer blocks, so the test is conservative.
+// Diagnosis stage 7: adequacy against the recording's own noise. The noise floor comes from short windows' second
+// differences (a slowly varying model error cancels in them, noise does not); the residual, aggregated over longer
+// blocks, is compared with the floor scaled to each block's duration (white at the short scale). Noise correlated
+// over a few samples (lag jitter, a SOC quantum) telescopes in longer blocks, so the test is conservative.
 #include <algorithm>
 #include <cmath>
 
@@ -50,25 +50,31 @@ std::vector<Block> blocks_of(const Observations& o, const std::vector<Recording>
 
 }  // namespace
 
+// Second differences of short windows' residual energies: a model error smooth over a few windows (a hill, a load,
+// a warm-up) cancels to second order, white noise keeps 6 sigma^2. Windows of a few seconds hold the noise's own short
+// correlation (a logger's filter) inside one window.
 NoiseFloor noise_floor(const Observations& short_obs, const Eigen::VectorXd& resid) {
   NoiseFloor f;
   double sum = 0.0, seconds = 0.0;
-  int pairs = 0;
-  for (Eigen::Index k = 1; k < short_obs.n(); ++k) {
-    const Window& a = short_obs.windows[static_cast<std::size_t>(k - 1)];
-    const Window& b = short_obs.windows[static_cast<std::size_t>(k)];
-    if (a.rec != b.rec) continue;
-    const double d = resid[k] - resid[k - 1];
-    sum += 0.5 * d * d;
+  int triples = 0;
+  auto duration = [&](const Window& w) {
     double t = 0.0;
-    for (std::size_t i = a.begin; i < b.end; ++i) t += short_obs.dt_s[a.rec][i];
-    seconds += 0.5 * t;
-    ++pairs;
+    for (std::size_t i = w.begin; i < w.end; ++i) t += short_obs.dt_s[w.rec][i];
+    return t;
+  };
+  for (Eigen::Index k = 1; k + 1 < short_obs.n(); ++k) {
+    const Window& a = short_obs.windows[static_cast<std::size_t>(k - 1)];
+    const Window& c = short_obs.windows[static_cast<std::size_t>(k + 1)];
+    if (a.rec != c.rec) continue;
+    const double d = resid[k + 1] - 2.0 * resid[k] + resid[k - 1];
+    sum += d * d / 6.0;
+    seconds += duration(short_obs.windows[static_cast<std::size_t>(k)]);
+    ++triples;
   }
-  if (pairs == 0 || !(seconds > 0.0)) return f;
+  if (triples == 0 || !(seconds > 0.0)) return f;
   f.variance_per_s = sum / seconds;  // variance of a window's noise energy, per second of window (white)
-  f.pairs = pairs;
-  f.window_s = short_obs.window_s;
+  f.triples = triples;
+  f.window_s = seconds / triples;
   return f;
 }
 
@@ -85,9 +91,9 @@ Adequacy test_adequacy(const Observations& o, const std::vector<Recording>& recs
       expected += nf.variance_per_s * (b.end_s - b.start_s);
     }
     const double ratio = ss / expected;
-    // ln ratio under noise alone: chi^2 over the blocks, and the floor's own estimate (successive differences, about
-    // 2/3 efficient): variance 2 / blocks + 3 / pairs.
-    const double z = std::log(ratio) / std::sqrt(2.0 / static_cast<double>(blocks.size()) + 3.0 / nf.pairs);
+    // ln ratio under noise alone: chi^2 over the blocks, and the floor's own estimate (
+    // second differences, under 2/3 efficient): variance 2 / blocks + 3 / triples.
+    const double z = std::log(ratio) / std::sqrt(2.0 / static_cast<double>(blocks.size()) + 3.0 / nf.triples);
     if (z <= best.z) continue;
     best.z = z;
     best.ratio = ratio;
@@ -120,6 +126,8 @@ Finding adequacy_finding(const Adequacy& a, const NoiseFloor& nf, const Observat
   Finding f;
   f.effect = "unexplained";
   f.delta_bic = 0.0;
+  f.parameters.push_back({"residual_to_noise_variance_ratio", "1", a.ratio, a.ratio, a.ratio});
+  if (!a.inadequate) return f;  // at the floor: only a calibration outside its prior is left to say
   const double total_j = std::max(1e-9, std::abs(o.measured_j.sum()));
   f.description = "the residual is " + fixed(a.ratio, 1) + " times the recording's own noise floor (variance, over " +
                   fixed(a.scale_s, 0) + " s blocks; floor " + fixed(std::sqrt(nf.variance_per_s * nf.window_s) / 1e3, 2) +
@@ -141,7 +149,6 @@ Finding adequacy_finding(const Adequacy& a, const NoiseFloor& nf, const Observat
   if (worst)
     f.description += "; most in regime '" + worst->regime + "': " + fixed(worst->mean_w, 0) + " W [" + fixed(worst->ci_low_w, 0) +
                      ", " + fixed(worst->ci_high_w, 0) + "]";
-  f.parameters.push_back({"residual_to_noise_variance_ratio", "1", a.ratio, a.ratio, a.ratio});
   f.parameters.push_back({"flagged_energy_j", "J", a.flagged_j, a.flagged_j, a.flagged_j});
   return f;
 }
@@ -153,7 +160,13 @@ namespace rollsim::diag {
 // The calibrated model's residual on short windows, and the floor from it.
 NoiseFloor calibrated_noise_floor(const Observations& o, const std::vector<Recording>& recs, const Signatures& s,
                                   const Calibration& cal, double lag_samples, const DiagnoseOptions& opt) {
-  const Observations shortw = rewindow(o, recs, std::min(opt.noise_window_s, o.window_s));
+  double dt = 1.0;
+  if (!o.dt_s.empty() && !o.dt_s.front().empty()) {
+    std::vector<double> d = o.dt_s.front();
+    std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2), d.end());
+    dt = d[d.size() / 2];
+  }
+  const Observations shortw = rewindow(o, recs, std::min(std::max(opt.noise_window_s, 2.0 * dt), o.window_s));
   if (shortw.n() < 4) return {};
   const Eigen::VectorXd& k = cal.model.fit.coef;
   const Eigen::VectorXd b = window_energies(s.base.power_w, shortw, lag_samples);
@@ -166,22 +179,24 @@ NoiseFloor calibrated_noise_floor(const Observations& o, const std::vector<Recor
 
 namespace rollsim::diag {
 
-// The model's residual with its calibration (scale, RRC level, aero C) free per recording: across trips these
-// scatter (tyre pressure, the day's weather, a logger's gain) without any physics missing, so the adequacy test
-// must not take that scatter for a missing effect. The effects found stay shared.
+// The model's residual with the RRC level and aero C free per recording: across trips these scatter (tyre pressure,
+// road surface, the day's weather) without any physics missing, so the adequacy test must not take that scatter for
+// a missing effect. The channel scale (one logger) and the effects found stay shared.
 Eigen::VectorXd per_recording_residual(const Model& m, const Observations& o, std::size_t recordings) {
   if (recordings < 2) return *m.y - m.x * m.fit.coef;
   const auto nr = static_cast<Eigen::Index>(recordings), n = o.n(), rest = m.x.cols() - 3;
-  Eigen::MatrixXd x = Eigen::MatrixXd::Zero(n, 3 * nr + rest);
+  Eigen::MatrixXd x = Eigen::MatrixXd::Zero(n, 1 + 2 * nr + rest);
+  x.col(0) = m.x.col(0);
   for (Eigen::Index w = 0; w < n; ++w) {
     const auto r = static_cast<Eigen::Index>(o.windows[static_cast<std::size_t>(w)].rec);
-    for (Eigen::Index c = 0; c < 3; ++c) x(w, c * nr + r) = m.x(w, c);
+    x(w, 1 + r) = m.x(w, 1);
+    x(w, 1 + nr + r) = m.x(w, 2);
   }
   x.rightCols(rest) = m.x.rightCols(rest);
   Prior p;
   for (Eigen::Index r = 0; r < nr; ++r) {
-    p.rows.push_back({nr + r, m.prior.rows[0].weight, 0.0});
-    p.rows.push_back({2 * nr + r, m.prior.rows[1].weight, 0.0});
+    p.rows.push_back({1 + r, m.prior.rows[0].weight, 0.0});
+    p.rows.push_back({1 + nr + r, m.prior.rows[1].weight, 0.0});
   }
   return *m.y - x * least_squares(x, *m.y, p).coef;
 }

@@ -45,10 +45,10 @@ namespace diag {
 
 // measured = s sim + a S_rrc + b S_drag, with a and b per 10 % change. RRC level and aero C carry Gaussian
 // penalties at their published uncertainty (they keep short trips, where scale, RRC and C are nearly collinear,
-// physical); the scale is held in its box. Whatever the box keeps the scale from absorbing is left in the residual,
-// for the effects and the adequacy test to explain: a calibration never hides it.
+// physical) and, like the scale, a box (RRC and C at two of those sds). Whatever the boxes keep the calibration from
+// absorbing is left in the residual, for the effects and the adequacy test to explain: a calibration never hides it.
 Calibration calibrate(const Observations& o, const Variant& base, const Variant& rrc, const Variant& drag,
-                      const CalibrationPriors& priors) {
+                      const CalibrationPriors& priors, double bic_threshold) {
   const Eigen::Index n = o.n();
   Calibration c;
   Model& m = c.model;
@@ -60,52 +60,62 @@ Calibration calibrate(const Observations& o, const Variant& base, const Variant&
   m.fold_of = &o.fold_of;
   const Fit unpenalised = least_squares(m.x, o.measured_j);
   const double noise_sd = std::sqrt(unpenalised.rss / std::max<double>(1.0, static_cast<double>(n - 3)));
-  m.prior.rows = {{1, noise_sd / (priors.rrc_level_sd / 0.1), 0.0}, {2, noise_sd / (priors.drag_sd / 0.1), 0.0}};
+  const double rrc_sd = priors.rrc_level_sd / 0.1, drag_sd = priors.drag_sd / 0.1;  // in coefficient units
+  m.prior.rows = {{1, noise_sd / rrc_sd, 0.0}, {2, noise_sd / drag_sd, 0.0}};
   const Fit free = least_squares(m.x, o.measured_j, m.prior);
   const double bound = priors.scale_bound(o.channel);
-  m.prior.scale_low = 1.0 - bound;
-  m.prior.scale_high = 1.0 + bound;
-  c.prior_scale_sd = bound;
-  c.free_scale = free.coef[0];
+  m.prior.boxes = {{0, 1.0 - bound, 1.0 + bound}, {1, -2.0 * rrc_sd, 2.0 * rrc_sd}, {2, -2.0 * drag_sd, 2.0 * drag_sd}};
+  c.free_coef = free.coef;
+  c.prior_scale_bound = bound;
   m.fit = least_squares(m.x, o.measured_j, m.prior);
-  c.scale_at_bound = m.fit.coef[0] != c.free_scale;
+  c.at_bound = (m.fit.coef - free.coef).norm() > 1e-12 * free.coef.norm();
   c.absorbed_j = (m.x * free.coef).sum() - (m.x * m.fit.coef).sum();
   const Eigen::VectorXd resid = o.measured_j - m.x * m.fit.coef;
   const double rho = std::clamp(lag1_autocorrelation(resid), 0.0, 0.95);
   m.n_eff = std::max(4.0, static_cast<double>(n) * (1.0 - rho) / (1.0 + rho));
   m.inflate = std::sqrt(static_cast<double>(n) / m.n_eff);  // autocorrelated windows carry less information
+  // The data want out of the boxes when the free estimate lies beyond one by more than 1 % (of the scale, or of the
+  // RRC level or C), or when freeing them passes a discovery's evidence bar. Either way it is reported, never a
+  // silent nothing_missing; the Delta BIC says whether this data alone is sure of it.
+  c.dbic_leave = c.at_bound ? m.n_eff * std::log(m.fit.rss / std::max(1e-300, free.rss)) - std::log(m.n_eff) : 0.0;
+  double excess = 0.0;
+  for (const auto& b : m.prior.boxes) {
+    const double unit = b.column == 0 ? 1.0 : 0.1;  // RRC and C coefficients are per 10 %
+    excess = std::max({excess, unit * (free.coef[b.column] - b.high), unit * (b.low - free.coef[b.column])});
+  }
+  c.sure = c.at_bound && c.dbic_leave >= bic_threshold;
+  c.outside_prior = c.at_bound && (excess >= 0.01 || c.sure);
   m.heldout = heldout_prediction(m.x, o.measured_j, o.fold_of, m.prior);
   return c;
 }
 
-}  // namespace diag
-}  // namespace rollsim
-
-namespace rollsim::diag {
-
-// What the scale held at its bound leaves, and which catalogue effects could take a level error of that size: an
-// effect whose signature alone explains at least half of it with an amplitude inside its bounds.
+// What the boxes leave, and which catalogue effects could take a level error of that size: an effect whose
+// signature alone explains at least 80 % of it with an amplitude inside its bounds.
 std::string calibration_outside_prior_text(const Calibration& c, const Observations& o, const std::vector<Candidate>& cands) {
-  const Eigen::VectorXd& base = c.model.x.col(0);
+  const Eigen::VectorXd left = c.model.x * (c.free_coef - c.model.fit.coef);
   const double s = c.model.fit.coef[0];
-  const Eigen::VectorXd left = (c.free_scale - s) * base;
   std::string could;
   for (const auto& cand : cands) {
     const double ss = cand.signature.squaredNorm();
     if (!(ss > 0.0) || could.find(to_string(cand.id)) != std::string::npos) continue;
     const double proj = cand.signature.dot(left);
     const double amp = proj / ss / s, explained = proj * proj / ss / std::max(1e-300, left.squaredNorm());
-    if (explained >= 0.5 && amp >= cand.min() && amp <= cand.max())
+    if (explained >= 0.8 && amp >= cand.min() && amp <= cand.max())
       could += (could.empty() ? "" : ", ") + to_string(cand.id) + " (" + fixed(amp, 3) + " " + cand.amplitude->unit + ")";
   }
-  return "the data alone wanted a channel scale of " + fixed(c.free_scale, 3) + ", outside its prior [" +
-         fixed(c.model.prior.scale_low, 2) + ", " + fixed(c.model.prior.scale_high, 2) + "] for a " + to_string(o.channel) +
-         " channel; it would have absorbed " + fixed(100.0 * c.absorbed_j / std::max(1e-9, std::abs(o.measured_j.sum())), 1) +
-         " % of the measured energy. " +
-         (could.empty() ? std::string("No catalogue effect alone explains a level error of that size: a drive efficiency, "
-                                      "capacity or consumer the model lacks")
-                        : "Effects that could explain a level error of that size: " + could +
-                              " (not separable from it on this data: log a standstill, a steady-speed run and a hill)");
+  const Eigen::VectorXd& f = c.free_coef;
+  return "the calibration alone wanted a channel scale of " + fixed(f[0], 3) + " (prior [" + fixed(1.0 - c.prior_scale_bound, 2) +
+         ", " + fixed(1.0 + c.prior_scale_bound, 2) + "] for a " + to_string(o.channel) + " channel), RRC level " +
+         fixed(100.0 * 0.1 * f[1] / f[0], 0) + " % and aero C " + fixed(100.0 * 0.1 * f[2] / f[0], 0) +
+         " % (Delta BIC " + fixed(c.dbic_leave, 1) + " for leaving its prior: " +
+         (c.sure ? "this data is sure of it" : "this data alone cannot tell") + "); it would have absorbed " +
+         fixed(100.0 * c.absorbed_j / std::max(1e-9, std::abs(o.measured_j.sum())), 1) + " % of the measured energy. " +
+         (could.empty() ? std::string("No catalogue effect alone explains that energy: a drive efficiency, usable capacity "
+                                      "or consumer the model lacks")
+                        : "Effects that could explain it, not separable from each other on this data: " + could +
+                              " (to separate: log a long standstill, steady-speed runs at two speeds and the route both ways)");
 }
 
-}  // namespace rollsim::diag
+}  // namespace diag
+}  // namespace rollsim
+

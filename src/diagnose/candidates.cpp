@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "pipeline.hpp"
+#include "rollsim/common/units.hpp"
 
 namespace rollsim::diag {
 namespace {
@@ -106,7 +107,7 @@ AmbientSetting ambient_setting(const std::vector<Recording>& recordings, const D
   const auto [lo, hi] = std::minmax_element(a.ambient_k.begin(), a.ambient_k.end());
   a.testable = *hi - *lo >= opt.ambient_min_spread_k;
   notes.push_back(a.testable ? "ambient_rrc tested across " + std::to_string(recordings.size()) + " recordings at " +
-                                   fixed(*lo - 273.15, 1) + " to " + fixed(*hi - 273.15, 1) + " degC (one shared RRC level)"
+                                   fixed(*lo - units::kKelvinOffset, 1) + " to " + fixed(*hi - units::kKelvinOffset, 1) + " degC (one shared RRC level)"
                              : "ambient_rrc not tested: recorded ambients span " + fixed(*hi - *lo, 1) + " K, under " +
                                    fixed(opt.ambient_min_spread_k, 1) + " K (the recordings are at the same ambient)");
   // Reference: the recordings' mean ambient, so that the ambient signature is nearly orthogonal to the shared RRC
@@ -128,7 +129,7 @@ Signatures compute_signatures(const Replayer& rp, const Observations& o, const V
       Candidate c;
       c.id = info.id;
       c.label = info.name;
-      c.shape = {{"reference_temp_c", amb.reference_k - 273.15}, {"ambient_temp_c", amb.reference_k - 273.15}};
+      c.shape = {{"reference_temp_c", amb.reference_k - units::kKelvinOffset}, {"ambient_temp_c", amb.reference_k - units::kKelvinOffset}};
       c.amplitude = &amp;
       c.across_trips = true;
       s.candidates.push_back(std::move(c));

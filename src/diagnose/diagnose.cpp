@@ -35,10 +35,13 @@ void report_calibration(const diag::Calibration& c, const diag::Observations& o,
   out.channel_scale = k[0];
   out.rrc_level_change = 0.1 * k[1] / k[0];
   out.drag_change = 0.1 * k[2] / k[0];
-  out.channel_scale_prior_low = c.model.prior.scale_low;
-  out.channel_scale_prior_high = c.model.prior.scale_high;
-  out.channel_scale_free = c.free_scale;
-  out.channel_scale_outside_prior = c.scale_at_bound;
+  out.channel_scale_prior_low = 1.0 - c.prior_scale_bound;
+  out.channel_scale_prior_high = 1.0 + c.prior_scale_bound;
+  out.channel_scale_free = c.free_coef[0];
+  out.rrc_level_change_free = 0.1 * c.free_coef[1] / c.free_coef[0];
+  out.drag_change_free = 0.1 * c.free_coef[2] / c.free_coef[0];
+  out.calibration_delta_bic_leaving_prior = c.dbic_leave;
+  out.channel_scale_outside_prior = c.outside_prior;
   out.scale_absorbed_energy_pct = 100.0 * c.absorbed_j / std::max(1e-9, std::abs(o.measured_j.sum()));
   out.lag1_autocorrelation = diag::lag1_autocorrelation(Eigen::VectorXd(o.measured_j - c.model.x * k));
   out.effective_windows = c.model.n_eff;
@@ -93,7 +96,7 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
   base.window_j = window_energies(base.power_w, obs, lag.samples);
   out.raw_trip_energy_error_pct = energy_error_pct(base.window_j, obs.measured_j);
   const Signatures sig = compute_signatures(rp, obs, base, lag.samples, amb, ctx, opt);
-  const Calibration cal = calibrate(obs, sig.base, sig.rrc, sig.drag, opt.priors);
+  const Calibration cal = calibrate(obs, sig.base, sig.rrc, sig.drag, opt.priors, opt.bic_threshold);
   report_calibration(cal, obs, lag, out);
   SelectionContext sc{rp, obs, sig.base, lag.samples, ctx, amb, recordings, opt, {}};
   out.located = locate_regimes(obs, recordings, cycles, sig, cal.model.fit.coef, lag.samples, &sc.standing);
@@ -110,10 +113,12 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
   const Adequacy after = test_adequacy(obs, recordings, per_recording_residual(m, obs, recordings.size()), floor, opt);
   out.final_residual_to_noise_ratio = after.ratio, out.final_residual_to_noise_z = after.z;
   // Never nothing_missing above the noise floor, nor behind a calibration held at its prior's bound.
-  if (after.inadequate || (cal.scale_at_bound && out.findings.empty())) {
+  if (after.inadequate || (cal.outside_prior && out.findings.empty())) {
     Finding f = adequacy_finding(after, floor, obs, out.located);
-    if (cal.scale_at_bound) f.description += "; " + calibration_outside_prior_text(cal, obs, sig.candidates);
+    if (cal.at_bound) f.description += (after.inadequate ? "; " : "") + calibration_outside_prior_text(cal, obs, sig.candidates);
     out.findings.push_back(std::move(f));
+  } else if (cal.at_bound) {
+    out.notes.push_back("calibration at its prior's bound, not significantly beyond it: " + calibration_outside_prior_text(cal, obs, sig.candidates));
   }
   out.verdict = out.findings.empty() ? "nothing_missing"
                 : out.findings.front().confounded_with.empty() ? "missing_physics" : "confounded";

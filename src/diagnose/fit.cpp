@@ -30,26 +30,71 @@ Fit penalised(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, const std::vec
 
 }  // namespace
 
-// The scale's box is exact for a convex quadratic: profiled over the scale (the rest minimised), the criterion is a
-// parabola in it, so where the free optimum leaves the box the constrained one sits on the nearer bound.
+// Boxes by active sets: where the free optimum leaves a box, every combination of boxed columns held free, at
+// their lower or at their upper bound is solved, and the feasible one of least penalised criterion kept (exact for
+// this convex quadratic; at most 3^3 small solves, and only when a bound is active).
 Fit least_squares(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, const Prior& prior) {
-  Fit f = penalised(x, y, prior.rows);
-  if (f.coef[0] >= prior.scale_low && f.coef[0] <= prior.scale_high) return f;
-  const double s = std::clamp(f.coef[0], prior.scale_low, prior.scale_high);
-  const Eigen::Index k = x.cols() - 1;
-  std::vector<Prior::Row> rows;
-  for (const auto& r : prior.rows)
-    if (r.column > 0) rows.push_back({r.column - 1, r.weight, r.target});
-  Fit rest;
-  if (k > 0) rest = penalised(x.rightCols(k), y - s * x.col(0), rows);
-  Fit out;
-  out.coef.resize(x.cols());
-  out.coef[0] = s;
-  if (k > 0) out.coef.tail(k) = rest.coef;
-  out.rss = (y - x * out.coef).squaredNorm();
-  out.cov = Eigen::MatrixXd::Zero(x.cols(), x.cols());
-  if (k > 0) out.cov.bottomRightCorner(k, k) = rest.cov;
-  return out;
+  Fit free = penalised(x, y, prior.rows);
+  auto feasible = [&](const Eigen::VectorXd& c) {
+    for (const auto& b : prior.boxes)
+      if (c[b.column] < b.low - 1e-12 || c[b.column] > b.high + 1e-12) return false;
+    return true;
+  };
+  if (feasible(free.coef)) return free;
+  auto criterion = [&](const Eigen::VectorXd& c) {
+    double v = (y - x * c).squaredNorm();
+    for (const auto& r : prior.rows) v += r.weight * r.weight * (c[r.column] - r.target) * (c[r.column] - r.target);
+    return v;
+  };
+  const std::size_t nb = prior.boxes.size();
+  int combos = 1;
+  for (std::size_t k = 0; k < nb; ++k) combos *= 3;
+  Fit best;
+  double best_value = 1e300;
+  for (int combo = 1; combo < combos; ++combo) {
+    std::vector<int> state(nb);  // 0 free, 1 low, 2 high
+    for (int k = 0, c = combo; k < static_cast<int>(nb); ++k, c /= 3) state[static_cast<std::size_t>(k)] = c % 3;
+    std::vector<double> fixed_value(static_cast<std::size_t>(x.cols()), std::nan(""));
+    for (std::size_t k = 0; k < nb; ++k)
+      if (state[k]) fixed_value[static_cast<std::size_t>(prior.boxes[k].column)] = state[k] == 1 ? prior.boxes[k].low : prior.boxes[k].high;
+    std::vector<Eigen::Index> free_cols, new_index(static_cast<std::size_t>(x.cols()), -1);
+    Eigen::VectorXd yr = y;
+    for (Eigen::Index c = 0; c < x.cols(); ++c) {
+      const double v = fixed_value[static_cast<std::size_t>(c)];
+      if (std::isnan(v)) {
+        new_index[static_cast<std::size_t>(c)] = static_cast<Eigen::Index>(free_cols.size());
+        free_cols.push_back(c);
+      } else {
+        yr -= v * x.col(c);
+      }
+    }
+    Eigen::VectorXd coef(x.cols());
+    Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(x.cols(), x.cols());
+    if (!free_cols.empty()) {
+      Eigen::MatrixXd xr(x.rows(), static_cast<Eigen::Index>(free_cols.size()));
+      for (std::size_t k = 0; k < free_cols.size(); ++k) xr.col(static_cast<Eigen::Index>(k)) = x.col(free_cols[k]);
+      std::vector<Prior::Row> rows;
+      for (const auto& r : prior.rows)
+        if (new_index[static_cast<std::size_t>(r.column)] >= 0) rows.push_back({new_index[static_cast<std::size_t>(r.column)], r.weight, r.target});
+      const Fit f = penalised(xr, yr, rows);
+      for (std::size_t k = 0; k < free_cols.size(); ++k) {
+        coef[free_cols[k]] = f.coef[static_cast<Eigen::Index>(k)];
+        for (std::size_t q = 0; q < free_cols.size(); ++q)
+          cov(free_cols[k], free_cols[q]) = f.cov(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(q));
+      }
+    }
+    for (Eigen::Index c = 0; c < x.cols(); ++c)
+      if (!std::isnan(fixed_value[static_cast<std::size_t>(c)])) coef[c] = fixed_value[static_cast<std::size_t>(c)];
+    if (!feasible(coef)) continue;
+    const double value = criterion(coef);
+    if (value >= best_value) continue;
+    best_value = value;
+    best.coef = coef;
+    best.cov = cov;
+  }
+  if (best.coef.size() == 0) return free;  // unreachable: all at bounds is always feasible
+  best.rss = (y - x * best.coef).squaredNorm();
+  return best;
 }
 
 double lag1_autocorrelation(const Eigen::VectorXd& r) {

@@ -3,6 +3,7 @@
 #include <sstream>
 
 #include "pipeline.hpp"
+#include "rollsim/common/json.hpp"
 #include "rollsim/common/error.hpp"
 
 namespace rollsim {
@@ -16,29 +17,9 @@ std::string num(double v) {
   return os.str();
 }
 
-std::string fixed(double v, int digits) {
-  std::ostringstream os;
-  os.setf(std::ios::fixed);
-  os.precision(digits);
-  os << v;
-  return os.str();
-}
-
 }  // namespace diag
 
 using diag::num;
-
-namespace {
-std::string json_escape(const std::string& s) {
-  std::string o;
-  for (char c : s) {
-    if (c == '"' || c == '\\') o += '\\';
-    if (c == '\n') { o += "\\n"; continue; }
-    o += c;
-  }
-  return o;
-}
-}  // namespace
 
 std::string diagnosis_json(const Diagnosis& d) {
   std::ostringstream os;
@@ -46,7 +27,8 @@ std::string diagnosis_json(const Diagnosis& d) {
   os << "  \"windows\": " << d.windows << ",\n  \"effective_windows\": " << num(d.effective_windows) << ",\n";
   os << "  \"calibration\": {\"channel_scale\": " << num(d.channel_scale) << ", \"rrc_level_change\": " << num(d.rrc_level_change)
      << ", \"drag_change\": " << num(d.drag_change) << ", \"channel_scale_prior\": {\"low\": " << num(d.channel_scale_prior_low)
-     << ", \"high\": " << num(d.channel_scale_prior_high) << "}, \"channel_scale_free\": " << num(d.channel_scale_free)
+     << ", \"high\": " << num(d.channel_scale_prior_high) << "}, \"channel_scale_free\": " << num(d.channel_scale_free) << ", \"rrc_level_change_free\": " << num(d.rrc_level_change_free)
+     << ", \"drag_change_free\": " << num(d.drag_change_free) << ", \"delta_bic_leaving_prior\": " << num(d.calibration_delta_bic_leaving_prior)
      << ", \"channel_scale_outside_prior\": " << (d.channel_scale_outside_prior ? "true" : "false")
      << ", \"scale_absorbed_energy_pct\": " << num(d.scale_absorbed_energy_pct) << "},\n";
   os << "  \"adequacy\": {\"noise_floor_j\": " << num(d.noise_floor_j) << ", \"residual_to_noise_ratio\": "
@@ -56,7 +38,7 @@ std::string diagnosis_json(const Diagnosis& d) {
   os << "  \"lag_samples\": " << d.lag_samples << ",\n";
   os << "  \"lag_s\": {\"value\": " << num(d.lag_s) << ", \"ci_low\": " << num(d.lag_ci_low_s) << ", \"ci_high\": " << num(d.lag_ci_high_s) << "},\n";
   os << "  \"window_s\": " << num(d.window_s) << ",\n  \"notes\": [";
-  for (std::size_t i = 0; i < d.notes.size(); ++i) os << (i ? ", " : "") << "\"" << json_escape(d.notes[i]) << "\"";
+  for (std::size_t i = 0; i < d.notes.size(); ++i) os << (i ? ", " : "") << json_string(d.notes[i]);
   os << "],\n";
   os << "  \"raw_trip_energy_error_pct\": " << num(d.raw_trip_energy_error_pct) << ",\n";
   os << "  \"heldout_rmse_calibrated\": " << num(d.heldout_rmse_calibrated_j) << ",\n";
@@ -65,7 +47,7 @@ std::string diagnosis_json(const Diagnosis& d) {
   for (std::size_t i = 0; i < d.findings.size(); ++i) {
     const auto& f = d.findings[i];
     os << (i ? "," : "") << "\n    {\"effect\": \"" << f.effect << "\", ";
-    if (!f.description.empty()) os << "\"description\": \"" << json_escape(f.description) << "\", ";
+    if (!f.description.empty()) os << "\"description\": " << json_string(f.description) << ", ";
     os << "\"parameters\": {";
     for (std::size_t k = 0; k < f.parameters.size(); ++k) {
       const auto& p = f.parameters[k];
@@ -80,7 +62,7 @@ std::string diagnosis_json(const Diagnosis& d) {
     for (std::size_t k = 0; k < f.confounded_with.size(); ++k) os << (k ? ", " : "") << "\"" << f.confounded_with[k] << "\"";
     os << "], \"separating_tests\": [";
     for (std::size_t k = 0; k < f.separating_tests.size(); ++k)
-      os << (k ? ", " : "") << "\"" << json_escape(f.separating_tests[k]) << "\"";
+      os << (k ? ", " : "") << json_string(f.separating_tests[k]);
     os << "], \"delta_bic\": " << num(f.delta_bic) << ", \"heldout_rmse_before\": " << num(f.heldout_rmse_before_j)
        << ", \"heldout_rmse_after\": " << num(f.heldout_rmse_after_j)
        << ", \"heldout_energy_error_pct_before\": " << num(f.heldout_energy_error_pct_before)
@@ -117,8 +99,9 @@ std::string diagnosis_text(const Diagnosis& d) {
   os << "calibration: channel scale " << d.channel_scale << " (prior [" << d.channel_scale_prior_low << ", "
      << d.channel_scale_prior_high << "]), RRC level " << 100 * d.rrc_level_change << " %, aero C " << 100 * d.drag_change << " %\n";
   if (d.channel_scale_outside_prior)
-    os << "  the data alone wanted a channel scale of " << d.channel_scale_free << ", outside its prior: held at the bound, it leaves "
-       << d.scale_absorbed_energy_pct << " % of the measured energy for the effects to explain\n";
+    os << "  outside its prior (Delta BIC " << d.calibration_delta_bic_leaving_prior << "): the data alone wanted scale "
+       << d.channel_scale_free << ", RRC level " << 100 * d.rrc_level_change_free << " %, aero C " << 100 * d.drag_change_free
+       << " %; held in the prior, it leaves " << d.scale_absorbed_energy_pct << " % of the measured energy for the effects\n";
   os << "noise floor: " << d.noise_floor_j / 1e3 << " kJ per noise window; calibrated residual " << d.residual_to_noise_ratio
      << " x the floor (z " << d.residual_to_noise_z << ", " << d.adequacy_scale_s << " s blocks), after the findings "
      << d.final_residual_to_noise_ratio << " x (z " << d.final_residual_to_noise_z << ")\n";

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "rollsim/common/format.hpp"
 #include "rollsim/diagnose/diagnose.hpp"
 #include "rollsim/sim/effect.hpp"
 
@@ -75,15 +76,19 @@ LagEstimate estimate_lag(const std::vector<std::vector<double>>& sim_w, const Ob
 
 // ---- least squares with priors (fit.cpp) -----------------------------------------------------------------------
 
-/// Priors of the calibration columns: Gaussian penalties (rows pulling a coefficient towards `target`) and a hard
-/// box on the channel scale (column 0).
+/// Priors of the calibration columns: Gaussian penalties (rows pulling a coefficient towards `target`) and hard
+/// boxes (the channel scale, column 0; the RRC level and aero C, columns 1 and 2).
 struct Prior {
   struct Row {
     Eigen::Index column;
     double weight, target;
   };
+  struct Box {
+    Eigen::Index column;
+    double low, high;
+  };
   std::vector<Row> rows;
-  double scale_low = -1e300, scale_high = 1e300;
+  std::vector<Box> boxes;
 };
 
 struct Fit {
@@ -135,13 +140,16 @@ void set_heldout_metrics(Finding& f, const Model& before, const Eigen::VectorXd&
 
 struct Calibration {
   Model model;                // measured = s sim + a S_rrc + b S_drag, priors applied
-  double free_scale = 1.0;    // the scale the data alone would take
-  double prior_scale_sd = 0.0;
-  bool scale_at_bound = false;
-  double absorbed_j = 0.0;    // energy the free scale would have absorbed beyond the bounded one
+  double prior_scale_bound = 0.0;
+  Eigen::VectorXd free_coef;   // without the boxes (penalties kept)
+  bool at_bound = false;       // a box is active
+  double dbic_leave = 0.0;     // how strongly the data want out of the boxes (Delta BIC, free against boxed)
+  bool sure = false;           // freeing the boxes passes a discovery's evidence bar
+  bool outside_prior = false;  // at a bound, beyond it by over 1 % or surely
+  double absorbed_j = 0.0;     // energy the free calibration would have absorbed beyond the boxed one
 };
 Calibration calibrate(const Observations& o, const Variant& base, const Variant& rrc, const Variant& drag,
-                      const CalibrationPriors& priors);
+                      const CalibrationPriors& priors, double bic_threshold);
 
 // ---- candidate signatures (candidates.cpp) ---------------------------------------------------------------------
 
@@ -248,7 +256,7 @@ std::vector<DiagnosisWindow> window_series(const Observations& o, const std::vec
 
 // ---- small text helpers (output.cpp) ---------------------------------------------------------------------------
 std::string num(double v);
-std::string fixed(double v, int digits);
+using rollsim::fixed;  // common/format.hpp
 
 }  // namespace rollsim::diag
 
@@ -258,10 +266,10 @@ namespace rollsim::diag {
 
 struct NoiseFloor {
   double variance_per_s = 0.0;  // of a window's noise energy [J^2], per second of window
-  int pairs = 0;
+  int triples = 0;
   double window_s = 0.0;
 };
-/// From the calibrated residual of short windows (`short_obs`): half the mean squared successive difference.
+/// From the calibrated residual of short windows (`short_obs`): the mean squared second difference over 6.
 NoiseFloor noise_floor(const Observations& short_obs, const Eigen::VectorXd& resid);
 
 struct Adequacy {

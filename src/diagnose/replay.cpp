@@ -6,6 +6,7 @@
 #include <thread>
 
 #include "pipeline.hpp"
+#include "rollsim/common/parallel.hpp"
 #include "rollsim/sim/simulation.hpp"
 
 namespace rollsim::diag {
@@ -28,10 +29,10 @@ double shifted(const std::vector<double>& p, std::size_t i, double lag) {
   return k + 1 < p.size() ? (1.0 - f) * p[k] + f * p[k + 1] : p.back();
 }
 
-double lag_sse(const std::vector<std::vector<double>>& sim_w, const Observations& o, double lag) {
+double lag_sse(const std::vector<std::vector<double>>& sim_w, const Observations& o, double lag, std::size_t first) {
   double sse = 0.0;
   for (std::size_t ri = 0; ri < sim_w.size(); ++ri)
-    for (std::size_t i = 10; i < sim_w[ri].size(); ++i) {  // the same samples for every lag searched
+    for (std::size_t i = first; i < sim_w[ri].size(); ++i) {  // the same samples for every lag searched
       const double e = o.measured_w[ri][i] - shifted(sim_w[ri], i, lag);
       sse += e * e;
     }
@@ -65,11 +66,10 @@ std::vector<std::vector<double>> Replayer::power(const EffectList& extra) const 
 // Independent replays, so they run in parallel (each thread assembles its own model).
 std::vector<Variant> Replayer::run(const std::vector<EffectList>& extras, const Observations& o, double lag_samples) const {
   std::vector<Variant> out(extras.size());
-  std::atomic<std::size_t> next{0};
   std::exception_ptr failure;
   std::mutex failure_mutex;
-  auto work = [&] {
-    for (std::size_t k = next++; k < extras.size(); k = next++) {
+  auto work = [&](std::size_t k) {
+    {
       try {
         out[k].power_w = power(extras[k]);
         out[k].window_j = window_energies(out[k].power_w, o, lag_samples);
@@ -79,12 +79,7 @@ std::vector<Variant> Replayer::run(const std::vector<EffectList>& extras, const 
       }
     }
   };
-  const unsigned n = std::max(1u, std::min<unsigned>(threads ? threads : std::thread::hardware_concurrency(),
-                                                     static_cast<unsigned>(extras.size())));
-  std::vector<std::thread> pool;
-  for (unsigned t = 1; t < n; ++t) pool.emplace_back(work);
-  work();
-  for (auto& t : pool) t.join();
+  parallel_for(extras.size(), threads, work);
   if (failure) std::rethrow_exception(failure);
   return out;
 }
@@ -100,21 +95,26 @@ Eigen::VectorXd window_energies(const std::vector<std::vector<double>>& power_w,
   return e;
 }
 
-// Whole samples 0-10 first, then 0.05-sample steps about the best; the interval is where the per-sample criterion
+// Whole samples first, then 0.05-sample steps about the best; the interval is where the per-sample criterion
 // n_eff ln(SSE / SSE_min) stays under 3.84, n_eff from the residual's lag-1 autocorrelation (AR(1)).
 LagEstimate estimate_lag(const std::vector<std::vector<double>>& sim_w, const Observations& o) {
   LagEstimate l;
   if (o.channel == ChannelKind::soc) return l;
+  std::vector<double> dts(o.dt_s.front());
+  std::nth_element(dts.begin(), dts.begin() + static_cast<std::ptrdiff_t>(dts.size() / 2), dts.end());
+  const double dt = dts.empty() ? 1.0 : dts[dts.size() / 2];
+  // Up to 10 samples or 3 s, whichever is longer (loggers lag by 0.3-1.7 s; at 10 Hz that is 17 samples).
+  const int max_lag = std::max(10, static_cast<int>(std::ceil(3.0 / dt)));
   int best_whole = 0;
   double best = 1e300;
-  for (int lag = 0; lag <= 10; ++lag) {
-    const double sse = lag_sse(sim_w, o, lag);
+  for (int lag = 0; lag <= max_lag; ++lag) {
+    const double sse = lag_sse(sim_w, o, lag, static_cast<std::size_t>(max_lag));
     if (sse < best) best = sse, best_whole = lag;
   }
   std::vector<double> grid, sse;
-  for (double lag = std::max(0.0, best_whole - 1.0); lag <= std::min(10.0, best_whole + 1.0) + 1e-9; lag += 0.05) {
+  for (double lag = std::max(0.0, best_whole - 1.0); lag <= std::min<double>(max_lag, best_whole + 1.0) + 1e-9; lag += 0.05) {
     grid.push_back(lag);
-    sse.push_back(lag_sse(sim_w, o, lag));
+    sse.push_back(lag_sse(sim_w, o, lag, static_cast<std::size_t>(max_lag)));
   }
   const std::size_t k = static_cast<std::size_t>(std::min_element(sse.begin(), sse.end()) - sse.begin());
   l.samples = grid[k];
@@ -122,10 +122,10 @@ LagEstimate estimate_lag(const std::vector<std::vector<double>>& sim_w, const Ob
   double num = 0.0, den = 0.0, count = 0.0;
   for (std::size_t ri = 0; ri < sim_w.size(); ++ri) {
     double prev = 0.0;
-    for (std::size_t i = 10; i < sim_w[ri].size(); ++i) {
+    for (std::size_t i = static_cast<std::size_t>(max_lag); i < sim_w[ri].size(); ++i) {
       const double e = o.measured_w[ri][i] - shifted(sim_w[ri], i, l.samples);
       den += e * e;
-      if (i > 10) num += e * prev;
+      if (i > static_cast<std::size_t>(max_lag)) num += e * prev;
       prev = e;
       count += 1.0;
     }
@@ -137,9 +137,6 @@ LagEstimate estimate_lag(const std::vector<std::vector<double>>& sim_w, const Ob
   while (hi + 1 < grid.size() && n_eff * std::log(sse[hi + 1] / sse[k]) < 3.84) ++hi;
   l.low = grid[lo];
   l.high = grid[hi];
-  std::vector<double> dts(o.dt_s.front());
-  std::nth_element(dts.begin(), dts.begin() + static_cast<std::ptrdiff_t>(dts.size() / 2), dts.end());
-  const double dt = dts.empty() ? 1.0 : dts[dts.size() / 2];
   l.seconds = l.samples * dt;
   l.low_s = l.low * dt;
   l.high_s = l.high * dt;

@@ -5,6 +5,7 @@
 #include <tuple>
 
 #include "pipeline.hpp"
+#include "rollsim/common/units.hpp"
 
 namespace rollsim {
 
@@ -64,8 +65,8 @@ TripLevel trip_level_ambient(const SelectionContext& sc, const Model& m) {
   xt.col(0) = xm.col(0);
   for (Eigen::Index w = 0; w < n; ++w) xt(w, 1 + static_cast<Eigen::Index>(o.windows[static_cast<std::size_t>(w)].rec)) = xm(w, 1);
   xt.rightCols(xm.cols() - 2) = xm.rightCols(xm.cols() - 2);
-  Prior pt = m.prior;
-  pt.rows.clear();
+  Prior pt;
+  pt.boxes = {m.prior.boxes.front()};  // the scale's (the RRC column is split per trip here)
   for (Eigen::Index r = 0; r < nr; ++r) pt.rows.push_back({1 + r, m.prior.rows[0].weight, 0.0});
   pt.rows.push_back({1 + nr, m.prior.rows[1].weight, 0.0});
   const Fit f = least_squares(xt, o.measured_j, pt);
@@ -190,9 +191,9 @@ Finding catalogue_finding(const SelectionContext& sc, const Candidate& c, const 
   f.fitted[c.amplitude->name] = value;
   if (c.across_trips) {
     const auto [lo, hi] = std::minmax_element(sc.ambient.ambient_k.begin(), sc.ambient.ambient_k.end());
-    f.description = "RRC level follows ambient temperature across the recordings (" + fixed(*lo - 273.15, 1) + " to " +
-                    fixed(*hi - 273.15, 1) + " degC): " + fixed(100.0 * value, 2) + " % per K colder, referred to " +
-                    fixed(sc.ambient.reference_k - 273.15, 1) + " degC; the written vehicle is neutral at that reference, set "
+    f.description = "RRC level follows ambient temperature across the recordings (" + fixed(*lo - units::kKelvinOffset, 1) + " to " +
+                    fixed(*hi - units::kKelvinOffset, 1) + " degC): " + fixed(100.0 * value, 2) + " % per K colder, referred to " +
+                    fixed(sc.ambient.reference_k - units::kKelvinOffset, 1) + " degC; the written vehicle is neutral at that reference, set "
                     "ambient_temp_c per trip";
   }
   if (best.standing)

@@ -93,7 +93,7 @@ class AmbientCompoundTruth final : public Effect {
 class AirDensityTruth final : public Effect {
  public:
   AirDensityTruth(double rho_cda_20, double ambient_c, double pressure_ratio)
-      : k_(0.5 * rho_cda_20 * (pressure_ratio * 293.15 / (ambient_c + 273.15) - 1.0)) {}
+      : k_(0.5 * rho_cda_20 * (pressure_ratio * 293.15 / (ambient_c + units::kKelvinOffset) - 1.0)) {}
   std::string id() const override { return "truth_air_density"; }
   double extra_resistance_n(const EffectInputs& in, const double*) const override {
     const double v = std::max(in.speed_mps, 0.0);
@@ -478,7 +478,7 @@ Recording generate_case(const Vehicle& vehicle, const SyntheticCase& o) {
     std::mt19937 sensor_rng(o.seed * 104729u + 7u);
     std::normal_distribution<double> sensor(0.0, 0.3);
     std::vector<double> t(n);
-    for (auto& x : t) x = 0.5 * std::round((*o.ambient_temp_c + 273.15 + sensor(sensor_rng)) / 0.5);
+    for (auto& x : t) x = 0.5 * std::round((*o.ambient_temp_c + units::kKelvinOffset + sensor(sensor_rng)) / 0.5);
     rec.ambient_temp_k = t;
   }
   // no grade column in any channel: the diagnosis sees a flat road

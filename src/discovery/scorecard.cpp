@@ -1,4 +1,5 @@
 // Discovery benchmark: concealed-effect cases, blind diagnosis, parameter-only and sparse-regression baselines.
+#include "rollsim/common/parallel.hpp"
 #include "rollsim/discovery/scorecard.hpp"
 
 #include <algorithm>
@@ -272,11 +273,11 @@ BenchResult run_discovery_bench(const Vehicle& vehicle, const BenchOptions& opt)
   for (std::size_t c = 0; c < cases.size(); ++c)
     for (int s = 0; s < cases[c].seeds; ++s) tasks.push_back({c, s});
   std::vector<Outcome> out(tasks.size());
-  std::atomic<std::size_t> next{0}, done{0};
+  std::atomic<std::size_t> done{0};
   std::mutex io;
   const unsigned threads = opt.threads > 0 ? opt.threads : std::max(1u, std::thread::hardware_concurrency());
-  auto worker = [&] {
-    for (std::size_t k; (k = next.fetch_add(1)) < tasks.size();) {
+  auto worker = [&](std::size_t k) {
+    {
       const Case& c = cases[tasks[k].c];
       SyntheticCase s = c.synth;
       s.seed = c.seed0 + static_cast<unsigned>(tasks[k].s);
@@ -308,9 +309,7 @@ BenchResult run_discovery_bench(const Vehicle& vehicle, const BenchOptions& opt)
       }
     }
   };
-  std::vector<std::thread> pool;
-  for (unsigned i = 0; i < threads; ++i) pool.emplace_back(worker);
-  for (auto& th : pool) th.join();
+  parallel_for(tasks.size(), threads, worker);
 
   BenchResult res;
   res.threads = threads;
@@ -399,6 +398,9 @@ std::string bench_text(const BenchResult& r) {
         "named %: rollsim's named-alone rate with its Wilson 95 % interval.\n\n";
   const double best_threshold =
       r.sparse_summary.empty() ? 0.0 : r.sparse_summary[static_cast<std::size_t>(r.sparse_best)].threshold;
+  std::size_t label_w = 62;  // the case column fits the longest label
+  for (const auto& row : r.rows) label_w = std::max(label_w, row.label.size() + 2);
+  const int lw = static_cast<int>(label_w);
   std::string group;
   for (const auto& row : r.rows) {
     if (row.group == "null" || row.group == "reversed") continue;
@@ -409,7 +411,7 @@ std::string bench_text(const BenchResult& r) {
              : group == "trips" ? "Across trips: ambient temperature on RRC (4 trips diagnosed together, held out by trip)"
                                 : "Two effects at once")
          << "\n"
-         << std::left << std::setw(62) << "case" << std::setw(18) << "expected" << std::right << std::setw(14) << "rollsim"
+         << std::left << std::setw(lw) << "case" << std::setw(18) << "expected" << std::right << std::setw(14) << "rollsim"
          << std::setw(8) << "unexpl." << std::setw(6) << "neg." << std::setw(18) << "named % (Wilson)" << std::setw(12)
          << "calib" << std::setw(14) << ("sparse@" + num(best_threshold)) << "\n";
     }
@@ -419,7 +421,7 @@ std::string bench_text(const BenchResult& r) {
     std::ostringstream named;
     named << std::fixed << std::setprecision(0) << 100.0 * row.rollsim.named / std::max(1, row.rollsim.n()) << " (" << 100 * lo
           << "-" << 100 * hi << ")";
-    os << std::left << std::setw(62) << row.label << std::setw(18) << exp << std::right << std::setw(14) << cell(row.rollsim)
+    os << std::left << std::setw(lw) << row.label << std::setw(18) << exp << std::right << std::setw(14) << cell(row.rollsim)
        << std::setw(8) << row.rollsim_unexplained << std::setw(6) << row.rollsim_wrong_sign << std::setw(18) << named.str()
        << std::setw(12) << cell(row.calibration) << std::setw(14) << cell(row.sparse) << "\n";
   }

@@ -233,7 +233,7 @@ std::shared_ptr<const Effect> cold_start_effect(const EpaTestRow& row, double co
                      {"heat_per_wheel_work", 0.6},
                      {"heat_loss_w_per_k", 40.0},
                      {"warm_excess_k", 60.0}};
-  return make_effect("engine_warmup", p, EffectContext{*row.test_mass_kg, 0.0});
+  return make_effect(EffectId::engine_warmup, p, EffectContext{*row.test_mass_kg, 0.0});
 }
 
 }  // namespace rollsim::validate

@@ -25,8 +25,8 @@ struct CalibrationPriors {
   double terminal_scale_bound = 0.05;  ///< battery power, or voltage x current: scale within 1 +- this
   double fuel_scale_bound = 0.05;      ///< direct fuel flow
   double soc_scale_bound = 0.10;       ///< state of charge: usable capacity +- 10 %
-  double rrc_level_sd = 0.15;          ///< RRC level: tyre label class width, pressure, road surface
-  double drag_sd = 0.15;               ///< aero C: coast-down repeatability, CdA from published figures
+  double rrc_level_sd = 0.10;  ///< RRC level: a tyre label class's width, +-0.2 bar of pressure; boxed at 2 sd
+  double drag_sd = 0.10;       ///< aero C: CdA from published figures, coast-down repeatability; boxed at 2 sd
   double scale_bound(ChannelKind k) const;
 };
 /// Reads a vehicle file's optional `calibration_priors:` block (keys as the fields above, fractions), marking it
@@ -42,9 +42,9 @@ struct DiagnoseOptions {
   double collinear_corr = 0.9;     ///< |corr| of calibration-cleaned signatures above which effects are confounded
   int max_effects = 2;
   CalibrationPriors priors;
-  /// Adequacy against the recording's own noise: the noise floor comes from windows of this length (their
-  /// successive differences), and the residual is tested against it aggregated at each of the scales below.
-  double noise_window_s = 10.0;
+  /// Adequacy against the recording's own noise: the noise floor comes from windows of this length (at least two
+  /// samples; their second differences), and the residual is tested against it aggregated at each scale below.
+  double noise_window_s = 2.0;
   std::vector<double> adequacy_scales_s{30.0, 60.0, 120.0, 300.0};
   double adequacy_z = 3.3;          ///< one-sided, per scale (about 0.05 % each)
   double adequacy_min_ratio = 2.0;  ///< and at least this variance ratio over the floor
@@ -149,8 +149,9 @@ struct Diagnosis {
   /// The channel scale's prior (a box) and what the data alone wanted; outside, the scale is held at the bound and
   /// the energy it would have absorbed is left for the effects (and reported in a finding).
   double channel_scale_prior_low = 0.0, channel_scale_prior_high = 0.0;
-  double channel_scale_free = 1.0;
-  bool channel_scale_outside_prior = false;
+  double channel_scale_free = 1.0, rrc_level_change_free = 0.0, drag_change_free = 0.0;  ///< without the boxes
+  double calibration_delta_bic_leaving_prior = 0.0;  ///< free against boxed calibration
+  bool channel_scale_outside_prior = false;          ///< a box is active and the data significantly want out of it
   double scale_absorbed_energy_pct = 0.0;  ///< of the measured energy
   /// Adequacy: the calibrated residual's variance over the noise floor at the worst scale, and that scale.
   double noise_floor_j = 0.0;              ///< sd of one noise window's energy (successive differences)

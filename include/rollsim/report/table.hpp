@@ -26,4 +26,9 @@ class TextTable {
   std::vector<std::vector<std::string>> rows_;
 };
 
+// The common/ formatters and JSON writer under the names callers in report's namespace have used.
+using rollsim::fixed;
+using rollsim::json_string;
+using rollsim::JsonObject;
+
 }  // namespace rollsim::report
