@@ -51,7 +51,7 @@ TEST(DiagnoseEnergy, UncalibratedModelEnergyIsSimulatesOnTheSameTrace) {
     const Recording rec = udds_recording(v, j_per_unit);
     // `simulate --replay` on the recording's trace: its integrated totals.
     const SimulationResult sim = simulate_replay(VehicleModel::assemble(v), cycle_of_recording(rec));
-    const double model_j = fuel ? sim.fuel_volume_m3 * j_per_unit : sim.energy.battery_terminal_j;
+    const double model_j = fuel ? sim.fuel->volume_m3 * j_per_unit : sim.energy.battery_terminal_j;
     const Diagnosis d = diagnose(v, {rec});
     ASSERT_EQ(d.lag_samples, 0);
     ASSERT_NEAR(d.windows * d.window_s, rec.duration_s(), 1e-9);  // the windows cover the trace

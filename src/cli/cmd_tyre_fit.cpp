@@ -15,6 +15,7 @@
 #include "rollsim/common/atomic_file.hpp"
 #include "rollsim/common/csv.hpp"
 #include "rollsim/common/error.hpp"
+#include "rollsim/common/format.hpp"
 #include "rollsim/common/units.hpp"
 #include "rollsim/common/yaml_reader.hpp"
 #include "rollsim/report/table.hpp"
@@ -97,7 +98,7 @@ std::vector<HysteresisParam> parse_free(const std::string& text) {
   return out;
 }
 
-std::string pct(double x, int d = 2) { return report::fixed(x * 100.0, d); }
+std::string pct(double x, int d = 2) { return fixed(x * 100.0, d); }
 
 void print_fit(const TyreFit& fit, const std::optional<LabelBand>& band, const std::optional<RrcPoint>& iso) {
   report::TextTable t({"constant", "value", "95 % low", "95 % high", "note"});
@@ -130,9 +131,9 @@ void print_fit(const TyreFit& fit, const std::optional<LabelBand>& band, const s
     report::TextTable r({"point", "p [kPa]", "load [N]", "speed [km/h]", "RRC x1000", "model x1000", "error %"});
     r.set_left_aligned(0);
     for (const auto& x : fit.residuals) {
-      r.add_row({x.point.where, report::fixed(x.point.pressure_pa / 1e3, 0), report::fixed(x.point.load_n, 0),
-                 report::fixed(units::mps_to_kmh(x.point.speed_mps), 1), report::fixed(x.point.rrc * 1e3, 3),
-                 report::fixed(x.model_rrc * 1e3, 3), pct(x.relative_error)});
+      r.add_row({x.point.where, fixed(x.point.pressure_pa / 1e3, 0), fixed(x.point.load_n, 0),
+                 fixed(units::mps_to_kmh(x.point.speed_mps), 1), fixed(x.point.rrc * 1e3, 3),
+                 fixed(x.model_rrc * 1e3, 3), pct(x.relative_error)});
     }
     std::cout << r.render();
   }
@@ -142,9 +143,9 @@ void print_fit(const TyreFit& fit, const std::optional<LabelBand>& band, const s
     const double rrc = evaluate_rolling_resistance(at, iso->load_n, iso->speed_mps).rrc;
     const bool inside = rrc >= band->rrc_min && rrc <= band->rrc_max;
     std::cout << "EU label class " << band->label_class << " (C1, Regulation (EU) 2020/740): RRC "
-              << report::fixed(band->rrc_min * 1e3, 2) << (band->open_below ? " (open below)" : "") << " - "
-              << report::fixed(band->rrc_max * 1e3, 2) << (band->open_above ? " (open above)" : "")
-              << " kg/t; the fitted tyre at ISO 28580 conditions: " << report::fixed(rrc * 1e3, 2) << " kg/t, "
+              << fixed(band->rrc_min * 1e3, 2) << (band->open_below ? " (open below)" : "") << " - "
+              << fixed(band->rrc_max * 1e3, 2) << (band->open_above ? " (open above)" : "")
+              << " kg/t; the fitted tyre at ISO 28580 conditions: " << fixed(rrc * 1e3, 2) << " kg/t, "
               << (inside ? "inside" : "OUTSIDE") << " the band\n";
   }
 }
@@ -163,10 +164,10 @@ void run_evaluate(const std::string& path, const std::string& drum_text) {
   std::vector<double> cols[6];
   for (const auto& e : ev.tyres) {
     t.add_row({e.name, pct(e.one_point_rms), pct(e.one_point_max), pct(e.full_fit_rms), pct(e.thesis_rms, 1),
-               pct(e.constant_rms, 1), pct(e.median_shape_rms), report::fixed(e.measured.pressure_exponent, 3),
-               report::fixed(e.one_point.pressure_exponent, 3), report::fixed(e.full_fit.pressure_exponent, 3),
-               report::fixed(e.measured.load_exponent, 3), report::fixed(e.one_point.load_exponent, 3),
-               report::fixed(e.full_fit.load_exponent, 3), pct(e.measured.speed_rise, 1), pct(e.one_point.speed_rise, 1),
+               pct(e.constant_rms, 1), pct(e.median_shape_rms), fixed(e.measured.pressure_exponent, 3),
+               fixed(e.one_point.pressure_exponent, 3), fixed(e.full_fit.pressure_exponent, 3),
+               fixed(e.measured.load_exponent, 3), fixed(e.one_point.load_exponent, 3),
+               fixed(e.full_fit.load_exponent, 3), pct(e.measured.speed_rise, 1), pct(e.one_point.speed_rise, 1),
                pct(e.full_fit.speed_rise, 1)});
     const double v[6] = {e.one_point_rms, e.one_point_max, e.full_fit_rms, e.thesis_rms, e.constant_rms, e.median_shape_rms};
     for (int k = 0; k < 6; ++k) cols[k].push_back(v[k]);
@@ -185,8 +186,8 @@ void run_evaluate(const std::string& path, const std::string& drum_text) {
   t.add_row(med);
   t.add_row(wst);
   std::cout << t.render();
-  std::cout << "thesis model's own exponents (scaled): pressure " << report::fixed(ev.tyres.front().thesis.pressure_exponent, 3)
-            << ", load " << report::fixed(ev.tyres.front().thesis.load_exponent, 3) << ", rise "
+  std::cout << "thesis model's own exponents (scaled): pressure " << fixed(ev.tyres.front().thesis.pressure_exponent, 3)
+            << ", load " << fixed(ev.tyres.front().thesis.load_exponent, 3) << ", rise "
             << pct(ev.tyres.front().thesis.speed_rise, 1) << " % (" << ev.tyres.front().name << ")\n";
   std::cout << "\nShared constants fitted on all " << sets.size() << " sets and, leave-one-tyre-out, without each:\n";
   report::TextTable s({"fitted without", "frequency_slope_per_hz", "deflection_exponent", "load_exponent",

@@ -35,9 +35,9 @@ std::string gnuplot_quoted(const std::string& text) {
   return o + "'";
 }
 
-report::JsonObject row_json(const validate::RowOutcome& o) {
+JsonObject row_json(const validate::RowOutcome& o) {
   const auto& r = *o.row;
-  report::JsonObject j;
+  JsonObject j;
   j.add("test_number", r.test_number).add("make", r.make).add("model", r.model).add("fuel", o.powertrain);
   j.add("cycle", validate::to_string(r.cycle)).add("procedure", r.procedure).add("line", static_cast<int>(r.line));
   j.add("half", o.fitting_half ? "fitting" : "held-out");
@@ -54,16 +54,16 @@ void print_summary(const validate::Validation& v) {
   const auto& f = v.fitted;
   std::cout << "EPA Test Car List: " << v.rows.size() << " rows; split by the hash of make|model: fitting half sets "
             << "the constants, held-out half judges them\n";
-  std::cout << "fitted on the fitting half: petrol indicated efficiency " << report::fixed(f.defaults.petrol_indicated_efficiency, 3)
-            << " (" << f.petrol_rows << " rows), diesel " << report::fixed(f.defaults.diesel_indicated_efficiency, 3) << " ("
-            << f.diesel_rows << " rows), charge efficiency " << report::fixed(f.defaults.charge_efficiency, 3) << " ("
-            << f.electric_rows << " rows), cold-start fuel excess " << report::fixed(f.defaults.cold_fuel_excess, 3) << " ("
+  std::cout << "fitted on the fitting half: petrol indicated efficiency " << fixed(f.defaults.petrol_indicated_efficiency, 3)
+            << " (" << f.petrol_rows << " rows), diesel " << fixed(f.defaults.diesel_indicated_efficiency, 3) << " ("
+            << f.diesel_rows << " rows), charge efficiency " << fixed(f.defaults.charge_efficiency, 3) << " ("
+            << f.electric_rows << " rows), cold-start fuel excess " << fixed(f.defaults.cold_fuel_excess, 3) << " ("
             << f.cold_start_rows << " FTPs' bag 1 vs bag 3)\n";
   for (const bool fitting : {false, true}) {
     const auto c = validate::coverage(v, fitting);
     std::cout << (fitting ? "fitting" : "held-out") << ": simulated " << c.simulated << " of " << c.eligible
               << " FTP-75, HWFET, US06 and charge-depleting rows ("
-              << report::fixed(c.eligible ? 100.0 * static_cast<double>(c.simulated) / static_cast<double>(c.eligible) : 0.0, 1)
+              << fixed(c.eligible ? 100.0 * static_cast<double>(c.simulated) / static_cast<double>(c.eligible) : 0.0, 1)
               << " %)\n";
   }
   report::TextTable t({"powertrain", "cycle", "half", "count", "median err %", "median |err| %", "p90 |err| %"});
@@ -73,8 +73,8 @@ void print_summary(const validate::Validation& v) {
   auto lines = validate::summarise(v);
   std::stable_sort(lines.begin(), lines.end(), [](const auto& a, const auto& b) { return a.half > b.half; });
   for (const auto& s : lines) {
-    t.add_row({s.powertrain, s.cycle, s.half, std::to_string(s.count), report::fixed(s.median_error_pct, 1),
-               report::fixed(s.median_abs_error_pct, 1), report::fixed(s.p90_abs_error_pct, 1)});
+    t.add_row({s.powertrain, s.cycle, s.half, std::to_string(s.count), fixed(s.median_error_pct, 1),
+               fixed(s.median_abs_error_pct, 1), fixed(s.p90_abs_error_pct, 1)});
   }
   std::cout << t.render();
   std::map<std::string, std::size_t> skipped;

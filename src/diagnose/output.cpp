@@ -16,13 +16,6 @@ std::string num(double v) {
   return os.str();
 }
 
-std::string fixed(double v, int digits) {
-  std::ostringstream os;
-  os.setf(std::ios::fixed);
-  os.precision(digits);
-  os << v;
-  return os.str();
-}
 
 }  // namespace diag
 

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "rollsim/common/format.hpp"
 #include "rollsim/diagnose/diagnose.hpp"
 #include "rollsim/sim/effect.hpp"
 
@@ -255,7 +256,6 @@ std::vector<DiagnosisWindow> window_series(const Observations& o, const std::vec
 
 // ---- small text helpers (output.cpp) ---------------------------------------------------------------------------
 std::string num(double v);
-std::string fixed(double v, int digits);
 
 }  // namespace rollsim::diag
 
