@@ -84,10 +84,13 @@ Recording recording(const Vehicle& v, std::shared_ptr<const Effect> truth, doubl
   std::vector<double> p;
   const auto step = static_cast<std::size_t>(std::lround(10.0 / hz));
   const auto shift = static_cast<std::size_t>(std::lround(lag_s * 10.0));
-  for (std::size_t i = shift; i < r.trace.size(); i += step) {
+  // An integrating logger: each sample holds the mean power over its interval (the truth's 0.1 s segments).
+  for (std::size_t i = shift; i + step < r.trace.size(); i += step) {
     rec.time_s.push_back(c.time_s[i]);
     rec.speed_mps.push_back(c.speed_mps[i]);
-    p.push_back(scale * r.trace[i - shift].battery_power_w + noise(rng));
+    double mean_w = 0.0;
+    for (std::size_t k = 0; k < step; ++k) mean_w += r.trace[i - shift + k].segment_battery_power_w / static_cast<double>(step);
+    p.push_back(scale * mean_w + noise(rng));
   }
   rec.battery_power_w = p;
   return rec;
