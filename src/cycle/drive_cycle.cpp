@@ -188,10 +188,10 @@ DriveCycle read_cycle_csv(const std::string& path, const std::string& name) {
                            std::to_string(table.row_line[r - 1]) + "; allowed: 0.001 to 86400 s between samples");
     }
     const double v = number(r, col_v);
-    const double v_max = col_kmh ? units::mps_to_kmh(kMaxCycleSpeed_mps) : kMaxCycleSpeed_mps;
-    if (!(v >= 0.0 && v <= v_max)) {
-      throw InputError(table.where(r, col_v), format_value(v) + " is not allowed: speed must be in [0, " +
-                                                  format_value(v_max) + "] " + (col_kmh ? "km/h" : "m/s") + " (500 km/h)");
+    const double v_max = col_kmh ? kMaxCycleSpeed_kmh : units::kmh_to_mps(kMaxCycleSpeed_kmh);
+    if (!(v >= 0.0 && v <= v_max * (1.0 + 1e-12))) {
+      throw InputError(table.where(r, col_v), format_value(v) + " is not allowed: speed must be in " +
+                                                  (col_kmh ? std::string(">= 0 and <= 500 km/h") : std::string(">= 0 and <= 138.9 m/s (500 km/h)")));
     }
     c.speed_mps[r] = col_kmh ? units::kmh_to_mps(v) : v;
     if (r > 0 && std::abs(c.speed_mps[r] - c.speed_mps[r - 1]) / dt > kMaxCycleAccel_mps2) {

@@ -55,8 +55,8 @@ DriveCycle read_cycle_csv(const std::string& path, const std::string& name);
 
 /// Largest |grade| a cycle may hold: 30 %, steeper than any public road.
 inline constexpr double kMaxCycleGrade = 0.30;
-/// Fastest a cycle may ask for [m/s]: 500 km/h, beyond any road car and any tyre's speed rating.
-inline constexpr double kMaxCycleSpeed_mps = 500.0 / 3.6;
+/// Fastest a cycle may ask for: 500 km/h, beyond any road car and any tyre's speed rating (a file's unit).
+inline constexpr double kMaxCycleSpeed_kmh = 500.0;
 /// Largest |acceleration| between two samples [m/s^2]: 2 g, beyond the grip of any tyre on a road.
 inline constexpr double kMaxCycleAccel_mps2 = 19.6;
 /// Closest and farthest two samples may be [s]: 1 ms (a 1 kHz logger) and one day (a car parked overnight).
