@@ -41,12 +41,17 @@ double CombustionPowertrain::max_wheel_force_n(int gear, double speed_mps, doubl
   return force_n;
 }
 
-void CombustionPowertrain::add_electric_load(double power_w, PowerFlow& flow) const {
-  const double fuel_w = power_w / (p_.alternator_efficiency * p_.engine.indicated_efficiency);
+void add_alternator_load(double power_w, double alternator_efficiency, double indicated_efficiency,
+                         const FuelParams& fuel, PowerFlow& flow) {
+  const double fuel_w = power_w / (alternator_efficiency * indicated_efficiency);
   flow.aux_power_w += power_w;
   flow.fuel_power_w += fuel_w;
   flow.engine_loss_w += fuel_w - power_w;
-  flow.fuel_rate_m3_per_s += fuel_w / (p_.fuel.lower_heating_value_j_per_kg * p_.fuel.density_kg_per_m3);
+  flow.fuel_rate_m3_per_s += fuel_w / (fuel.lower_heating_value_j_per_kg * fuel.density_kg_per_m3);
+}
+
+void CombustionPowertrain::add_electric_load(double power_w, PowerFlow& flow) const {
+  add_alternator_load(power_w, p_.alternator_efficiency, p_.engine.indicated_efficiency, p_.fuel, flow);
 }
 
 PowerFlow CombustionPowertrain::deliver(double wheel_force_n, double speed_mps, int gear,

@@ -131,11 +131,7 @@ double ConventionalPowertrain::max_wheel_force_n(int /*gear*/, double speed_mps,
 }
 
 void ConventionalPowertrain::add_electric_load(double power_w, PowerFlow& flow) const {
-  const double fuel_w = power_w / (p_.alternator_efficiency * p_.engine.indicated_efficiency);
-  flow.aux_power_w += power_w;
-  flow.fuel_power_w += fuel_w;
-  flow.engine_loss_w += fuel_w - power_w;
-  flow.fuel_rate_m3_per_s += fuel_w / (p_.fuel.lower_heating_value_j_per_kg * p_.fuel.density_kg_per_m3);
+  add_alternator_load(power_w, p_.alternator_efficiency, p_.engine.indicated_efficiency, p_.fuel, flow);
 }
 
 PowerFlow ConventionalPowertrain::deliver(double wheel_force_n, double speed_mps, int gear, double wheel_radius_m) const {

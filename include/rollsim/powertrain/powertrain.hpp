@@ -20,6 +20,13 @@ struct FuelParams {
   double co2_kg_per_kg = 0.0;   ///< tank-to-wheel CO2 per kg of fuel burned
 };
 
+struct PowerFlow;
+
+/// Books an electric load of `power_w` carried by an engine through its alternator: the fuel it costs at the
+/// engine's indicated efficiency, and the loss that is not the load. One rule for every fuel-burning powertrain.
+void add_alternator_load(double power_w, double alternator_efficiency, double indicated_efficiency,
+                         const FuelParams& fuel, PowerFlow& flow);
+
 /// Powers at one instant, all [W], signed where noted. Everything downstream of the wheel that the energy
 /// report and the energy balance need. Fields a powertrain does not have stay zero.
 struct PowerFlow {
