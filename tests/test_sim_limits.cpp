@@ -99,7 +99,8 @@ TEST(MotorTopSpeed, TraceBeyondTopSpeedGivesTheAnalyticCruiseAndReportsTheShortf
 // The limiter derates the motor continuously: full force below the band, none at max_speed_rpm, linear between.
 TEST(MotorTopSpeed, AvailableForceTapersContinuouslyToZeroAtMaxSpeed) {
   const auto m = model_of("vehicles/ev.yaml");
-  const auto& p = std::get<ElectricPowertrainParams>(load_vehicle_file(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/ev.yaml").powertrain);
+  const Vehicle vehicle = load_vehicle_file(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/ev.yaml");
+  const auto& p = std::get<ElectricPowertrainParams>(vehicle.powertrain);
   const double v_max = p.motor.max_speed_radps / p.reduction.ratio * m.wheel_radius_m;
   const double band = p.motor.speed_limit_band_fraction;
   auto force = [&](double v) { return m.powertrain->max_wheel_force_n(0, v, m.wheel_radius_m); };
