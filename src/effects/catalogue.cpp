@@ -7,6 +7,7 @@
 
 #include "rollsim/common/error.hpp"
 #include "rollsim/common/units.hpp"
+#include "rollsim/effects/road_profile.hpp"
 
 namespace rollsim {
 namespace {
@@ -353,6 +354,13 @@ std::vector<EffectInfo> build_catalogue() {
       "missing grade: constant offset or a cosine elevation-profile error along distance, force m g sin(theta)", "",
       {{&RoadGradeParams::grade_offset, {"grade_offset", "1", 0.0, 0.005, -0.2, 0.2, true}},
        {&RoadGradeParams::profile_wavelength_m, {"profile_wavelength_m", "m", 0.0, 0.0, 0.0, 1e6, false}}}));
+  c.push_back(row<RoadProfile, RoadProfileParams>(
+      I::road_profile, "road_profile",
+      "unrecorded road profile: an elevation along distance (linear between knots), force m g sin(theta(s)); the diagnosis "
+      "infers its knots from the residual (a vehicle file's has none and is flat)",
+      "",
+      {{&RoadProfileParams::profile_scale, {"profile_scale", "1", 0.0, 1.0, 0.0, 3.0, true}},
+       {&RoadProfileParams::knot_spacing_m, {"knot_spacing_m", "m", 100.0, 100.0, 10.0, 10000.0, false}}}));
   return c;
 }
 

@@ -26,6 +26,7 @@ enum class EffectId {
   regen_limit,
   engine_warmup,
   road_grade,
+  road_profile,
 };
 
 /// What an effect needs to know about the car it is fitted to (set from the vehicle description).
