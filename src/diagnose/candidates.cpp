@@ -64,6 +64,7 @@ std::vector<EffectParameters> shapes_of(const EffectInfo& info) {
   if (info.id == EffectId::tyre_warmup)
     return {{{"heat_capacity_j_per_k", 20000.0}}, {{"heat_capacity_j_per_k", 50000.0}}, {{"heat_capacity_j_per_k", 120000.0}}};
   if (info.id == EffectId::engine_warmup) return {{{"heat_capacity_j_per_k", 100000.0}}};
+  if (info.id == EffectId::road_profile) return {};  // inferred from the residual (road_profile.cpp), not one shape
   return {{}};
 }
 
@@ -173,13 +174,18 @@ Signatures compute_signatures(const Replayer& rp, const Observations& o, const V
       kept.push_back(std::move(c));
       continue;
     }
-    c.signature = (vars[k++].window_j - base.window_j) / c.amplitude->nominal;
+    c.signature = (vars[k].window_j - base.window_j) / c.amplitude->nominal;
+    c.power_w = std::move(vars[k++].power_w);
     if (c.signature.norm() > 0.0) kept.push_back(std::move(c));
   }
   s.candidates = std::move(kept);
   for (auto& b : s.basis) {
-    b.signature = b.kind == BasisShape::force ? Eigen::VectorXd(vars[k++].window_j - base.window_j)
-                                              : power_signature(o, rp.cycles, b.decay_s);
+    if (b.kind == BasisShape::force) {
+      b.signature = vars[k].window_j - base.window_j;
+      b.power_w = std::move(vars[k++].power_w);
+    } else {
+      b.signature = power_signature(o, rp.cycles, b.decay_s);
+    }
   }
   return s;
 }

@@ -1,4 +1,5 @@
 // Diagnosis output: the JSON and text reports, and the vehicle file with the fitted effects.
+#include <algorithm>
 #include <fstream>
 #include <sstream>
 
@@ -68,7 +69,24 @@ std::string diagnosis_json(const Diagnosis& d) {
        << ", \"heldout_energy_error_pct_before\": " << num(f.heldout_energy_error_pct_before)
        << ", \"heldout_energy_error_pct_after\": " << num(f.heldout_energy_error_pct_after)
        << ", \"heldout_lag1_autocorrelation_before\": " << num(f.heldout_lag1_autocorrelation_before)
-       << ", \"heldout_lag1_autocorrelation_after\": " << num(f.heldout_lag1_autocorrelation_after) << "}";
+       << ", \"heldout_lag1_autocorrelation_after\": " << num(f.heldout_lag1_autocorrelation_after);
+    if (f.road_profile) {
+      auto array = [&os](const char* key, const std::vector<double>& v) {
+        os << "\"" << key << "\": [";
+        for (std::size_t k = 0; k < v.size(); ++k) os << (k ? ", " : "") << num(v[k]);
+        os << "]";
+      };
+      os << ", \"road_profile\": {";
+      array("distance_m", f.road_profile->distance_m);
+      os << ", ";
+      array("elevation_m", f.road_profile->elevation_m);
+      os << ", ";
+      array("elevation_ci_low_m", f.road_profile->elevation_ci_low_m);
+      os << ", ";
+      array("elevation_ci_high_m", f.road_profile->elevation_ci_high_m);
+      os << "}";
+    }
+    os << "}";
   }
   os << (d.findings.empty() ? "" : "\n  ") << "],\n  \"located\": [";
   for (std::size_t i = 0; i < d.located.size(); ++i) {
@@ -128,6 +146,12 @@ std::string diagnosis_text(const Diagnosis& d) {
       else
         os << " [" << p.ci_low << ", " << p.ci_high << "] " << p.unit << "\n";
     }
+    if (f.road_profile && !f.road_profile->distance_m.empty()) {
+      const auto& p = *f.road_profile;
+      const auto [lo, hi] = std::minmax_element(p.elevation_m.begin(), p.elevation_m.end());
+      os << "    elevation profile: " << p.distance_m.size() << " knots over " << p.distance_m.back() / 1e3 << " km, "
+         << *lo << " to " << *hi << " m from the start's (with its 95 % band in --json, road_profile)\n";
+    }
     os << "    held-out RMSE " << f.heldout_rmse_before_j / 1e3 << " -> " << f.heldout_rmse_after_j / 1e3
        << " kJ/window, trip energy error " << f.heldout_energy_error_pct_before << " -> " << f.heldout_energy_error_pct_after
        << " %, residual lag-1 autocorrelation " << f.heldout_lag1_autocorrelation_before << " -> "
@@ -160,7 +184,8 @@ std::string fitted_vehicle_yaml(const std::string& vehicle_path, const Diagnosis
     if (line.rfind("effects:", 0) == 0) throw InputError(vehicle_path, "already has an effects: block; remove it to write a fitted one");
   std::vector<std::pair<std::string, EffectParameters>> eff;
   for (const auto& f : d.findings)
-    if (f.effect != "unexplained") eff.emplace_back(f.effect, f.fitted);  // described, not a module
+    // unexplained: described, not a module; road_profile: its knots are the diagnosis' output, not parameters
+    if (f.effect != "unexplained" && f.effect != "road_profile") eff.emplace_back(f.effect, f.fitted);
   if (!text.empty() && text.back() != '\n') text += '\n';
   text += "# effects fitted by rollsim diagnose (verdict: " + d.verdict + ")\n";
   if (eff.empty()) return text;

@@ -161,6 +161,7 @@ struct Candidate {
   const EffectParameterInfo* amplitude = nullptr;
   Eigen::VectorXd signature;  // window energy per unit amplitude
   bool across_trips = false;  // ambient_rrc: a per-recording level from the RRC-level variant (no own run)
+  std::vector<std::vector<double>> power_w;  // its variant's per-sample channel power at the nominal amplitude
   double min() const { return amplitude->min; }
   double max() const { return amplitude->max; }
 };
@@ -172,6 +173,7 @@ struct BasisShape {
   ForceShape shape = ForceShape::constant;
   double decay_s = 0.0;  // 0: no decay
   Eigen::VectorXd signature;
+  std::vector<std::vector<double>> power_w;  // force shapes: the variant's per-sample channel power (1 unit)
 };
 std::shared_ptr<const Effect> signature_force(ForceShape shape, double decay_s);
 /// A force k x 0.5 rho CdA v^2 (the aero calibration's signature; air density per recording).
@@ -241,6 +243,17 @@ std::vector<Finding> select_effects(const SelectionContext& sc, const std::vecto
                                     std::vector<EffectId>& chosen);
 std::vector<DetectionLimit> detection_limits(const std::vector<Candidate>& cands, const std::vector<EffectId>& chosen,
                                              const Model& m, const DiagnoseOptions& opt);
+
+// ---- road profile when elevation is withheld (road_profile.cpp) -------------------------------------------------
+
+struct NoiseFloor;
+/// The residual inverted into an elevation profile along distance; a road_profile finding (the model grows by its
+/// column) when it explains decisively more than any single shape, predicts held-out windows and the residual is
+/// quiet standing. One recording without elevation or grade, per-sample channels only; the evidence goes to `notes`.
+std::optional<Finding> infer_road_profile(const SelectionContext& sc, const std::vector<DriveCycle>& cycles,
+                                          const Signatures& sig, const std::vector<Finding>& found,
+                                          const std::vector<EffectId>& chosen, const NoiseFloor& floor, Model& m,
+                                          std::vector<std::string>& notes);
 
 // ---- unexplained residual (unexplained.cpp) --------------------------------------------------------------------
 

@@ -25,6 +25,11 @@ std::string separating_test(const std::string& a, const std::string& b) {
       {"battery_resistance", "tyre_slip", "compare hard accelerations at low and high speed: battery loss follows current squared, slip loss also grows with speed"},
       {"regen_limit", "rotational_inertia", "brake at different strengths from the same speed: a regen limit shows only above its power, inertia in every braking"},
       {"road_grade", "rr_speed", "drive the route in both directions, or record elevation: grade reverses with direction"},
+      {"road_profile", "road_grade", "record elevation (GPS or barometric altitude): the profile's hills and its net climb are one road"},
+      {"road_profile", "unexplained", "record elevation, or drive the route again: a road repeats at the same place, other causes do not"},
+      {"road_profile", "mass", "record elevation, or drive the route in both directions: hills reverse, a mass error does not"},
+      {"road_profile", "aux_load", "log a standstill: a road does nothing to a standing car, a load draws"},
+      {"road_profile", "tyre_warmup", "drive the route again warm: a road repeats at the same place, a warm-up does not"},
   };
   for (const auto& [x, y, text] : kTests) {
     if ((a == x && b == y) || (a == y && b == x)) return text;
