@@ -322,7 +322,7 @@ const std::vector<ConcealedTruthInfo>& concealed_truths() {
        "the same compound law on a tyre that starts each trip at ambient and warms (one-node heat balance)",
        {0.008}, SyntheticChannel::battery_power, true, +1},
       // What real roads, cars and loggers vary (issue 9), recorded through a real logger's artefacts.
-      {"rolling_hills", "road_grade", "m (hill amplitude, elevation withheld)",
+      {"rolling_hills", "road_profile", "m (hill amplitude, elevation withheld)",
        "three hills along distance, wavelengths 0.5-3 km, amplitude ~ wavelength, peak grade <= 8 %; no elevation recorded",
        {10, 25, 40}, SyntheticChannel::battery_power, false, 0, true},
       {"ac_duty_cycle", "aux_load", "W (compressor on)",
