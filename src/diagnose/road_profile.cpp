@@ -324,6 +324,18 @@ std::optional<Finding> infer_road_profile(const SelectionContext& sc, const std:
   for (const auto& b : sig.basis)
     comps.push_back({"unexplained", b.kind == BasisShape::force ? Eigen::VectorXd(k[0] * (energies(b.power_w) - base_s))
                                                                 : Eigen::VectorXd(k[0] * power_signature(sw, cycles, b.decay_s))});
+  // A force growing over the trip (an RRC rising with rain or a rougher road), linear and quadratic in time, through
+  // the same per-newton channel power: smooth in distance too, so a profile must beat it as well.
+  {
+    const auto& t = cyc.time_s;
+    const double span = std::max(1.0, t.back() - t.front());
+    for (int power = 1; power <= 2; ++power) {
+      std::vector<std::vector<double>> grow(1, std::vector<double>(base_w.size()));
+      for (std::size_t i = 0; i < base_w.size(); ++i)
+        grow[0][i] = (unit->power_w.front()[i] - base_w[i]) * std::pow((t[i] - t.front()) / span, power);
+      comps.push_back({"unexplained", k[0] * energies(grow)});
+    }
+  }
   const Competitor* rival = nullptr;
   for (auto& c : comps) {
     c.dbic = bic_single(rtr, c.column, r, n_eff);
@@ -382,8 +394,8 @@ std::optional<Finding> infer_road_profile(const SelectionContext& sc, const std:
                   "); held-out figures are for alternate 20 s blocks of 10 s windows";
   f.delta_bic = dbic;
   const double net_sd = std::sqrt(std::max(0.0, var[kb]));
-  f.parameters.push_back({"net_climb_m", "m", elev[kb], elev[kb] - 1.96 * net_sd, elev[kb] + 1.96 * net_sd});
   f.parameters.push_back({"profile_scale", "1", profile_scale, profile_scale - 1.96 * scale_se, profile_scale + 1.96 * scale_se});
+  f.parameters.push_back({"net_climb_m", "m", elev[kb], elev[kb] - 1.96 * net_sd, elev[kb] + 1.96 * net_sd});
   f.parameters.push_back({"knot_spacing_m", "m", bins.spacing_m, bins.spacing_m, bins.spacing_m});
   f.parameters.push_back({"effective_parameters", "1", best.edf, best.edf, best.edf});
   for (const auto& c : comps) {
