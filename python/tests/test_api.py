@@ -7,6 +7,7 @@ import json
 import os
 import subprocess
 import tempfile
+import time
 import unittest
 import warnings
 from pathlib import Path
@@ -163,6 +164,35 @@ class DiagnoseApi(unittest.TestCase):
             got = rollsim.diagnose(vehicle="twizy", recordings=[rec], preset="rsk_twizy")
         self.assertEqual(got, expected)
         self.assertIn(got["verdict"], ("nothing_missing", "missing_physics", "unexplained"))
+
+
+class GilRelease(unittest.TestCase):
+    def test_python_runs_while_a_simulation_runs(self):
+        # A worker thread runs NEDC simulations; the main thread notes the time at each turn of a loop while the
+        # worker is inside the call. With the GIL held for the call, the main thread would stand still throughout.
+        import threading
+        state = {"inside": False, "done": False, "t0": 0.0, "t1": 0.0}
+
+        def worker():
+            state["inside"] = True
+            state["t0"] = time.perf_counter()
+            rollsim.sweep("nominal", [("pressure", 1.8, 3.0, 30)], vehicle="ev", threads=1)
+            state["t1"] = time.perf_counter()
+            state["done"] = True
+
+        ticks = []
+        t = threading.Thread(target=worker)
+        t.start()
+        while not state["done"]:
+            if state["inside"]:
+                ticks.append(time.perf_counter())
+        t.join()
+        during = [x for x in ticks if state["t0"] <= x <= state["t1"]]
+        duration = state["t1"] - state["t0"]
+        self.assertGreater(len(during), 100, f"the main thread ran {len(during)} times in {duration:.3f} s")
+        edges = [state["t0"], *during, state["t1"]]
+        largest_gap = max(b - a for a, b in zip(edges, edges[1:]))
+        self.assertLess(largest_gap, 0.5 * duration, f"the main thread stood still {largest_gap:.3f} of {duration:.3f} s")
 
 
 class InputErrors(unittest.TestCase):
