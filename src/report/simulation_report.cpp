@@ -47,7 +47,7 @@ std::string summary_text(const SimulationResult& r, bool solver_stats) {
   const double km = r.distance_m / 1000.0;
   o << r.vehicle << " on " << r.cycle << " (" << r.mode << " simulation; road load: " << r.road_load << ")\n";
   o << "  distance " << fixed(km, 3) << " km in " << fixed(r.duration_s, 0) << " s, mean speed "
-    << fixed(km / (r.duration_s / 3600.0), 1) << " km/h\n";
+    << fixed(km / (r.duration_s / units::kSPerHour), 1) << " km/h\n";
   if (!r.moved()) {
     o << "  the car did not move: per-distance figures (" << (r.fuel ? "l/100 km, CO2 g/km" : "kWh/10 km, range")
       << ") are undefined\n";
@@ -204,7 +204,7 @@ std::vector<TraceColumn> trace_columns(const SimulationResult& r) {
       {"traction_power_kw", [](const P& p) { return p.traction_power_w / 1e3; }},
       {"battery_power_kw", [](const P& p) { return p.battery_power_w / 1e3; }},
       {"battery_current_a", [](const P& p) { return p.battery_current_a; }},
-      {"fuel_rate_lph", [](const P& p) { return p.fuel_rate_m3_per_s / units::kM3PerLitre * 3600.0; }},
+      {"fuel_rate_lph", [](const P& p) { return p.fuel_rate_m3_per_s / units::kM3PerLitre * units::kSPerHour; }},
       {"tyre_rrc", [](const P& p) { return p.rrc; }},
       {"soc_pct", [](const P& p) { return p.soc * 100.0; }},
   };

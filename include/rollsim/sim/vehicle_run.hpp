@@ -7,8 +7,7 @@
 
 #include "rollsim/cycle/drive_cycle.hpp"
 #include "rollsim/sim/simulation.hpp"
-#include "rollsim/tyre/tyre_spec.hpp"
-#include "rollsim/vehicle/vehicle.hpp"
+#include "rollsim/vehicle/vehicle.hpp"  // also TyreSpec: the sim layer reaches tyres only through the vehicle
 
 namespace rollsim {
 
