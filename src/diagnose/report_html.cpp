@@ -85,7 +85,7 @@ void findings_table(std::ostream& os, const Diagnosis& d) {
     for (std::size_t k = 0; k < f.confounded_with.size(); ++k) os << (k ? "<br>" : "") << html_escape(f.confounded_with[k]);
     os << (f.confounded_with.empty() ? "none" : "") << "</td><td class=\"wide\">";
     for (std::size_t k = 0; k < f.separating_tests.size(); ++k) os << (k ? "<br>" : "") << html_escape(f.separating_tests[k]);
-    os << "</td></tr>\n";
+    os << (f.separating_tests.empty() ? "&mdash;" : "") << "</td></tr>\n";
   }
   os << "</tbody></table></div>\n<dl>\n";
   for (const auto& f : d.findings)
