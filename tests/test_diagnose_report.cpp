@@ -198,9 +198,13 @@ TEST(DiagnoseReport, PageEscapesEveryTextAndDrawsARoadProfileWhereAFindingHasOne
   Finding road;
   road.effect = "road_profile";
   road.energy_share_pct = 1.5;
+  road.road_profile.emplace();
   for (int i = 0; i <= 50; ++i) {
-    road.road_profile.distance_m.push_back(100.0 * i);
-    road.road_profile.elevation_m.push_back(200.0 + 20.0 * std::sin(i / 8.0));
+    const double z = 20.0 * std::sin(i / 8.0);
+    road.road_profile->distance_m.push_back(100.0 * i);
+    road.road_profile->elevation_m.push_back(z);
+    road.road_profile->elevation_ci_low_m.push_back(z - 0.1 * i);
+    road.road_profile->elevation_ci_high_m.push_back(z + 0.1 * i);
   }
   d.findings.push_back(road);
   const std::string dir = ::testing::TempDir() + "/diag_report_escape";

@@ -122,20 +122,26 @@ std::vector<Figure> regime_figures(const Diagnosis& d, const fs::path& work) {
   return {{"regimes.svg", "Residual by driving regime (samples in brackets): mean and 95 % interval", script.str(), 120 + 34 * n}};
 }
 
-// Each road_profile finding's recovered elevation along distance.
+// Each road_profile finding's recovered elevation along distance, with its 95 % band where the finding has one.
 std::vector<Figure> road_figures(const Diagnosis& d, const fs::path& work) {
   std::vector<Figure> out;
   for (const auto& f : d.findings) {
-    const RoadProfile& p = f.road_profile;
+    if (!f.road_profile) continue;
+    const RecoveredProfile& p = *f.road_profile;
     const std::size_t n = std::min(p.distance_m.size(), p.elevation_m.size());
     if (n < 2) continue;
+    const bool band = p.elevation_ci_low_m.size() >= n && p.elevation_ci_high_m.size() >= n;
     std::string name = "road_profile";
     if (!out.empty()) name.append("_").append(std::to_string(out.size() + 1));
+    const std::string dat = report::gnuplot_string((work / (name + ".dat")).string());
     std::ofstream data(work / (name + ".dat"));
-    for (std::size_t i = 0; i < n; ++i) data << p.distance_m[i] / units::kMPerKm << " " << p.elevation_m[i] << "\n";
-    out.push_back({name + ".svg", "Recovered road profile (" + f.effect + "): elevation along distance",
-                   "set xlabel 'distance [km]'\nset ylabel 'elevation [m]'\nplot " +
-                       report::gnuplot_string((work / (name + ".dat")).string()) + " u 1:2 w l lw 2 t 'recovered'\n", 360});
+    for (std::size_t i = 0; i < n; ++i)
+      data << p.distance_m[i] / units::kMPerKm << " " << p.elevation_m[i] << " " << (band ? p.elevation_ci_low_m[i] : 0.0) << " "
+           << (band ? p.elevation_ci_high_m[i] : 0.0) << "\n";
+    std::string plot = "set xlabel 'distance driven [km]'\nset ylabel 'elevation relative to the start [m]'\nplot ";
+    if (band) plot += dat + " u 1:3:4 w filledcurves lc rgb '#c6dbef' t '95 % band', ";
+    out.push_back({name + ".svg", "Recovered road profile (" + f.effect + "): elevation along the distance driven",
+                   plot + dat + " u 1:2 w l lw 2 lc rgb '#08519c' t 'recovered'\n", 360});
   }
   return out;
 }

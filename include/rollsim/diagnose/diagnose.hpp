@@ -2,6 +2,7 @@
 #pragma once
 
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -93,9 +94,10 @@ struct ProfileInterval {
 ProfileInterval profile_likelihood_interval(const std::vector<double>& grid, const std::vector<double>& rss, double n_eff,
                                             double critical = 3.84);
 
-/// Elevation along distance, as a road_profile finding recovers it (empty for every other finding).
-struct RoadProfile {
-  std::vector<double> distance_m, elevation_m;
+/// A road profile recovered from the residual (road_profile findings): elevation along the distance driven, relative
+/// to the start, at the profile's knots, with its 95 % band (it widens along the trip: an elevation is a sum of grades).
+struct RecoveredProfile {
+  std::vector<double> distance_m, elevation_m, elevation_ci_low_m, elevation_ci_high_m;
 };
 
 struct Finding {
@@ -114,7 +116,7 @@ struct Finding {
   /// Whiteness of the held-out window residual: its lag-1 autocorrelation (0 for white noise), before and after.
   double heldout_lag1_autocorrelation_before = 0.0, heldout_lag1_autocorrelation_after = 0.0;
   EffectParameters fitted;  ///< for --write-vehicle
-  RoadProfile road_profile;
+  std::optional<RecoveredProfile> road_profile;  ///< road_profile findings: the profile itself
 };
 
 struct RegimeResidual {
