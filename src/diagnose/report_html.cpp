@@ -30,7 +30,8 @@ constexpr const char* kStyle =
     "pre{overflow-x:auto;background:#f4f4f4;padding:8px;font-size:.8em;overflow-wrap:normal}"
     "dt{font-weight:600}dd{margin:0 0 .6em 1em}";
 
-// Decimals showing about three significant digits of `scale` (at most six).
+// Decimals showing about three significant digits of `scale` (at most six). Fixed-point, unlike `significant`: a
+// value and its interval's ends share the decimals of the largest, and no reader meets "2.58e+03 W".
 int decimals_for(double scale) {
   if (!(std::abs(scale) > 0.0) || !std::isfinite(scale)) return 0;
   return std::clamp(2 - static_cast<int>(std::floor(std::log10(std::abs(scale)))), 0, 6);
