@@ -31,7 +31,10 @@ namespace {
 
 py::object from_json(const std::string& text) { return py::module_::import("json").attr("loads")(text); }
 std::string to_json(py::handle obj) { return py::module_::import("json").attr("dumps")(obj).cast<std::string>(); }
-void warn(const std::string& text) { PyErr_WarnEx(PyExc_UserWarning, text.c_str(), 1); }
+// What the CLI prints as "warning: ..." on stderr; raises if the user's warning filter turns it into an error.
+void warn(const std::string& text) {
+  if (PyErr_WarnEx(PyExc_UserWarning, text.c_str(), 1) != 0) throw py::error_already_set();
+}
 
 // A Python number as the text the command line would have been given (shortest round-trip form: exact).
 std::string number_text(py::handle x) {

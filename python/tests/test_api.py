@@ -152,6 +152,24 @@ class SelectionApi(unittest.TestCase):
             self.assertTrue(all(a > b for a, b in zip(rrc, rrc[1:])), rrc)
 
 
+    def test_sweep_leaving_the_domain_warns_and_returns_the_cli_points(self):
+        p = subprocess.run([BINARY, "sweep", "--tyre", "175-70R14", "--param", "load", "--from", "2000", "--to", "60000",
+                            "--steps", "40", "--json"], capture_output=True, text=True, cwd=REPO)
+        self.assertEqual(p.returncode, 2, p.stderr)
+        expected = [json.loads(line) for line in p.stdout.splitlines()]
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            got = rollsim.sweep("175-70R14", [("load", 2000, 60000, 40)])
+        self.assertEqual(got, expected)
+        self.assertTrue(0 < len(got) < 40)
+        self.assertEqual(len(caught), 1)
+        self.assertIn(str(caught[0].message).split(" (the ")[0], p.stderr)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            with self.assertRaises(UserWarning):
+                rollsim.sweep("175-70R14", [("load", 2000, 60000, 40)])
+
+
 class DiagnoseApi(unittest.TestCase):
     def test_diagnose_matches_cli(self):
         rec = str(SHARED / "data" / "recordings" / "rsk_renault_twizy" / "T1_07_01_2021.csv")
