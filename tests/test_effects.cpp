@@ -15,9 +15,7 @@ namespace {
 
 Vehicle vehicle(const std::string& name) { return load_vehicle_file(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/" + name); }
 
-EffectContext context(const Vehicle& v) {
-  return {v.body.test_mass_kg, v.body.air_density_kg_per_m3 * v.body.drag_coefficient * v.body.frontal_area_m2};
-}
+EffectContext context(const Vehicle& v) { return effect_context(v); }
 
 SimulationResult run(const Vehicle& v, std::shared_ptr<const Effect> e, bool forward = false) {
   VehicleModel m = VehicleModel::assemble(v);
@@ -185,7 +183,7 @@ TEST(EffectCatalogue, VehicleFileEffectsBlockIsReadStrictly) {
   }
   const Vehicle v = load_vehicle_file(good);
   ASSERT_EQ(v.effects.size(), 1u);
-  EXPECT_EQ(v.effects[0]->id(), "aux_load");
+  EXPECT_EQ(v.effects[0].id, EffectId::aux_load);
   EXPECT_GT(source_j(run(v, nullptr)), source_j(run(vehicle("ev.yaml"), nullptr)));
   EXPECT_THROW(load_vehicle_file(dir + "/ev_bad.yaml"), InputError);
   EXPECT_THROW(load_vehicle_file(dir + "/ev_range.yaml"), InputError);

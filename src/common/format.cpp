@@ -14,12 +14,18 @@ std::string format_value(double value) {
   return std::string(buf, res.ptr);
 }
 
-std::string fixed(double value, int decimals) {
+namespace {
+std::string printf_finite(double value, const char* format, int precision) {
   if (std::isnan(value)) return "NaN";
   if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
   char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, value);
+  std::snprintf(buf, sizeof buf, format, precision, value);
   return buf;
 }
+}  // namespace
+
+std::string fixed(double value, int decimals) { return printf_finite(value, "%.*f", decimals); }
+
+std::string significant(double value, int digits) { return printf_finite(value, "%.*g", digits); }
 
 }  // namespace rollsim

@@ -7,6 +7,8 @@
 
 #include "pipeline.hpp"
 
+#include "rollsim/common/units.hpp"
+
 namespace rollsim::diag {
 namespace {
 
@@ -136,7 +138,7 @@ Finding adequacy_finding(const Adequacy& a, const NoiseFloor& nf, const Observat
     f.description += ": " + std::to_string(a.flagged) + " of " + std::to_string(a.blocks) + " blocks beyond 3 noise sd, between " +
                      fixed(a.first_s / 60.0, 0) + " and " + fixed(a.last_s / 60.0, 0) + " min since the start (" +
                      fixed(a.first_m / 1e3, 1) + "-" + fixed(a.last_m / 1e3, 1) + " km), at a mean " +
-                     fixed(a.flagged_mean_speed_mps * 3.6, 0) + " km/h, net " + fixed(a.flagged_j / 1e3, 0) + " kJ (" +
+                     fixed(units::mps_to_kmh(a.flagged_mean_speed_mps), 0) + " km/h, net " + fixed(a.flagged_j / 1e3, 0) + " kJ (" +
                      fixed(100.0 * a.flagged_j / total_j, 1) + " % of the measured energy)";
   // The regime whose mean residual is furthest from zero, in units of its interval.
   const RegimeResidual* worst = nullptr;

@@ -42,7 +42,7 @@ class SignatureForce final : public Effect {
   SignatureForce(ForceShape shape, double decay_s) : shape_(shape), decay_s_(decay_s) {}
   std::string id() const override { return "signature_force"; }
   double extra_resistance_n(const EffectInputs& in, const double*) const override {
-    constexpr double kV100 = 100.0 / 3.6;
+    constexpr double kV100 = units::kmh_to_mps(100.0);
     const double v = std::max(in.speed_mps, 0.0);
     double f = 0.0;
     switch (shape_) {

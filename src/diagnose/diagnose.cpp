@@ -10,14 +10,6 @@
 namespace rollsim {
 namespace {
 
-EffectContext context_of(const Vehicle& v) {
-  EffectContext c;
-  c.mass_kg = v.body.test_mass_kg;
-  c.rho_cda_kg_per_m = v.coastdown ? 2.0 * v.coastdown->c_n_s2_per_m2
-                                   : v.body.air_density_kg_per_m3 * v.body.drag_coefficient * v.body.frontal_area_m2;
-  return c;
-}
-
 std::vector<DriveCycle> cycles_of(const std::vector<Recording>& recordings, std::vector<std::string>& notes) {
   std::vector<DriveCycle> cycles;
   for (const Recording& r : recordings) {
@@ -81,7 +73,7 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
   out.channel = to_string(obs.channel);
   out.windows = static_cast<int>(obs.n());
   out.window_s = obs.window_s;
-  const EffectContext ctx = context_of(vehicle);
+  const EffectContext ctx = effect_context(vehicle);
   const AmbientSetting amb = ambient_setting(recordings, opt, out.notes);
   Replayer rp{vehicle, cycles, {}, obs.channel == ChannelKind::soc, opt.threads};
   // Air density follows the recorded ambient (rho ~ 1 / T at one pressure, the vehicle's taken at 20 degC): known

@@ -5,6 +5,8 @@
 
 #include "pipeline.hpp"
 
+#include "rollsim/common/units.hpp"
+
 namespace rollsim::diag {
 namespace {
 
@@ -59,8 +61,8 @@ std::vector<RegimeResidual> locate_windows(const Observations& o, const std::vec
     const double v = distance_m / duration_s;
     const double p_w = res_j[static_cast<Eigen::Index>(w)] / duration_s;
     const double mid_s = 0.5 * (c.time_s[win.begin] + c.time_s[win.end]) - c.time_s.front();
-    vals[v < 0.5 ? "standing (window)" : v < 50 / 3.6 ? "speed 0-50 km/h (window)"
-                                       : v < 90 / 3.6 ? "speed 50-90 km/h (window)" : "speed >90 km/h (window)"].push_back(p_w);
+    vals[v < 0.5 ? "standing (window)" : v < units::kmh_to_mps(50.0) ? "speed 0-50 km/h (window)"
+                                       : v < units::kmh_to_mps(90.0) ? "speed 50-90 km/h (window)" : "speed >90 km/h (window)"].push_back(p_w);
     vals[mid_s < 600 ? "first 10 min (window)" : mid_s < 1800 ? "10-30 min (window)" : "after 30 min (window)"].push_back(p_w);
     const Recording& r = recordings[win.rec];
     if ((r.grade || r.elevation_m) && distance_m > 0.0) {
@@ -100,7 +102,7 @@ std::vector<RegimeResidual> locate_regimes(const Observations& o, const std::vec
       const double t = r.time_s[i] - r.time_s.front();
       all.push_back(res);
       vals[v < 0.3 ? "standing" : a > 0.3 ? "accelerating" : a < -0.3 ? "braking" : "cruising"].push_back(res);
-      if (v >= 0.3) vals[v < 50 / 3.6 ? "speed 0-50 km/h" : v < 90 / 3.6 ? "speed 50-90 km/h" : "speed >90 km/h"].push_back(res);
+      if (v >= 0.3) vals[v < units::kmh_to_mps(50.0) ? "speed 0-50 km/h" : v < units::kmh_to_mps(90.0) ? "speed 50-90 km/h" : "speed >90 km/h"].push_back(res);
       vals[t < 600 ? "first 10 min" : t < 1800 ? "10-30 min" : "after 30 min"].push_back(res);
       // Grade regimes only where the recording gave grade or elevation (the replay trace then carries it).
       if (r.grade || r.elevation_m) {

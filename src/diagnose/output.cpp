@@ -10,12 +10,7 @@ namespace rollsim {
 
 namespace diag {
 
-std::string num(double v) {
-  std::ostringstream os;
-  os.precision(6);
-  os << v;
-  return os.str();
-}
+std::string num(double v) { return significant(v, 6); }
 
 }  // namespace diag
 

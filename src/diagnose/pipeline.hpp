@@ -10,7 +10,7 @@
 
 #include "rollsim/common/format.hpp"
 #include "rollsim/diagnose/diagnose.hpp"
-#include "rollsim/sim/effect.hpp"
+#include "rollsim/effects/effect.hpp"
 
 namespace rollsim::diag {
 

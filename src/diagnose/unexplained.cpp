@@ -5,6 +5,8 @@
 
 #include "pipeline.hpp"
 
+#include "rollsim/common/units.hpp"
+
 namespace rollsim::diag {
 namespace {
 
@@ -104,7 +106,7 @@ std::optional<Finding> describe_unexplained(const SelectionContext& sc, const st
   double vmax = 0.0;
   for (const auto& r : sc.recordings)
     for (double v : r.speed_mps) vmax = std::max(vmax, v);
-  const BasisWords w = words_of(b, value, vmax > 90.0 / 3.6 ? 100.0 : 50.0, sc.obs.channel);
+  const BasisWords w = words_of(b, value, vmax > units::kmh_to_mps(90.0) ? 100.0 : 50.0, sc.obs.channel);
   const double share_pct = 100.0 * best.fit.coef[best.fit.coef.size() - 1] * b.signature.sum() /
                            std::max(1e-9, std::abs(sc.obs.measured_j.sum()));
   f.parameters.push_back({w.name, w.unit, value, value - 1.96 * se, value + 1.96 * se});

@@ -271,7 +271,7 @@ DriveCycle steady_cruise(std::mt19937& rng) {
   c.name = "steady";
   const double v0 = 25.0, phase = std::uniform_real_distribution<double>(0.0, kTwoPi)(rng);
   for (int t = 0; t <= 3720; ++t) {
-    double v = v0 + (1.0 / 3.6) * std::sin(kTwoPi * t / 600.0 + phase);
+    double v = v0 + units::kmh_to_mps(1.0) * std::sin(kTwoPi * t / 600.0 + phase);
     if (t < 60) v *= t / 60.0;
     if (t > 3660) v *= (3720 - t) / 60.0;
     c.time_s.push_back(t);

@@ -18,6 +18,7 @@
 #include "rollsim/common/yaml_reader.hpp"
 #include "rollsim/cycle/drive_cycle.hpp"
 #include "rollsim/diagnose/diagnose.hpp"
+#include "rollsim/common/format.hpp"
 
 namespace rollsim {
 
@@ -56,11 +57,7 @@ void merge_ids(std::vector<std::string>& to, const std::vector<std::string>& fro
 
 bool has(const std::vector<std::string>& v, const std::string& s) { return std::find(v.begin(), v.end(), s) != v.end(); }
 
-std::string num(double v) {
-  std::ostringstream os;
-  os << v;
-  return os.str();
-}
+std::string num(double v) { return significant(v, 6); }
 
 std::vector<Case> build_cases(const BenchOptions& o) {
   std::vector<Case> cases;

@@ -12,7 +12,7 @@ namespace rollsim {
 namespace {
 
 constexpr double kG = units::kStandardGravity_mps2;
-constexpr double kRefSpeed_mps = 100.0 / 3.6;  // rr_speed's coefficient is the RRC change at 100 km/h
+constexpr double kRefSpeed_mps = units::kmh_to_mps(100.0);  // rr_speed's coefficient is the RRC change at 100 km/h
 
 // Typed parameters of each module; their names, units, neutral values and bounds are declared once, in the
 // module's registry row below, beside the member each one fills.
@@ -388,7 +388,7 @@ const EffectInfo& effect_info(const std::string& name) {
   throw InputError("effect '" + name + "'", "is not a catalogue effect");
 }
 
-std::shared_ptr<const Effect> make_effect(EffectId id, const EffectParameters& given, const EffectContext& context) {
+EffectSpec effect_spec(EffectId id, const EffectParameters& given) {
   const EffectInfo& info = effect_info(id);
   EffectParameters p;
   for (const auto& pi : info.parameters) p[pi.name] = pi.neutral;
@@ -401,15 +401,23 @@ std::shared_ptr<const Effect> make_effect(EffectId id, const EffectParameters& g
                            format_value(it->max) + "] " + it->unit);
     p[name] = value;
   }
-  return info.make(p, context);
+  return {id, std::move(p)};
+}
+
+std::shared_ptr<const Effect> make_effect(const EffectSpec& spec, const EffectContext& context) {
+  return effect_info(spec.id).make(spec.parameters, context);
+}
+
+std::shared_ptr<const Effect> make_effect(EffectId id, const EffectParameters& given, const EffectContext& context) {
+  return make_effect(effect_spec(id, given), context);
 }
 
 std::shared_ptr<const Effect> make_effect(const std::string& name, const EffectParameters& params, const EffectContext& context) {
   return make_effect(effect_info(name).id, params, context);
 }
 
-std::vector<std::shared_ptr<const Effect>> load_effects(YamlMap effects, const EffectContext& context) {
-  std::vector<std::shared_ptr<const Effect>> out;
+std::vector<EffectSpec> load_effects(YamlMap effects) {
+  std::vector<EffectSpec> out;
   for (const auto& kv : effects.node()) {
     const std::string name = kv.first.as<std::string>();
     const EffectInfo* info = nullptr;
@@ -424,7 +432,7 @@ std::vector<std::shared_ptr<const Effect>> load_effects(YamlMap effects, const E
       if (auto v = m.optional_number(pi.name, Range::closed(pi.min, pi.max))) p[pi.name] = *v;
     }
     m.finish();
-    out.push_back(make_effect(info->id, p, context));
+    out.push_back(effect_spec(info->id, p));
   }
   effects.finish();
   return out;

@@ -78,7 +78,7 @@ std::optional<double> parse_clock(const std::string& text) {
   if (!sec) return std::nullopt;
   const int h = std::stoi(hh), m = std::stoi(mm);
   if (h > 23 || m > 59 || *sec < 0.0 || *sec >= 61.0) return std::nullopt;  // 60.x: a leap second
-  return h * 3600.0 + m * 60.0 + *sec;
+  return h * units::kSPerHour + m * 60.0 + *sec;
 }
 
 std::string lines_text(const CsvTable& t, std::size_t r0, std::size_t r1) {
@@ -168,8 +168,8 @@ ColumnMapping preset_mapping(const std::string& name) {
     m.source_for_canonical = {{"time_s", "Time[s]"},
                               {"speed_kmh", "Dyno_Spd[mph]"},
                               {"fuel_rate_lph", "Eng_FuelFlow_Direct_DI[ccps]"}};
-    m.scale_for_canonical = {{"speed_kmh", units::kMPerMile / 1000.0},  // mph -> km/h
-                             {"fuel_rate_lph", 3.6}};                    // cm3/s -> l/h
+    m.scale_for_canonical = {{"speed_kmh", units::kMpsPerMph / units::kMpsPerKmh},  // mph -> km/h
+                             {"fuel_rate_lph", units::kM3PerCm3 / units::kM3PerLitre * units::kSPerHour}};  // cm3/s -> l/h
     return m;
   }
   if (key == "rsk_twizy") {
@@ -464,7 +464,7 @@ Recording load_recording(const std::string& path, const ColumnMapping& mapping) 
   rec.battery_voltage_v = optional_channel("battery_voltage_v", 1e-9, 2000.0, "V", 1.0);
   rec.battery_current_a = optional_channel("battery_current_a", -big, big, "A", 1.0);
   rec.soc_fraction = optional_channel("soc_pct", 0.0, 100.0, "%", 0.01);
-  rec.fuel_rate_m3ps = optional_channel("fuel_rate_lph", 0.0, 1000.0, "l/h", units::kM3PerLitre / 3600.0);
+  rec.fuel_rate_m3ps = optional_channel("fuel_rate_lph", 0.0, 1000.0, "l/h", units::kM3PerLitre / units::kSPerHour);
   rec.elevation_m = optional_channel("elevation_m", -500.0, 9000.0, "m", 1.0);
   rec.grade = optional_channel("grade_pct", -30.0, 30.0, "%", 0.01);
   rec.ambient_temp_k = optional_channel("ambient_temp_c", -60.0, 70.0, "C", 1.0, units::kKelvinOffset);

@@ -47,7 +47,7 @@ std::string summary_text(const SimulationResult& r, bool solver_stats) {
   const double km = r.distance_m / 1000.0;
   o << r.vehicle << " on " << r.cycle << " (" << r.mode << " simulation; road load: " << r.road_load << ")\n";
   o << "  distance " << fixed(km, 3) << " km in " << fixed(r.duration_s, 0) << " s, mean speed "
-    << fixed(km / (r.duration_s / 3600.0), 1) << " km/h\n";
+    << fixed(km / (r.duration_s / units::kSPerHour), 1) << " km/h\n";
   if (!r.moved()) {
     o << "  the car did not move: per-distance figures (" << (r.fuel ? "l/100 km, CO2 g/km" : "kWh/10 km, range")
       << ") are undefined\n";
@@ -196,7 +196,7 @@ void write_trace_csv(std::ostream& out, const SimulationResult& r) {
     out << p.time_s << ',' << units::mps_to_kmh(p.target_speed_mps) << ',' << units::mps_to_kmh(p.speed_mps) << ',' << p.accel_mps2 << ','
         << p.grade * 100.0 << ',' << p.gear << ',' << p.rolling_force_n << ',' << p.aero_force_n << ','
         << p.grade_force_n << ',' << p.wheel_force_n << ',' << p.traction_power_w / 1e3 << ','
-        << p.battery_power_w / 1e3 << ',' << p.battery_current_a << ',' << p.fuel_rate_m3_per_s / units::kM3PerLitre * 3600.0 << ','
+        << p.battery_power_w / 1e3 << ',' << p.battery_current_a << ',' << p.fuel_rate_m3_per_s / units::kM3PerLitre * units::kSPerHour << ','
         << p.rrc << ',' << p.soc * 100.0 << '\n';
   }
 }

@@ -10,6 +10,7 @@
 #include "rollsim/cycle/drive_cycle.hpp"
 #include "rollsim/selection/common.hpp"
 #include "rollsim/vehicle/vehicle.hpp"
+#include "rollsim/common/format.hpp"
 
 namespace rollsim::selection {
 
@@ -78,14 +79,6 @@ std::vector<RegressOutcome> run_baseline(const Baseline& b) {
   return out;
 }
 
-namespace {
-std::string number_text(double v, int digits) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*g", digits, v);
-  return buf;
-}
-}  // namespace
-
 std::string baseline_yaml(const Baseline& b, const std::vector<RegressOutcome>& outcomes) {
   std::ostringstream y;
   y << "# Energy regression baseline for `rollsim regress` (forward simulation). Each case: the car, the tyre fitted\n"
@@ -100,8 +93,8 @@ std::string baseline_yaml(const Baseline& b, const std::vector<RegressOutcome>& 
       << "    tyre: " << c.tyre << "\n"
       << "    cycle: " << c.cycle << "\n"
       << "    unit: " << c.unit << "\n"
-      << "    expected: " << number_text(value, 6) << "\n"
-      << "    tolerance_pct: " << number_text(c.tolerance_pct, 6) << "\n";
+      << "    expected: " << significant(value, 6) << "\n"
+      << "    tolerance_pct: " << significant(c.tolerance_pct, 6) << "\n";
   }
   return y.str();
 }

@@ -21,7 +21,8 @@ VehicleModel VehicleModel::assemble(const Vehicle& vehicle) {
   m.road_load_description = m.road_load->describe();
   m.flat_road_load = m.road_load->at_grade(0.0);
   m.powertrain = make_powertrain(vehicle);
-  m.effects = vehicle.effects;
+  const EffectContext context = effect_context(vehicle);
+  for (const EffectSpec& spec : vehicle.effects) m.effects.push_back(make_effect(spec, context));
   return m;
 }
 

@@ -5,6 +5,8 @@
 #include <functional>
 
 #include "rollsim/common/error.hpp"
+#include "rollsim/common/units.hpp"
+#include "rollsim/common/format.hpp"
 
 namespace rollsim {
 namespace {
@@ -12,15 +14,10 @@ namespace {
 constexpr double kNoEffect = 0.005;  // |elasticity| below this reads as "no effect" in the text
 
 std::string f2(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%+.2f", x);
-  return buf;
+  const std::string s = fixed(x, 2);
+  return s[0] == '-' ? s : "+" + s;
 }
-std::string pct(double share) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.0f %%", 100.0 * share);
-  return buf;
-}
+std::string pct(double share) { return fixed(100.0 * share, 0) + " %"; }
 
 // Central difference of ln(output) against ln(parameter): symmetric, so first-order errors cancel.
 struct Responses {
@@ -118,7 +115,7 @@ std::string elasticity_sign(double elasticity) {
 
 TyreExplanation explain_tyre(const TyreState& tyre, double load_n, double speed_mps, double relative_step) {
   if (!(speed_mps > 0.0)) {
-    throw ModelDomainError("speed " + format_value(speed_mps * 3.6) +
+    throw ModelDomainError("speed " + format_value(units::mps_to_kmh(speed_mps)) +
                            " km/h: explaining needs a speed > 0 (at standstill RRC is 0 and has no elasticity)");
   }
   TyreExplanation out;

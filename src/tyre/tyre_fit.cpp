@@ -11,6 +11,7 @@
 #include "rollsim/common/units.hpp"
 #include "rollsim/tyre/hysteresis_model.hpp"
 #include "rollsim/tyre/least_squares.hpp"
+#include "rollsim/common/format.hpp"
 
 namespace rollsim {
 namespace {
@@ -307,11 +308,7 @@ RrcPoint iso28580_point(const TyreSize& size, double rrc, const std::string& whe
 namespace rollsim {
 namespace {
 
-std::string num(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.9g", v);
-  return buf;
-}
+std::string num(double v) { return significant(v, 9); }
 
 std::string yaml_quoted(const std::string& s) {
   std::string out = "\"";

@@ -7,6 +7,8 @@
 
 #include "rollsim/common/error.hpp"
 #include "rollsim/tyre/hysteresis_model.hpp"
+#include "rollsim/common/units.hpp"
+#include "rollsim/common/format.hpp"
 
 namespace rollsim {
 namespace {
@@ -51,11 +53,7 @@ LeverSums lever_sums(const Patch& p, int n) {
 }
 
 // Figures in messages: four significant digits say what is wrong without false precision.
-std::string v(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, std::abs(x) >= 1e3 && std::abs(x) < 1e12 ? "%.0f" : "%.4g", x);
-  return buf;
-}
+std::string v(double x) { return std::abs(x) >= 1e3 && std::abs(x) < 1e12 ? fixed(x, 0) : significant(x, 4); }
 
 }  // namespace
 
@@ -81,7 +79,7 @@ void check_operating_point(const TyreState& tyre, double load_n, double speed_mp
     throw ModelDomainError("inflation pressure " + v(tyre.pressure_pa / 1e5) + " bar: must be > 0");
   if (!(load_n > 0.0) || !std::isfinite(load_n)) throw ModelDomainError("normal load " + v(load_n) + " N: must be > 0");
   if (!(speed_mps >= 0.0) || !std::isfinite(speed_mps))
-    throw ModelDomainError("speed " + v(speed_mps * 3.6) + " km/h: must be >= 0");
+    throw ModelDomainError("speed " + v(units::mps_to_kmh(speed_mps)) + " km/h: must be >= 0");
   const auto& c = tyre.constants;
   if (c.elements < 2 || c.elements % 2 != 0)
     throw ModelDomainError("element count " + std::to_string(c.elements) + ": must be an even number >= 2");

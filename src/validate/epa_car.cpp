@@ -183,7 +183,7 @@ SkipReason check_car_fields(const EpaTestRow& r, std::string& detail) {
     return absurd(detail, "target C [N s^2/m^2]", *r.road_c_n_s2_per_m2, "0-4");
   for (double v_mps : {2.0, 10.0, 20.0, 30.0, 40.0}) {
     const double f_n = *r.road_a_n + v_mps * (*r.road_b_n_s_per_m + v_mps * *r.road_c_n_s2_per_m2);
-    if (f_n <= 0.0 || f_n > 5000.0) return absurd(detail, "target road load at " + format_value(v_mps * 3.6) + " km/h [N]", f_n, "0-5000 N");
+    if (f_n <= 0.0 || f_n > 5000.0) return absurd(detail, "target road load at " + format_value(units::mps_to_kmh(v_mps)) + " km/h [N]", f_n, "0-5000 N");
   }
   if (!r.rated_power_w) return missing(detail, "Rated Horsepower");
   if (*r.rated_power_w < 30e3 || *r.rated_power_w > 1.5e6) return absurd(detail, "rated power [W]", *r.rated_power_w, "30-1500 kW");

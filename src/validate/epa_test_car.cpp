@@ -14,9 +14,9 @@ namespace rollsim::validate {
 namespace {
 
 constexpr double kKgPerLb = 0.45359237;
-constexpr double kNPerLbf = 4.4482216152605;
+using units::kNPerLbf;
 constexpr double kWPerHp = 745.69987158;  // mechanical horsepower
-constexpr double kMpsPerMph = units::kMPerMile / 3600.0;
+using units::kMpsPerMph;
 
 std::string lower(std::string s) {
   std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });

@@ -48,15 +48,14 @@ CoastdownParams read_coastdown(YamlMap m) {
   CoastdownParams c;
   const bool us = m.has("a_lbf") || m.has("b_lbf_per_mph") || m.has("c_lbf_per_mph2");
   if (us) {
-    constexpr double kNPerLbf = 4.4482216152605;
-    constexpr double kMpsPerMph = units::kMPerMile / 3600.0;
+    using units::kNPerLbf, units::kMpsPerMph;
     c.a_n = m.number("a_lbf", Range::closed(0.0, 1e4)) * kNPerLbf;
     c.b_n_s_per_m = m.number("b_lbf_per_mph", Range::closed(-50.0, 50.0)) * kNPerLbf / kMpsPerMph;
     c.c_n_s2_per_m2 = m.number("c_lbf_per_mph2", Range::closed(0.0, 10.0)) * kNPerLbf / (kMpsPerMph * kMpsPerMph);
   } else {
     c.a_n = m.number("a_n", Range::closed(0.0, 5e4));
-    c.b_n_s_per_m = m.number("b_n_per_kmh", Range::closed(-50.0, 50.0)) * 3.6;
-    c.c_n_s2_per_m2 = m.number("c_n_per_kmh2", Range::closed(0.0, 1.0)) * 3.6 * 3.6;
+    c.b_n_s_per_m = m.number("b_n_per_kmh", Range::closed(-50.0, 50.0)) / units::kMpsPerKmh;
+    c.c_n_s2_per_m2 = m.number("c_n_per_kmh2", Range::closed(0.0, 1.0)) / (units::kMpsPerKmh * units::kMpsPerKmh);
   }
   m.finish();
   return c;
@@ -95,7 +94,7 @@ ElectricPowertrainParams read_electric(YamlMap& pt) {
     p.regen.max_power_w = m.number("max_power_kw", Range::closed(0.0, 5000.0)) * 1e3;
     p.regen.driven_axle_brake_fraction = m.number("driven_axle_brake_fraction", Range::fraction());
     p.regen.min_speed_mps = units::kmh_to_mps(m.number_or("min_speed_kmh", 0.0, Range::closed(0.0, 100.0)));
-    p.regen.fade_speed_mps = units::kmh_to_mps(m.number_or("fade_speed_kmh", p.regen.min_speed_mps * 3.6, Range::closed(0.0, 200.0)));
+    p.regen.fade_speed_mps = units::kmh_to_mps(m.number_or("fade_speed_kmh", units::mps_to_kmh(p.regen.min_speed_mps), Range::closed(0.0, 200.0)));
     if (p.regen.fade_speed_mps < p.regen.min_speed_mps)
       throw InputError(m.where("fade_speed_kmh"), "must be >= min_speed_kmh");
     m.finish();
@@ -196,13 +195,7 @@ Vehicle load_vehicle_file(const std::string& path) {
     throw InputError(pt.where("type"), "'" + type + "' is not allowed: must be electric or combustion");
   }
   pt.finish();
-  if (auto eff = root.optional_map("effects")) {
-    EffectContext ctx;
-    ctx.mass_kg = v.body.test_mass_kg;
-    ctx.rho_cda_kg_per_m = v.coastdown ? 2.0 * v.coastdown->c_n_s2_per_m2
-                                       : v.body.air_density_kg_per_m3 * v.body.drag_coefficient * v.body.frontal_area_m2;
-    v.effects = load_effects(*eff, ctx);
-  }
+  if (auto eff = root.optional_map("effects")) v.effects = load_effects(*eff);
   // A vehicle may name its logger's columns; the recording module reads these blocks (rollsim diagnose).
   root.accept("recording_columns");
   root.accept("recording_scale");
@@ -230,6 +223,16 @@ std::vector<std::string> check_tyre_loads(const Vehicle& vehicle, const std::str
     }
   }
   return warnings;
+}
+
+EffectContext effect_context(const Vehicle& vehicle) {
+  const BodyParams& b = vehicle.body;
+  EffectContext ctx;
+  ctx.mass_kg = b.test_mass_kg;
+  // A coast-down C is half of rho CdA (F = C v^2 = rho CdA v^2 / 2).
+  ctx.rho_cda_kg_per_m = vehicle.coastdown ? 2.0 * vehicle.coastdown->c_n_s2_per_m2
+                                           : b.air_density_kg_per_m3 * b.drag_coefficient * b.frontal_area_m2;
+  return ctx;
 }
 
 void fit_tyres(Vehicle& vehicle, const TyreSpec& tyre) {

@@ -1,4 +1,4 @@
-// Numbers as text: the two forms every report, table and error message uses.
+// Numbers as text: the forms every report, table and error message uses.
 #pragma once
 
 #include <string>
@@ -11,5 +11,9 @@ std::string format_value(double value);
 
 /// Fixed-point text of `value` with `decimals` digits after the point, for tables ("NaN"/"inf" for non-finite values).
 std::string fixed(double value, int decimals);
+
+/// `value` to `digits` significant digits ("%g" style: 0.000123, 1.23e+06), for figures whose magnitude varies
+/// (fitted parameters, message values); "NaN"/"inf" for non-finite values.
+std::string significant(double value, int digits);
 
 }  // namespace rollsim

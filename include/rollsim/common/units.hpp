@@ -13,6 +13,10 @@ inline constexpr double kMPerKm = 1000.0;
 inline constexpr double kM3PerLitre = 1.0e-3;
 inline constexpr double kKelvinOffset = 273.15;
 inline constexpr double kMPerMile = 1609.344;
+inline constexpr double kSPerHour = 3600.0;
+inline constexpr double kM3PerCm3 = 1.0e-6;
+inline constexpr double kMpsPerMph = kMPerMile / kSPerHour;
+inline constexpr double kNPerLbf = 4.4482216152605;
 
 constexpr double kmh_to_mps(double speed_kmh) { return speed_kmh * kMpsPerKmh; }
 constexpr double mps_to_kmh(double speed_mps) { return speed_mps / kMpsPerKmh; }

@@ -6,7 +6,7 @@
 #include <random>
 #include <vector>
 
-#include "rollsim/sim/effect.hpp"
+#include "rollsim/effects/effect.hpp"
 
 namespace rollsim {
 

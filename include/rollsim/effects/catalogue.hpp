@@ -1,4 +1,4 @@
-// Catalogue of physical effects beyond the base model (tyre warm-up, auxiliary load, wind, ...), each a sim Effect.
+// Catalogue of physical effects beyond the base model (tyre warm-up, auxiliary load, wind, ...), each an Effect.
 #pragma once
 
 #include <functional>
@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "rollsim/common/yaml_reader.hpp"
-#include "rollsim/sim/effect.hpp"
+#include "rollsim/effects/effect.hpp"
 
 namespace rollsim {
 
@@ -69,14 +69,27 @@ const EffectInfo& effect_info(EffectId id);
 const EffectInfo& effect_info(const std::string& name);  ///< throws InputError for an unknown name
 const std::string& to_string(EffectId id);
 
-/// Builds one effect; missing parameters take their neutral (or default) value; throws InputError on an unknown
-/// id or parameter, or a value out of bounds.
+/// An effect as a vehicle description states it: which one and its parameters, checked against the registry's
+/// bounds. The model (an Effect) is built from it only when a simulation is assembled, against that car's context,
+/// so a description can be copied, changed and written back without holding simulator objects.
+struct EffectSpec {
+  EffectId id{};
+  EffectParameters parameters;  ///< complete: every registry parameter, defaults filled in
+};
+
+/// Checks `given` against the registry row of `id` and fills in the neutral (or default) value of each missing
+/// parameter; throws InputError on an unknown parameter or a value out of bounds.
+EffectSpec effect_spec(EffectId id, const EffectParameters& given);
+
+/// Builds one effect model from a spec, for the car described by `context`.
+std::shared_ptr<const Effect> make_effect(const EffectSpec& spec, const EffectContext& context);
+/// Same, checking the parameters first (effect_spec).
 std::shared_ptr<const Effect> make_effect(EffectId id, const EffectParameters& params, const EffectContext& context);
 std::shared_ptr<const Effect> make_effect(const std::string& name, const EffectParameters& params,
                                           const EffectContext& context);
 
 /// Reads a vehicle file's `effects:` block ({id: {param: value}}), strictly.
-std::vector<std::shared_ptr<const Effect>> load_effects(YamlMap effects, const EffectContext& context);
+std::vector<EffectSpec> load_effects(YamlMap effects);
 
 /// The `effects:` block text (YAML, two-space indented under `effects:`) for these effects.
 std::string effects_yaml(const std::vector<std::pair<std::string, EffectParameters>>& effects);

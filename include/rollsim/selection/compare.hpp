@@ -7,6 +7,7 @@
 #include "rollsim/cycle/drive_cycle.hpp"
 #include "rollsim/tyre/tyre_spec.hpp"
 #include "rollsim/vehicle/vehicle.hpp"
+#include "rollsim/common/units.hpp"
 
 namespace rollsim::selection {
 
@@ -57,7 +58,7 @@ struct Comparison {
 
 struct CompareOptions {
   double diameter_tolerance_pct = 3.0;
-  double reference_speed_mps = 80.0 / 3.6;
+  double reference_speed_mps = units::kmh_to_mps(80.0);
 };
 
 /// Runs the car (forward simulation) with its own tyre and with each candidate on all four wheels.

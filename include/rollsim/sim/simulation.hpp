@@ -8,10 +8,11 @@
 
 #include "rollsim/cycle/drive_cycle.hpp"
 #include "rollsim/powertrain/powertrain.hpp"
-#include "rollsim/sim/effect.hpp"
+#include "rollsim/effects/effect.hpp"
 #include "rollsim/sim/ode_integrator.hpp"
 #include "rollsim/vehicle/road_load.hpp"
 #include "rollsim/vehicle/vehicle.hpp"
+#include "rollsim/common/units.hpp"
 
 namespace rollsim {
 
@@ -46,7 +47,7 @@ struct SimulationOptions {
   bool record_trace = false;           ///< one row per cycle sample
   /// A shortfall is reported where the car falls behind the trace by more than this (the regulation's
   /// speed tolerance is 2 km/h).
-  double shortfall_threshold_mps = 2.0 / 3.6;
+  double shortfall_threshold_mps = units::kmh_to_mps(2.0);
 };
 
 /// Energies over a run [J]. At the wheel hubs: traction + unmet demand = rolling + aero + grade + other +

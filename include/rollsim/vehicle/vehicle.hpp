@@ -9,7 +9,7 @@
 
 #include "rollsim/powertrain/combustion.hpp"
 #include "rollsim/powertrain/electric.hpp"
-#include "rollsim/sim/effect.hpp"
+#include "rollsim/effects/catalogue.hpp"
 #include "rollsim/tyre/tyre_spec.hpp"
 #include "rollsim/vehicle/road_load.hpp"
 
@@ -45,13 +45,16 @@ struct Vehicle {
   std::optional<TyreSpec> rear_tyre;
   std::optional<CoastdownParams> coastdown;  ///< when set, it is the road load; tyres only gear the car
   PowertrainParams powertrain;
-  std::vector<std::shared_ptr<const Effect>> effects;  ///< the file's `effects:` block (effects/catalogue.hpp)
+  std::vector<EffectSpec> effects;  ///< the file's `effects:` block; models are built by the simulation's assembly
 
   bool is_electric() const { return std::holds_alternative<ElectricPowertrainParams>(powertrain); }
 };
 
 /// Loads a vehicle file; tyre files named in it are found beside it or in the shipped tyres/.
 Vehicle load_vehicle_file(const std::string& path);
+
+/// What the effect models need to know of this car (its test mass and air density x drag area).
+EffectContext effect_context(const Vehicle& vehicle);
 
 /// Replaces the tyres of all four wheels (the `--tyre` option).
 void fit_tyres(Vehicle& vehicle, const TyreSpec& tyre);
