@@ -265,7 +265,7 @@ std::vector<Finding> select_effects(const SelectionContext& sc, const std::vecto
       f = catalogue_finding(sc, c, best, prof, m.inflate);
       add_confounders(f, c, cands, passing, m, sc.opt.collinear_corr);
     }
-    set_heldout_metrics(f, m, best.score.heldout);
+    set_finding_metrics(f, m, c.signature, best.score);
     m = extended(m, c.signature, best.score);
     chosen.push_back(c.id);
     out.push_back(std::move(f));

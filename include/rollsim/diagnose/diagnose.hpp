@@ -1,6 +1,8 @@
 // Diagnosis of a recording against the model: locate the mismatch, name the missing catalogue effect, fit it.
 #pragma once
 
+#include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -92,6 +94,12 @@ struct ProfileInterval {
 ProfileInterval profile_likelihood_interval(const std::vector<double>& grid, const std::vector<double>& rss, double n_eff,
                                             double critical = 3.84);
 
+/// A road profile recovered from the residual (road_profile findings): elevation along the distance driven, relative
+/// to the start, at the profile's knots, with its 95 % band (it widens along the trip: an elevation is a sum of grades).
+struct RecoveredProfile {
+  std::vector<double> distance_m, elevation_m, elevation_ci_low_m, elevation_ci_high_m;
+};
+
 struct Finding {
   std::string effect;  ///< catalogue identifier, or "unexplained" (described by its signature)
   std::string description;  ///< in words, with the fitted numbers (unexplained findings)
@@ -100,11 +108,15 @@ struct Finding {
   std::vector<ParameterEstimate> parameters;
   std::vector<std::string> confounded_with;
   double delta_bic = 0.0;
+  /// The fitted effect's energy over all windows (in-sample) as a share of the measured energy; negative when the
+  /// effect returns energy. Not a number for a finding that is no fitted effect (a residual left above the noise).
+  double energy_share_pct = std::numeric_limits<double>::quiet_NaN();
   double heldout_rmse_before_j = 0.0, heldout_rmse_after_j = 0.0;  ///< per window
   double heldout_energy_error_pct_before = 0.0, heldout_energy_error_pct_after = 0.0;
   /// Whiteness of the held-out window residual: its lag-1 autocorrelation (0 for white noise), before and after.
   double heldout_lag1_autocorrelation_before = 0.0, heldout_lag1_autocorrelation_after = 0.0;
   EffectParameters fitted;  ///< for --write-vehicle
+  std::optional<RecoveredProfile> road_profile;  ///< road_profile findings: the profile itself
 };
 
 struct RegimeResidual {
