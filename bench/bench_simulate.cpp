@@ -3,7 +3,10 @@
 
 #include <string>
 
+#include "rollsim/common/yaml_reader.hpp"
+#include "rollsim/report/simulation_report.hpp"
 #include "rollsim/sim/simulation.hpp"
+#include "rollsim/sim/vehicle_run.hpp"
 
 namespace {
 
@@ -43,5 +46,17 @@ BENCHMARK_CAPTURE(BM_SimulateReplay, NedcEv, "ev.yaml", "nedc")->Unit(benchmark:
 // The replay reuses a repeated segment's integrals, and NEDC repeats its urban cycle four times: WLTC, which
 // repeats nothing, shows the cost per evaluated segment (1800 s).
 BENCHMARK_CAPTURE(BM_SimulateReplay, WltcEv, "ev.yaml", "wltc")->Unit(benchmark::kMicrosecond);
+
+// One `rollsim simulate --json` run as the CLI and the Python API do it: load the vehicle and the cycle, assemble,
+// simulate, write the summary. The Python call's overhead is judged against this (python/bench_python.py).
+void BM_RunVehicleFiles(benchmark::State& state, const std::string& vehicle, const std::string& cycle_name) {
+  for (auto _ : state) {
+    const auto v = rollsim::load_vehicle_file(rollsim::resolve_data_file(vehicle, "vehicles", ".yaml", "--vehicle"));
+    const auto cycle = rollsim::load_cycle(cycle_name);
+    auto run = rollsim::run_vehicle(v, std::nullopt, cycle, false, {});
+    benchmark::DoNotOptimize(rollsim::report::to_json(run.result, run.tyre_label).str());
+  }
+}
+BENCHMARK_CAPTURE(BM_RunVehicleFiles, NedcEv, "ev", "nedc")->Unit(benchmark::kMillisecond);
 
 }  // namespace

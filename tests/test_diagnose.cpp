@@ -299,3 +299,45 @@ TEST(DiagnoseLimits, BatteryResistanceIsVisibleOnStateOfCharge) {
   }
   EXPECT_TRUE(seen);
 }
+
+namespace rollsim {
+namespace {
+
+// A regen cap of 4 kW (the truth: the powertrain's own regen limit lowered) leaves braking energy unrecovered from a
+// lower braking power than the catalogue's default 10 kW limit. With that one limit the fit needed a friction share
+// above 1 (out of bounds), so a force-squared tyre slip was named instead; the limit is a shape grid now, profiled.
+TEST(DiagnoseLimits, NamesALowRegenCapAsARegenLimit) {
+  const Vehicle v = ev();
+  // Seed 25090's profile reaches limits above every braking power of its trace, where the signature is zero.
+  for (unsigned seed : {1u, 2u, 25090u}) {
+    SyntheticCase c;
+    c.effects = {{"regen_cap", 4000.0}};
+    c.seed = seed;
+    const Diagnosis d = diagnose(v, {generate_case(v, c)});
+    ASSERT_FALSE(d.findings.empty());
+    const Finding& f = d.findings.front();
+    EXPECT_EQ(f.effect, "regen_limit") << "seed " << seed;
+    EXPECT_TRUE(f.confounded_with.empty()) << "seed " << seed;
+    // The residual left after it is at the noise (it was 2.3-2.9 times the floor after tyre slip).
+    EXPECT_LT(d.final_residual_to_noise_ratio, 1.5) << "seed " << seed;
+  }
+}
+
+// An engine warming in minutes (the truth's oil and coolant nodes, fuel channel, 10 % cold excess) is a start-decaying
+// excess like a fast tyre warm-up. With one slow engine shape against three tyre shapes, the tyre's 20 kJ/K shape won
+// with a cold RRC excess of 50-60 %; with a grid of engine shapes the engine is named (or confounded with the tyre).
+TEST(DiagnoseLimits, EngineWarmingInMinutesIsNotNamedATyreWarmup) {
+  const Vehicle ice = load_vehicle_file(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/ice.yaml");
+  for (unsigned seed : {1u, 3u, 4u}) {
+    SyntheticCase c;
+    c.channel = SyntheticChannel::fuel_rate;
+    c.effects = {{"engine_oil_coolant", 0.1}};
+    c.seed = seed;
+    const Diagnosis d = diagnose(ice, {generate_case(ice, c)});
+    ASSERT_FALSE(d.findings.empty());
+    EXPECT_EQ(d.findings.front().effect, "engine_warmup") << "seed " << seed;
+  }
+}
+
+}  // namespace
+}  // namespace rollsim

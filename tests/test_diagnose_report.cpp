@@ -46,8 +46,9 @@ DriveCycle repeated(const std::string& name, int repeats, double dt_s) {
 // replay's segment mean). A 1 Hz sampler of the instantaneous power at the interval's start reads P(v0) with the
 // interval's acceleration, which on this piecewise-linear trace differs from the interval's mean by more than the
 // noise floor (5.7 x on WLTC x 2 with 300 W noise): the diagnosis compares interval energies.
+// `injected_pct`, when given, receives the added force's battery energy as a share of the recorded energy.
 Recording with_concealed_speed_force(const Vehicle& v, const DriveCycle& c, double n_at_100kmh, double noise_w, unsigned seed,
-                                     double decay_s = 1200.0) {
+                                     double decay_s = 1200.0, double* injected_pct = nullptr) {
   SimulationOptions so;
   so.record_trace = true;
   const SimulationResult s = simulate_replay(VehicleModel::assemble(v), c, so);
@@ -58,11 +59,18 @@ Recording with_concealed_speed_force(const Vehicle& v, const DriveCycle& c, doub
   std::mt19937 rng(seed);
   std::normal_distribution<double> noise(0.0, noise_w);
   std::vector<double> p(c.time_s.size());
+  double added_j = 0.0, total_j = 0.0;
   for (std::size_t i = 0; i < p.size(); ++i) {
     const double speed = c.speed_mps[i];
     const double force = n_at_100kmh * speed / (100.0 / 3.6) * std::exp(-(c.time_s[i] - c.time_s.front()) / decay_s);
     p[i] = s.trace[i].segment_battery_power_w + force * speed / 0.85 + noise(rng);
+    if (i + 1 < p.size()) {
+      const double dt = c.time_s[i + 1] - c.time_s[i];
+      added_j += force * speed / 0.85 * dt;
+      total_j += p[i] * dt;
+    }
   }
+  if (injected_pct) *injected_pct = 100.0 * added_j / total_j;
   r.battery_power_w = p;
   return r;
 }
@@ -101,6 +109,20 @@ TEST(DiagnoseUnexplained, ConcealedForceProportionalToSpeedIsDescribedBySignatur
   EXPECT_NO_THROW(load_vehicle_file(out));
 }
 
+TEST(DiagnoseUnexplained, EnergyShareIsTheConcealedForcesShareOfTheRecordedEnergy) {
+  const Vehicle v = load_vehicle_file(src("vehicles/ev.yaml"));
+  double injected_pct = 0.0;
+  const Diagnosis d = diagnose(v, {with_concealed_speed_force(v, repeated("wltc", 2, 1.0), 300.0, 300.0, 7, 1200.0, &injected_pct)});
+  // Every fitted finding's share together carries the injected energy (the calibration may take a little of it:
+  // a speed-proportional force looks partly like a higher RRC level).
+  double found_pct = 0.0;
+  for (const auto& f : d.findings)
+    if (!std::isnan(f.energy_share_pct)) found_pct += f.energy_share_pct;
+  EXPECT_GT(injected_pct, 1.0);
+  EXPECT_NEAR(found_pct, injected_pct, 0.3 * injected_pct) << "injected " << injected_pct << " %\n" << diagnosis_text(d);
+  EXPECT_NE(diagnosis_json(d).find("\"energy_share_pct\": "), std::string::npos);
+}
+
 TEST(DiagnoseUnexplained, NoUnexplainedFindingWithoutAConcealedForce) {
   const Vehicle v = load_vehicle_file(src("vehicles/ev.yaml"));
   const DriveCycle c = repeated("wltc", 2, 1.0);
@@ -111,6 +133,20 @@ TEST(DiagnoseUnexplained, NoUnexplainedFindingWithoutAConcealedForce) {
 
 bool have_gnuplot() { return std::system("command -v gnuplot > /dev/null 2>&1") == 0; }
 
+// Text as the page must show it: the five HTML-special characters as entities.
+std::string html_escape_for_test(const std::string& t) {
+  std::string o;
+  for (char c : t) o += c == '&' ? "&amp;" : c == '<' ? "&lt;" : c == '>' ? "&gt;" : c == '"' ? "&quot;" : c == '\'' ? "&#39;" : std::string(1, c);
+  return o;
+}
+
+std::string read_text(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
 TEST(DiagnoseReport, WritesFiguresAndAnHtmlPageEmbeddingThem) {
   if (!have_gnuplot()) GTEST_SKIP() << "gnuplot not installed";
   const Vehicle v = load_vehicle_file(src("vehicles/ev.yaml"));
@@ -118,7 +154,8 @@ TEST(DiagnoseReport, WritesFiguresAndAnHtmlPageEmbeddingThem) {
   const std::string dir = ::testing::TempDir() + "/diag_report_test/sub";
   fs::remove_all(dir);
   const auto files = write_diagnosis_report(dir, d, "test");
-  const std::vector<std::string> svgs{"energy.svg", "cumulative.svg", "residual_speed.svg", "residual_accel.svg", "residual_time.svg"};
+  const std::vector<std::string> svgs{"regimes.svg", "energy.svg", "cumulative.svg", "residual_speed.svg", "residual_accel.svg",
+                                      "residual_time.svg"};
   for (const auto& s : svgs) {
     ASSERT_TRUE(fs::exists(fs::path(dir) / s)) << s;
     std::ifstream in(fs::path(dir) / s);
@@ -135,10 +172,90 @@ TEST(DiagnoseReport, WritesFiguresAndAnHtmlPageEmbeddingThem) {
   EXPECT_EQ(count, svgs.size());  // self-contained: every figure inline
   EXPECT_EQ(html.find("<?xml"), std::string::npos);
   EXPECT_EQ(html.find("src=\""), std::string::npos);  // nothing loaded from elsewhere
-  EXPECT_NE(html.find("verdict"), std::string::npos);
+  EXPECT_EQ(html.find("<link"), std::string::npos);
+  EXPECT_NE(html.find(html_escape_for_test(diagnosis_headline(d))), std::string::npos);
+  // The raw text only inside the folded section, after every figure and table.
+  const auto details = html.find("<details");
+  ASSERT_NE(details, std::string::npos);
+  EXPECT_GT(html.find("<pre>"), details);
+  EXPECT_GT(details, html.rfind("<svg"));
+  EXPECT_GT(details, html.rfind("<table"));
+  // No road profile figure without a road_profile finding.
+  EXPECT_EQ(html.find("id=\"road\""), std::string::npos);
   EXPECT_EQ(files.size(), svgs.size() + 1);
   // No temporary left beside the outputs.
   for (const auto& e : fs::directory_iterator(dir)) EXPECT_EQ(e.path().filename().string().rfind(".", 0), std::string::npos) << e.path();
+}
+
+TEST(DiagnoseReport, PageEscapesEveryTextAndDrawsARoadProfileWhereAFindingHasOne) {
+  if (!have_gnuplot()) GTEST_SKIP() << "gnuplot not installed";
+  const Vehicle v = load_vehicle_file(src("vehicles/ev.yaml"));
+  Diagnosis d = diagnose(v, {with_concealed_speed_force(v, repeated("wltc", 1, 1.0), 0.0, 300.0, 2)});
+  // Text that is markup in HTML and syntax (or an enhanced-text subscript) in gnuplot, in a title, a regime, a note.
+  const std::string hostile = "<script>alert('x')</script> fuel_rate & \"q\" > 1 %";
+  d.located.push_back({hostile, 10, -5.0, -20.0, 10.0});
+  d.notes.push_back(hostile);
+  Finding road;
+  road.effect = "road_profile";
+  road.energy_share_pct = 1.5;
+  road.road_profile.emplace();
+  for (int i = 0; i <= 50; ++i) {
+    const double z = 20.0 * std::sin(i / 8.0);
+    road.road_profile->distance_m.push_back(100.0 * i);
+    road.road_profile->elevation_m.push_back(z);
+    road.road_profile->elevation_ci_low_m.push_back(z - 0.1 * i);
+    road.road_profile->elevation_ci_high_m.push_back(z + 0.1 * i);
+  }
+  d.findings.push_back(road);
+  const std::string dir = ::testing::TempDir() + "/diag_report_escape";
+  fs::remove_all(dir);
+  write_diagnosis_report(dir, d, hostile);
+  const std::string html = read_text(fs::path(dir) / "report.html");
+  EXPECT_EQ(html.find("<script"), std::string::npos);
+  EXPECT_NE(html.find("<title>&lt;script&gt;alert(&#39;x&#39;)&lt;/script&gt; fuel_rate &amp; &quot;q&quot; &gt; 1 %</title>"), std::string::npos);
+  // gnuplot drew the regime's name as written (enhanced text off: no subscript), escaped in its SVG.
+  const std::string regimes = read_text(fs::path(dir) / "regimes.svg");
+  EXPECT_NE(regimes.find("&lt;script>alert"), std::string::npos);  // gnuplot escapes & and <, which is enough in XML
+  EXPECT_NE(regimes.find("fuel_rate &amp; \"q\" > 1 % (10)"), std::string::npos);
+  // The road profile: its own section and figure, and its SVG file.
+  EXPECT_NE(html.find("id=\"road\""), std::string::npos);
+  EXPECT_NE(html.find("id=\"road_profile\""), std::string::npos);
+  EXPECT_TRUE(fs::exists(fs::path(dir) / "road_profile.svg"));
+  // Inline SVGs keep their own ids: gnuplot's gpPt0 appears once per figure, prefixed.
+  EXPECT_EQ(html.find("id='gpPt0'"), std::string::npos);
+  EXPECT_NE(html.find("id='road_profile-gpPt0'"), std::string::npos);
+}
+
+TEST(DiagnoseReport, HeadlineStatesVerdictFindingShareAndHeldOutChange) {
+  Diagnosis d;
+  d.verdict = "confounded";
+  d.heldout_rmse_calibrated_j = 10e3;
+  d.heldout_energy_error_pct_calibrated = 4.0;
+  Finding f;
+  f.effect = "tyre_warmup";
+  f.parameters.push_back({"cold_excess", "1", 0.2, 0.1, 0.3});
+  f.energy_share_pct = 3.04;
+  f.heldout_rmse_before_j = 10e3, f.heldout_rmse_after_j = 7.5e3;
+  f.heldout_energy_error_pct_before = 4.0, f.heldout_energy_error_pct_after = 1.0;
+  f.confounded_with = {"aux_load"};
+  d.findings.push_back(f);
+  const std::string h = diagnosis_headline(d);
+  EXPECT_EQ(h.rfind("Confounded: ", 0), 0u) << h;
+  EXPECT_NE(h.find("tyre_warmup (cold_excess = 0.200 [0.100, 0.300])"), std::string::npos) << h;
+  EXPECT_NE(h.find("3.0 % of the measured energy"), std::string::npos) << h;
+  EXPECT_NE(h.find("cannot tell from aux_load"), std::string::npos) << h;
+  // 10 kJ to 7.5 kJ is 25 % lower.
+  EXPECT_NE(h.find("falls from 10.0 to 7.50 kJ (25 % lower)"), std::string::npos) << h;
+  EXPECT_NE(h.find("from 4.00 % to 1.00 %"), std::string::npos) << h;
+
+  Diagnosis none;
+  none.verdict = "nothing_missing";
+  none.final_residual_to_noise_ratio = 1.2;
+  none.heldout_rmse_calibrated_j = 2e3;
+  const std::string n = diagnosis_headline(none);
+  EXPECT_EQ(n.rfind("Nothing missing: ", 0), 0u) << n;
+  EXPECT_NE(n.find("1.2 x the recording's noise floor"), std::string::npos) << n;
+  EXPECT_NE(n.find("stays at 2.00 kJ per window"), std::string::npos) << n;
 }
 
 TEST(DiagnoseReport, UnwritableDirectoryIsAnInputError) {

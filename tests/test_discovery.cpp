@@ -161,6 +161,11 @@ TEST(Scorecard, SignedAndReversedRowsCountNegativeSizesAsMistakes) {
   EXPECT_EQ(score_findings({"null", {}, 0, ""}, {{"unexplained", {}, 1.0}}), Tally::mistaken);
   EXPECT_EQ(score_findings({"two", {"tyre_warmup", "aux_load"}, 0, ""}, {{"aux_load", {}, 500.0}, {"tyre_warmup", {}, 0.2}}),
             Tally::named);
+  // Two at once: an unexplained finding alone is missed (the table's rule for every effect row), not a wrong name.
+  const RowRule two{"two", {"wind", "mass"}, 0, ""};
+  EXPECT_EQ(score_findings(two, {{"unexplained", {}, 1.0}}), Tally::missed);
+  EXPECT_EQ(score_findings(two, {{"unexplained", {}, 1.0}, {"wind", {}, 3.0}}), Tally::confounded);
+  EXPECT_EQ(score_findings(two, {{"aux_load", {}, 300.0}}), Tally::mistaken);
 }
 
 }  // namespace

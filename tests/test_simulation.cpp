@@ -104,6 +104,22 @@ TEST(Simulation, StandstillCostsOnlyAuxiliaries) {
   EXPECT_EQ(r.energy.rolling_j, 0.0);
 }
 
+// On a slope too, forward and replay: the car stands on its brakes. The replay held it with the powertrain, which
+// drew the machine's constant loss (800 W on ev.yaml) at every uphill stop: a withheld climb then looked, at the
+// stops, like an auxiliary load to the diagnosis (which replays its truths and its model alike).
+TEST(Simulation, StandstillOnASlopeCostsOnlyAuxiliaries) {
+  const auto m = model_of("vehicles/ev.yaml");
+  const double aux_w = std::get<ElectricPowertrainParams>(load_vehicle_file(shipped("vehicles/ev.yaml")).powertrain).aux_power_w;
+  for (double grade : {0.05, -0.05}) {
+    DriveCycle c = constant_speed_cycle(0.0, 300.0);
+    c.grade.assign(c.time_s.size(), grade);
+    for (const auto& r : {simulate_forward(m, c), simulate_replay(m, c)}) {
+      EXPECT_NEAR(r.energy.battery_terminal_j, aux_w * 300.0, 1e-6 * aux_w * 300.0) << r.mode << " grade " << grade;
+      EXPECT_EQ(r.energy.friction_brake_j, 0.0) << r.mode;
+    }
+  }
+}
+
 // Published trend: a higher pressure lowers RRC and so the car's energy; the rolling share moves most.
 TEST(Simulation, HigherTyrePressureLowersEnergy) {
   Vehicle v = load_vehicle_file(shipped("vehicles/ev.yaml"));

@@ -11,6 +11,7 @@
 #include "rollsim/report/table.hpp"
 #include "rollsim/selection/common.hpp"
 #include "rollsim/selection/compare.hpp"
+#include "rollsim/selection/front_end.hpp"
 #include "selection_cli.hpp"
 
 namespace rollsim::cli {
@@ -23,12 +24,6 @@ struct CompareOptionsText {
   std::string diameter_tolerance_pct = "3";
   bool json = false, csv = false;
 };
-
-std::string size_text(const TyreSpec& t) {
-  if (t.size) return t.size->designation;
-  return "R" + fixed(t.state.geometry.outer_radius_m * 1e3, 0) + " W" +
-         fixed(t.state.geometry.section_width_m * 1e3, 0);
-}
 
 std::string signed_fixed(double v, int d) { return (v > 0 ? "+" : "") + fixed(v, d); }
 
@@ -45,7 +40,7 @@ void print_table(const selection::Comparison& c) {
   t.set_left_aligned(2);
   t.set_left_aligned(h.size() - 1);
   auto row = [&](const selection::CandidateResult& r, const std::string& rank) {
-    std::vector<std::string> cells{rank, r.tyre.name + (r.is_own ? " (own)" : ""), size_text(r.tyre),
+    std::vector<std::string> cells{rank, r.tyre.name + (r.is_own ? " (own)" : ""), selection::tyre_size_text(r.tyre),
                                    fixed(units::pa_to_bar(r.tyre.state.pressure_pa), 1),
                                    fixed(r.rrc_80 * 1e3, 3), fixed(r.rr_power_80_w, 1),
                                    fixed(r.value, c.shows_range ? 4 : 3),
@@ -67,25 +62,7 @@ void print_table(const selection::Comparison& c) {
 }
 
 void print_json(const selection::Comparison& c) {
-  auto emit = [&](const selection::CandidateResult& r, int rank) {
-    JsonObject j;
-    j.add("vehicle", c.vehicle).add("cycle", c.cycle).add("tyre", r.tyre.name).add("source", r.tyre.source);
-    j.add("size", size_text(r.tyre)).add("own", r.is_own);
-    if (rank > 0) j.add("rank", rank); else j.add_null("rank");
-    j.add("pressure_bar", units::pa_to_bar(r.tyre.state.pressure_pa))
-        .add("wheel_load_n", r.fit.wheel_load_n)
-        .add("capacity_n", r.fit.capacity_n)
-        .add("diameter_change_pct", r.fit.diameter_change_pct)
-        .add("rrc_80kmh", r.rrc_80)
-        .add("rr_power_80kmh_w", r.rr_power_80_w)
-        .add(c.unit, r.value)
-        .add("diff_pct", r.diff_pct);
-    if (c.shows_range) j.add("range_km", r.range_km).add("range_change_km", r.range_change_km);
-    j.add("fits", r.fit.fits).add("reason", r.fit.reason);
-    std::cout << j.str() << "\n";
-  };
-  for (std::size_t i = 0; i < c.ranked.size(); ++i) emit(c.ranked[i], static_cast<int>(i + 1));
-  for (const auto& r : c.unfit) emit(r, 0);
+  for (const auto& j : selection::comparison_json(c)) std::cout << j.str() << "\n";
 }
 
 void print_csv(const selection::Comparison& c, bool header) {
@@ -100,7 +77,7 @@ void print_csv(const selection::Comparison& c, bool header) {
   };
   auto emit = [&](const selection::CandidateResult& r, int rank) {
     std::cout << q(c.vehicle) << "," << c.cycle << "," << (rank > 0 ? std::to_string(rank) : "") << "," << q(r.tyre.name)
-              << "," << q(size_text(r.tyre)) << "," << fixed(units::pa_to_bar(r.tyre.state.pressure_pa), 2)
+              << "," << q(selection::tyre_size_text(r.tyre)) << "," << fixed(units::pa_to_bar(r.tyre.state.pressure_pa), 2)
               << "," << fixed(r.rrc_80, 6) << "," << fixed(r.rr_power_80_w, 2) << ","
               << fixed(r.value, 5) << "," << c.unit << "," << fixed(r.diff_pct, 3) << ","
               << (c.shows_range ? fixed(r.range_km, 2) : "") << ","
@@ -115,33 +92,13 @@ void run_compare(const CompareOptionsText& o) {
   if (o.vehicles.empty()) throw InputError("--vehicle", "missing: give the car, e.g. --vehicle ev");
   if (o.json && o.csv) throw InputError("--csv", "not allowed together with --json");
   selection::CompareOptions copt;
-  copt.diameter_tolerance_pct =
-      parse_option_number(o.diameter_tolerance_pct, "--diameter-tolerance-pct", Range::open_low(0.0, 100.0));
+  copt.diameter_tolerance_pct = selection::parse_diameter_tolerance_pct(o.diameter_tolerance_pct);
 
   // Candidates: --tyre files, then every *.yaml of the catalogue; a broken file is named and skipped.
-  bool broken = false;
-  std::vector<TyreSpec> candidates;
-  for (const auto& t : o.tyres) candidates.push_back(load_tyre_file(resolve_data_file(t, "tyres", ".yaml", "--tyre")));
-  if (o.use_catalogue || o.tyres.empty()) {
-    namespace fs = std::filesystem;
-    const std::string dir = o.catalogue.empty() ? data_root() + "/tyres/catalogue" : o.catalogue;
-    std::error_code ec;
-    if (!fs::is_directory(dir, ec)) throw InputError("--catalogue " + dir, "not a folder");
-    std::vector<std::string> files;
-    for (const auto& e : fs::directory_iterator(dir)) {
-      if (e.path().extension() == ".yaml" || e.path().extension() == ".yml") files.push_back(e.path().string());
-    }
-    std::sort(files.begin(), files.end());
-    if (files.empty()) throw InputError("--catalogue " + dir, "holds no *.yaml tyre files");
-    for (const auto& f : files) {
-      try {
-        candidates.push_back(load_tyre_file(f));
-      } catch (const std::exception& e) {
-        std::cerr << "error: skipped broken catalogue file: " << e.what() << "\n";
-        broken = true;
-      }
-    }
-  }
+  const selection::CandidateList list = selection::load_candidates(o.tyres, o.use_catalogue, o.catalogue);
+  for (const auto& b : list.broken) std::cerr << "error: skipped broken catalogue file: " << b << "\n";
+  const bool broken = !list.broken.empty();
+  const std::vector<TyreSpec>& candidates = list.tyres;
   std::vector<std::string> cycles = o.cycles.empty() ? std::vector<std::string>{"nedc"} : o.cycles;
   bool csv_header = true;
   for (const auto& vname : o.vehicles) {

@@ -34,16 +34,8 @@ void run_diagnose(const DiagnoseCliOptions& o) {
   if (!o.json.empty()) check_output_file(o.json, "--json");
   if (!o.write_vehicle.empty()) check_output_file(o.write_vehicle, "--write-vehicle");
   // Column mapping: a preset, then the vehicle file's own logger mapping, then the command line's options.
-  ColumnMapping mapping;
-  if (!o.preset.empty()) mapping = preset_mapping(o.preset);
-  {
-    YamlMap vehicle_file = YamlMap::load_file(vehicle_path);
-    mapping = merge_mapping(mapping, column_mapping_from_yaml(vehicle_file));
-  }
-  ColumnMapping overrides;
-  for (const auto& c : o.columns) parse_column_option(c, overrides);
-  for (const auto& s : o.scales) parse_scale_option(s, overrides);
-  mapping = merge_mapping(mapping, overrides);
+  YamlMap vehicle_file = YamlMap::load_file(vehicle_path);
+  const ColumnMapping mapping = assemble_mapping(o.preset, vehicle_file, o.columns, o.scales);
   std::vector<Recording> recs;
   for (const auto& r : o.recordings) recs.push_back(load_recording(r, mapping));
   for (const auto& r : recs)

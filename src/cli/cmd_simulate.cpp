@@ -15,6 +15,7 @@
 #include "rollsim/common/yaml_reader.hpp"
 #include "rollsim/report/simulation_report.hpp"
 #include "rollsim/sim/simulation.hpp"
+#include "rollsim/sim/vehicle_run.hpp"
 
 namespace rollsim::cli {
 namespace {
@@ -50,25 +51,12 @@ void run_simulate(const SimulateOptions& o) {
   std::vector<Run> runs;
   for (const auto& cycle : cycles) {
     for (const auto& tyre : tyre_sets) {
-      Vehicle v = base;
-      std::string label = v.front_tyre ? v.front_tyre->name : "coast-down";
-      if (tyre) {
-        fit_tyres(v, *tyre);
-        label = tyre->name;
-      }
+      VehicleRun run = run_vehicle(base, tyre, cycle, o.replay, sim_opt);
       // Once per tyre set (the first cycle): an overloaded tyre is allowed but said.
       if (&cycle == &cycles.front()) {
-        for (const auto& w : check_tyre_loads(v, tyre ? "--tyre '" + tyre->source + "'" : base.source))
-          std::cerr << "warning: " << w << "\n";
+        for (const auto& w : run.warnings) std::cerr << "warning: " << w << "\n";
       }
-      const VehicleModel model = VehicleModel::assemble(v);
-      SimulationResult r;
-      try {
-        r = o.replay ? simulate_replay(model, cycle, sim_opt) : simulate_forward(model, cycle, sim_opt);
-      } catch (const SolverError& e) {
-        throw std::runtime_error(std::string("simulation of '") + v.name + "' on " + cycle.name +
-                                 " failed, no result is reported: " + e.what());
-      }
+      const Vehicle& v = run.vehicle;
       // With coast-down road load, say how much of A the tyres account for (the rest is driveline drag).
       if (v.coastdown && v.front_tyre && !o.json) {
         const double tyre_a_n = tyre_rolling_force_at_standstill_limit_n(v);
@@ -76,7 +64,7 @@ void run_simulate(const SimulateOptions& o) {
                   << fixed(v.coastdown->a_n, 1) << " N (" << fixed(100.0 * tyre_a_n / v.coastdown->a_n, 1)
                   << " %)\n";
       }
-      runs.push_back({label, std::move(r)});
+      runs.push_back({run.tyre_label, std::move(run.result)});
     }
   }
 

@@ -19,6 +19,7 @@
 #include "rollsim/common/units.hpp"
 #include "rollsim/report/table.hpp"
 #include "rollsim/selection/common.hpp"
+#include "rollsim/selection/front_end.hpp"
 #include "rollsim/selection/sweep.hpp"
 #include "selection_cli.hpp"
 
@@ -27,8 +28,8 @@ namespace {
 
 struct SweepOptionsText {
   std::string tyre, vehicle, cycle = "nedc";
-  std::vector<std::string> params, from, to, steps;
-  std::string load_n, speed_kmh = "80", output, plot, threads;
+  selection::SweepRequest request;
+  std::string output, plot;
   bool base100 = false, json = false;
 };
 
@@ -123,32 +124,7 @@ std::string render_plot(const selection::SweepResult& r, const std::string& tyre
 
 void run_sweep(const SweepOptionsText& o) {
   if (o.tyre.empty()) throw InputError("--tyre", "missing: give the tyre to sweep, e.g. --tyre 175-70R14");
-  if (o.params.empty()) throw InputError("--param", "missing: pressure, diameter, width, load, load-pct or speed");
-  if (o.params.size() > 2) throw InputError("--param", "at most two parameters (a grid)");
-  if (o.from.size() != o.params.size() || o.to.size() != o.params.size()) {
-    throw InputError("--from/--to", "give one --from and one --to per --param");
-  }
-  if (o.steps.size() > o.params.size()) throw InputError("--steps", "more --steps than --param");
-  selection::SweepOptions so;
-  for (std::size_t i = 0; i < o.params.size(); ++i) {
-    const auto p = selection::parse_sweep_param(o.params[i]);
-    const std::string opt = "--param " + o.params[i];
-    if (!p) throw InputError(opt, "unknown: must be pressure, diameter, width, load, load-pct or speed");
-    selection::SweepAxis a;
-    a.param = *p;
-    a.from = parse_option_number(o.from[i], "--from", Range{});
-    a.to = parse_option_number(o.to[i], "--to", Range{});
-    if (i < o.steps.size()) {
-      const double n = parse_option_number(o.steps[i], "--steps", Range::closed(-1e9, 1e6));
-      if (n != std::floor(n)) throw InputError("--steps", format_value(n) + " is not allowed: must be a whole number >= 2");
-      a.steps = static_cast<int>(n);
-    }
-    selection::check_axis(a, opt);
-    so.axes.push_back(a);
-  }
-  if (!o.load_n.empty()) so.load_n = parse_option_number(o.load_n, "--load-n", Range::open_low(0.0, 1e6));
-  so.speed_kmh = parse_option_number(o.speed_kmh, "--speed-kmh", Range::closed(0.0, 500.0));
-  if (!o.threads.empty()) so.threads = static_cast<unsigned>(parse_option_number(o.threads, "--threads", Range::closed(1, 1024)));
+  selection::SweepOptions so = selection::sweep_options_from_request(o.request);
   // Every destination is checked before the sweep, and all are written after it (nothing is left behind).
   if (!o.output.empty()) check_output_file(o.output, "--output");
   if (!o.plot.empty()) {
@@ -173,16 +149,7 @@ void run_sweep(const SweepOptionsText& o) {
   std::string table;
   if (o.json) {
     std::ostringstream out;
-    for (const auto& p : r.points) {
-      JsonObject j;
-      for (std::size_t i = 0; i < r.axes.size(); ++i) {
-        j.add(selection::sweep_param_key(r.axes[i].param) + "_" + selection::sweep_param_unit(r.axes[i].param), p.values[i]);
-      }
-      j.add("load_n", p.load_n).add("speed_kmh", p.speed_kmh).add("rrc", p.rr.rrc).add("rr_force_n", p.rr.rr_force_n)
-          .add("rr_power_w", p.rr.rr_power_w);
-      if (r.vehicle) j.add(r.energy_unit, p.energy);
-      out << j.str() << "\n";
-    }
+    for (const auto& j : selection::sweep_json(r)) out << j.str() << "\n";
     table = out.str();
   } else {
     table = selection::sweep_csv(r);
@@ -205,17 +172,17 @@ void register_sweep_command(CLI::App& app) {
   CLI::App* sub = app.add_subcommand(
       "sweep", "Sweep one or two tyre parameters: RRC, force and power, or a car's energy/fuel on a cycle (CSV)");
   sub->add_option("--tyre", o->tyre, "Tyre file or shipped name")->type_name("FILE");
-  sub->add_option("--param", o->params, "pressure (bar), diameter (mm), width (mm), load (N), load-pct or speed (km/h); "
+  sub->add_option("--param", o->request.params, "pressure (bar), diameter (mm), width (mm), load (N), load-pct or speed (km/h); "
                                         "twice for a grid")
       ->type_name("P");
-  sub->add_option("--from", o->from, "First value of the range (one per --param)")->type_name("X");
-  sub->add_option("--to", o->to, "Last value of the range (one per --param)")->type_name("X");
-  sub->add_option("--steps", o->steps, "Points per range including both ends (default 11)")->type_name("N");
-  sub->add_option("--load-n", o->load_n, "Fixed normal load per tyre [N] (default 80 % of maximum load)")->type_name("N");
-  sub->add_option("--speed-kmh", o->speed_kmh, "Fixed speed [km/h] (default 80)")->type_name("KMH");
+  sub->add_option("--from", o->request.from, "First value of the range (one per --param)")->type_name("X");
+  sub->add_option("--to", o->request.to, "Last value of the range (one per --param)")->type_name("X");
+  sub->add_option("--steps", o->request.steps, "Points per range including both ends (default 11)")->type_name("N");
+  sub->add_option("--load-n", o->request.load_n, "Fixed normal load per tyre [N] (default 80 % of maximum load)")->type_name("N");
+  sub->add_option("--speed-kmh", o->request.speed_kmh, "Fixed speed [km/h] (default 80)")->type_name("KMH");
   sub->add_option("--vehicle", o->vehicle, "Run this car with the swept tyre on all four wheels")->type_name("FILE");
   sub->add_option("--cycle", o->cycle, "Drive cycle for --vehicle (default nedc)")->type_name("CYCLE");
-  sub->add_option("--threads", o->threads, "Worker threads for vehicle sweeps (default: every core)")->type_name("N");
+  sub->add_option("--threads", o->request.threads, "Worker threads for vehicle sweeps (default: every core)")->type_name("N");
   sub->add_option("--output", o->output, "Write the CSV here (atomically) instead of stdout")->type_name("FILE.csv");
   sub->add_option("--plot", o->plot, "Draw RRC against the swept parameter with gnuplot")->type_name("FILE.svg|.png");
   sub->add_flag("--base100", o->base100, "Plot RRC as base 100 at the first point of each line");

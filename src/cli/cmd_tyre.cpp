@@ -15,6 +15,7 @@
 #include "rollsim/report/table.hpp"
 #include "rollsim/tyre/explain.hpp"
 #include "rollsim/tyre/tyre_model.hpp"
+#include "rollsim/tyre/tyre_request.hpp"
 #include "rollsim/tyre/tyre_spec.hpp"
 
 namespace rollsim::cli {
@@ -23,95 +24,13 @@ namespace {
 // Options are taken as text and parsed here so that every bad value gets the same kind of message, naming the
 // option, the value and what is allowed (CLI11 would accept "nan" silently for a double).
 struct TyreOptions {
-  std::string file;
-  std::string size;
-  std::string outer_radius_m, width_m, pressure_bar, load_n, load_pct;
+  TyreRequest tyre;
   std::vector<std::string> speeds_kmh;
   bool json = false;
   bool explain = false;
 };
 
 std::string kg_text(double n) { return fixed(n / units::kStandardGravity_mps2, 0) + " kg"; }
-
-// Builds the tyre from a file, a designation, or explicit geometry; --pressure-bar overrides a file's pressure.
-TyreSpec build_tyre(const TyreOptions& o) {
-  TyreSpec spec;
-  const bool has_geometry = !o.outer_radius_m.empty() || !o.width_m.empty();
-  if (!o.file.empty()) {
-    if (!o.size.empty()) throw InputError("--size '" + o.size + "'", "not allowed together with a tyre file");
-    if (has_geometry) {
-      throw InputError(o.outer_radius_m.empty() ? "--width-m" : "--outer-radius-m",
-                       "not allowed together with a tyre file (the file gives the geometry)");
-    }
-    spec = load_tyre_file(resolve_data_file(o.file, "tyres", ".yaml", "tyre file"));
-  } else if (!o.size.empty()) {
-    if (has_geometry) {
-      throw InputError(o.outer_radius_m.empty() ? "--width-m" : "--outer-radius-m",
-                       "not allowed together with --size (the designation gives the geometry)");
-    }
-    spec.size = parse_tyre_size(o.size, "--size");
-    spec.name = o.size;
-    spec.source = "--size '" + o.size + "'";
-    spec.state.geometry.outer_radius_m = spec.size->outer_radius_m;
-    spec.state.geometry.section_width_m = spec.size->section_width_m;
-    spec.state.geometry.rim_radius_m = spec.size->rim_diameter_m / 2.0;
-    if (spec.size->load_index) {
-      spec.max_load_n = *load_index_max_load_kg(*spec.size->load_index) * units::kStandardGravity_mps2;
-    }
-  } else {
-    if (o.outer_radius_m.empty() || o.width_m.empty()) {
-      throw InputError(o.outer_radius_m.empty() ? "--outer-radius-m" : "--width-m",
-                       "missing: give a tyre file (e.g. 'rollsim tyre 175-70R14'), --size \"175/70 R14 84T\", or both "
-                       "--outer-radius-m and --width-m");
-    }
-    spec.name = "R " + o.outer_radius_m + " m, W " + o.width_m + " m";
-    spec.source = "command line";
-    spec.state.geometry.outer_radius_m = parse_option_number(o.outer_radius_m, "--outer-radius-m", Range::open_low(0.0, 1.5));
-    spec.state.geometry.section_width_m = parse_option_number(o.width_m, "--width-m", Range::open_low(0.0, 1.0));
-  }
-  if (!o.pressure_bar.empty()) {
-    spec.state.pressure_pa = units::bar_to_pa(parse_option_number(o.pressure_bar, "--pressure-bar", Range::open_low(0.0, 20.0)));
-  } else if (o.file.empty()) {
-    throw InputError("--pressure-bar", "missing: the inflation pressure in bar is needed (e.g. --pressure-bar 2.1)");
-  }
-  return spec;
-}
-
-struct LoadChoice {
-  double load_n;
-  std::string where;  // the option or rule that set it, for error messages
-};
-
-LoadChoice choose_load(const TyreOptions& o, const TyreSpec& spec) {
-  if (!o.load_n.empty() && !o.load_pct.empty()) {
-    throw InputError("--load-pct", "not allowed together with --load-n: give one of them");
-  }
-  if (!o.load_n.empty()) {
-    return {parse_option_number(o.load_n, "--load-n", Range::open_low(0.0, 1e6)), "--load-n " + o.load_n};
-  }
-  const bool pct_given = !o.load_pct.empty();
-  const double pct = pct_given ? parse_option_number(o.load_pct, "--load-pct", Range::open_low(0.0, 300.0)) : 80.0;
-  if (!(spec.max_load_n > 0.0)) {
-    throw InputError(pct_given ? "--load-pct " + o.load_pct : "--load-n",
-                     pct_given ? "the tyre's maximum load is unknown (no load index): give --load-n N instead"
-                               : "missing: the tyre's maximum load is unknown (no load index), so the default 80 % "
-                                 "of it cannot be used; give --load-n N");
-  }
-  return {pct / 100.0 * spec.max_load_n,
-          pct_given ? "--load-pct " + o.load_pct : "the default load (80 % of the maximum load)"};
-}
-
-// The model's domain errors carry no origin; name the file/options they came from.
-template <typename F>
-auto named(const TyreSpec& spec, const LoadChoice& load, const TyreOptions& o, F&& f) {
-  try {
-    return f();
-  } catch (const ModelDomainError& e) {
-    std::string where = spec.source + " at " + load.where;
-    if (!o.pressure_bar.empty()) where += ", --pressure-bar " + o.pressure_bar;
-    throw InputError(where, e.what());
-  }
-}
 
 std::string describe_tyre(const TyreSpec& spec) {
   const auto& g = spec.state.geometry;
@@ -155,8 +74,8 @@ std::string explanation_text(const TyreExplanation& x) {
 }
 
 void run_tyre(const TyreOptions& o) {
-  const TyreSpec spec = build_tyre(o);
-  const LoadChoice load = choose_load(o, spec);
+  const TyreSpec spec = build_requested_tyre(o.tyre);
+  const TyreLoadChoice load = choose_requested_load(o.tyre, spec);
   if (o.explain && spec.state.model != TyreModelKind::Thesis) {
     throw InputError("--explain", "explains the thesis model's mechanisms; " + spec.source +
                                       " uses the hysteresis model (model: kind: hysteresis)");
@@ -170,7 +89,7 @@ void run_tyre(const TyreOptions& o) {
       const std::size_t comma = given.find(',', start);
       const std::string item = given.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
       if (item.empty()) throw InputError("--speed-kmh '" + given + "'", "an empty value between commas; give e.g. 50,80,120");
-      speeds_kmh.push_back(parse_option_number(item, "--speed-kmh", Range::closed(0.0, 500.0)));
+      speeds_kmh.push_back(parse_requested_speed_kmh(item));
       if (comma == std::string::npos) break;
       start = comma + 1;
     }
@@ -189,8 +108,8 @@ void run_tyre(const TyreOptions& o) {
   std::vector<TyreExplanation> explanations;
   for (const double v_kmh : speeds_kmh) {
     const double v_mps = units::kmh_to_mps(v_kmh);
-    results.push_back(named(spec, load, o, [&] { return evaluate_rolling_resistance(spec.state, load.load_n, v_mps); }));
-    if (o.explain) explanations.push_back(named(spec, load, o, [&] { return explain_tyre(spec.state, load.load_n, v_mps); }));
+    results.push_back(named_tyre_request(o.tyre, spec, load, [&] { return evaluate_rolling_resistance(spec.state, load.load_n, v_mps); }));
+    if (o.explain) explanations.push_back(named_tyre_request(o.tyre, spec, load, [&] { return explain_tyre(spec.state, load.load_n, v_mps); }));
   }
 
   // Warned only once the point is known to be solvable, so a rejected load gets one message, not two.
@@ -204,27 +123,7 @@ void run_tyre(const TyreOptions& o) {
   if (o.json) {
     for (std::size_t i = 0; i < results.size(); ++i) {
       const auto& r = results[i];
-      JsonObject j;
-      j.add("tyre", spec.name).add("source", spec.source);
-      j.add("model", spec.state.model == TyreModelKind::Thesis ? "thesis" : "hysteresis");
-      if (spec.size) j.add("size", spec.size->designation);
-      j.add("outer_radius_m", spec.state.geometry.outer_radius_m)
-          .add("section_width_m", spec.state.geometry.section_width_m)
-          .add("rim_radius_m", spec.state.geometry.rim_radius_m)
-          .add("pressure_bar", p_bar)
-          .add("load_n", load.load_n);
-      if (spec.max_load_n > 0.0) j.add("max_load_n", spec.max_load_n); else j.add_null("max_load_n");
-      j.add("speed_kmh", speeds_kmh[i])
-          .add("rrc", r.rrc)
-          .add("rr_force_n", r.rr_force_n)
-          .add("rr_power_w", r.rr_power_w)
-          .add("stiffness_n_per_m", r.stiffness_n_per_m)
-          .add("deflection_m", r.deflection_m)
-          .add("contact_length_m", r.contact_length_m)
-          .add("offset_e_m", r.offset_e_m)
-          .add("rrc_coulomb", r.rrc_coulomb)
-          .add("rrc_viscous", r.rrc_viscous)
-          .add("rrc_rotational_drag", r.rrc_rotational_drag);
+      JsonObject j = tyre_point_json(spec, load.load_n, speeds_kmh[i], r);
       if (o.explain) {
         for (const auto& p : explanations[i].parameters) {
           j.add("elasticity_rrc_" + p.key, p.rrc_elasticity).add("elasticity_power_" + p.key, p.power_elasticity);
@@ -258,17 +157,17 @@ void register_tyre_command(CLI::App& app) {
   auto opts = std::make_shared<TyreOptions>();
   CLI::App* sub = app.add_subcommand(
       "tyre", "Rolling resistance of one tyre at one load and one or more speeds (table, --json, or --explain)");
-  sub->add_option("tyre_file", opts->file,
+  sub->add_option("tyre_file", opts->tyre.file,
                   "Tyre YAML file, or a name in the shipped tyres/ folder (e.g. 175-70R14)")
       ->type_name("FILE");
-  sub->add_option("--size", opts->size, "Size designation instead of a file, e.g. \"175/70 R14 84T\"")
+  sub->add_option("--size", opts->tyre.size, "Size designation instead of a file, e.g. \"175/70 R14 84T\"")
       ->type_name("SIZE");
-  sub->add_option("--outer-radius-m", opts->outer_radius_m, "Unloaded outer radius R [m] (with --width-m)")->type_name("M");
-  sub->add_option("--width-m", opts->width_m, "Section width W [m] (with --outer-radius-m)")->type_name("M");
-  sub->add_option("--pressure-bar", opts->pressure_bar, "Inflation pressure [bar]; overrides a file's pressure")
+  sub->add_option("--outer-radius-m", opts->tyre.outer_radius_m, "Unloaded outer radius R [m] (with --width-m)")->type_name("M");
+  sub->add_option("--width-m", opts->tyre.width_m, "Section width W [m] (with --outer-radius-m)")->type_name("M");
+  sub->add_option("--pressure-bar", opts->tyre.pressure_bar, "Inflation pressure [bar]; overrides a file's pressure")
       ->type_name("BAR");
-  sub->add_option("--load-n", opts->load_n, "Normal load per tyre [N]")->type_name("N");
-  sub->add_option("--load-pct", opts->load_pct, "Normal load as % of the tyre's maximum load (default 80)")
+  sub->add_option("--load-n", opts->tyre.load_n, "Normal load per tyre [N]")->type_name("N");
+  sub->add_option("--load-pct", opts->tyre.load_pct, "Normal load as % of the tyre's maximum load (default 80)")
       ->type_name("PCT");
   sub->add_option("--speed-kmh", opts->speeds_kmh, "Speed(s) [km/h]: several values, repeated or comma-separated "
                                                     "(default 80)")

@@ -1,4 +1,4 @@
-// Option parsing and progress shared by the tyre-selection commands (compare, sweep, sensitivity, regress).
+// Progress display shared by the tyre-selection commands (compare, sweep, sensitivity, regress).
 #pragma once
 
 #include <unistd.h>
@@ -14,17 +14,6 @@
 #include "rollsim/common/yaml_reader.hpp"
 
 namespace rollsim::cli {
-
-// Options arrive as text so that every bad value gets a message naming option, value and what is allowed.
-inline double parse_option_number(const std::string& text, const std::string& option, Range range) {
-  char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  if (text.empty() || end != text.c_str() + text.size()) {
-    throw InputError(option, "'" + text + "' is not a number; " + range.describe());
-  }
-  if (!range.contains(v)) throw InputError(option, format_value(v) + " is not allowed: " + range.describe_for(v));
-  return v;
-}
 
 /// Progress on stderr, only when stderr is a terminal (pipes and logs stay clean). Thread-safe.
 class Progress {

@@ -249,4 +249,14 @@ std::string resolve_data_file(const std::string& name, const std::string& shippe
                    "file not found (looked in the current folder and in " + shipped.string() + ")");
 }
 
+double parse_option_number(const std::string& text, const std::string& option, Range range) {
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  if (text.empty() || end != text.c_str() + text.size()) {
+    throw InputError(option, "'" + text + "' is not a number; " + range.describe());
+  }
+  if (!range.contains(v)) throw InputError(option, format_value(v) + " is not allowed: " + range.describe_for(v));
+  return v;
+}
+
 }  // namespace rollsim

@@ -121,7 +121,11 @@ DriveCycle load_cycle(const std::string& name_or_path, const std::string& option
 }
 
 DriveCycle read_cycle_csv(const std::string& path, const std::string& name) {
-  const CsvTable table = read_csv(path);
+  return cycle_from_table(read_csv(path), name);
+}
+
+DriveCycle cycle_from_table(const CsvTable& table, const std::string& name) {
+  const std::string& path = table.file;
   const std::string allowed = "time_s, speed_kmh or speed_mps, optional grade_pct or elevation_m";
   const std::string found = "found columns: " + table.columns_list();
   // A header of numbers means the file has none, and its first sample would otherwise be lost or misread.

@@ -182,8 +182,10 @@ Model extended(const Model& m, const Eigen::VectorXd& signature, const Scored& s
   return e;
 }
 
-void set_heldout_metrics(Finding& f, const Model& before, const Eigen::VectorXd& after_pred) {
+void set_finding_metrics(Finding& f, const Model& before, const Eigen::VectorXd& signature, const Scored& after) {
   const Eigen::VectorXd& y = *before.y;
+  const Eigen::VectorXd& after_pred = after.heldout;
+  f.energy_share_pct = 100.0 * after.fit.coef[after.fit.coef.size() - 1] * signature.sum() / std::max(1e-9, std::abs(y.sum()));
   f.heldout_rmse_before_j = rmse(before.heldout, y);
   f.heldout_rmse_after_j = rmse(after_pred, y);
   f.heldout_energy_error_pct_before = energy_error_pct(before.heldout, y);

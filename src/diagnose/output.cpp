@@ -1,5 +1,6 @@
 // Diagnosis output: the JSON and text reports, and the vehicle file with the fitted effects.
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <sstream>
 
@@ -59,7 +60,9 @@ std::string diagnosis_json(const Diagnosis& d) {
     os << "], \"separating_tests\": [";
     for (std::size_t k = 0; k < f.separating_tests.size(); ++k)
       os << (k ? ", " : "") << json_string(f.separating_tests[k]);
-    os << "], \"delta_bic\": " << num(f.delta_bic) << ", \"heldout_rmse_before\": " << num(f.heldout_rmse_before_j)
+    os << "], \"delta_bic\": " << num(f.delta_bic)
+       << ", \"energy_share_pct\": " << (std::isnan(f.energy_share_pct) ? "null" : num(f.energy_share_pct))
+       << ", \"heldout_rmse_before\": " << num(f.heldout_rmse_before_j)
        << ", \"heldout_rmse_after\": " << num(f.heldout_rmse_after_j)
        << ", \"heldout_energy_error_pct_before\": " << num(f.heldout_energy_error_pct_before)
        << ", \"heldout_energy_error_pct_after\": " << num(f.heldout_energy_error_pct_after)
@@ -147,6 +150,7 @@ std::string diagnosis_text(const Diagnosis& d) {
       os << "    elevation profile: " << p.distance_m.size() << " knots over " << p.distance_m.back() / 1e3 << " km, "
          << *lo << " to " << *hi << " m from the start's (with its 95 % band in --json, road_profile)\n";
     }
+    if (!std::isnan(f.energy_share_pct)) os << "    " << f.energy_share_pct << " % of the measured energy (in-sample)\n";
     os << "    held-out RMSE " << f.heldout_rmse_before_j / 1e3 << " -> " << f.heldout_rmse_after_j / 1e3
        << " kJ/window, trip energy error " << f.heldout_energy_error_pct_before << " -> " << f.heldout_energy_error_pct_after
        << " %, residual lag-1 autocorrelation " << f.heldout_lag1_autocorrelation_before << " -> "

@@ -133,8 +133,9 @@ Scored score_column(const Model& m, const Eigen::VectorXd& signature);
 void add_heldout(const Model& m, const Eigen::VectorXd& signature, Scored& s);
 bool improves_heldout(const Model& m, const Scored& s);
 Model extended(const Model& m, const Eigen::VectorXd& signature, const Scored& s);
-/// Held-out metrics of a finding, from the model before and after it.
-void set_heldout_metrics(Finding& f, const Model& before, const Eigen::VectorXd& after_pred);
+/// Held-out metrics of a finding, from the model before it and the fit with its signature as the last column,
+/// and the share of the measured energy that column carries.
+void set_finding_metrics(Finding& f, const Model& before, const Eigen::VectorXd& signature, const Scored& after);
 
 // ---- calibration with priors (calibration.cpp) -----------------------------------------------------------------
 

@@ -61,7 +61,10 @@ ProfileResult profile_time_constant(const Model& m, const TimeProfile& tp, const
   std::size_t k = 0;
   for (double g : tp.grid) {
     sigs.push_back(g == tp.selected ? selected_signature : other_sigs[k++]);
-    rss.push_back(least_squares(hcat(m.x, sigs.back()), *m.y, m.prior).rss);
+    // Where the effect does nothing at this grid value (a regen limit above every braking power of the trace), the
+    // model is the one without it: a zero column has no least-squares solution of its own.
+    const bool inert = !(sigs.back().norm() > 0.0);
+    rss.push_back(inert ? m.fit.rss : least_squares(hcat(m.x, sigs.back()), *m.y, m.prior).rss);
   }
   ProfileResult r{profile_likelihood_interval(tp.grid, rss, m.n_eff), tp.parameter, selected_signature, selected_score};
   double kept = tp.selected;

@@ -41,15 +41,16 @@ std::string separating_test(const std::string& a, const std::string& b) {
 namespace diag {
 namespace {
 
-// Time-constant parameters profiled when their effect is found, and their grid ranges.
-struct TimeParameter {
+// Shape parameters (time constants, the regen limit) profiled when their effect is found, and their grid ranges.
+struct ShapeParameter {
   EffectId effect;
   const char* parameter;
   double low, high;
 };
-constexpr TimeParameter kTimeParameters[] = {
+constexpr ShapeParameter kShapeParameters[] = {
     {EffectId::tyre_warmup, "heat_capacity_j_per_k", 10000.0, 320000.0},   // tau ~ C / h: ~3-60 min at 20-50 W/K
     {EffectId::engine_warmup, "heat_capacity_j_per_k", 25000.0, 800000.0},  // oil, block and coolant of small to large engines
+    {EffectId::regen_limit, "regen_limit_w", 1500.0, 48000.0},               // braking power at the wheels, small to large motors
 };
 
 // ambient_rrc's evidence lives in a few per-trip RRC levels, not in the windows: a trip's RRC level also moves with
@@ -153,7 +154,7 @@ std::vector<Passing> passing_candidates(const SelectionContext& sc, const std::v
 }
 
 std::optional<ProfileResult> refine(const SelectionContext& sc, Candidate& c, const Model& m, Passing& best) {
-  for (const auto& tp : kTimeParameters) {
+  for (const auto& tp : kShapeParameters) {
     if (c.id != tp.effect || !c.shape.count(tp.parameter)) continue;
     TimeProfile prof;
     prof.parameter = tp.parameter;
@@ -269,7 +270,7 @@ std::vector<Finding> select_effects(const SelectionContext& sc, const std::vecto
       f = catalogue_finding(sc, c, best, prof, m.inflate);
       add_confounders(f, c, cands, passing, m, sc.opt.collinear_corr);
     }
-    set_heldout_metrics(f, m, best.score.heldout);
+    set_finding_metrics(f, m, c.signature, best.score);
     m = extended(m, c.signature, best.score);
     chosen.push_back(c.id);
     out.push_back(std::move(f));

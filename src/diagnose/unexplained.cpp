@@ -107,8 +107,7 @@ std::optional<Finding> describe_unexplained(const SelectionContext& sc, const st
   for (const auto& r : sc.recordings)
     for (double v : r.speed_mps) vmax = std::max(vmax, v);
   const BasisWords w = words_of(b, value, vmax > units::kmh_to_mps(90.0) ? 100.0 : 50.0, sc.obs.channel);
-  const double share_pct = 100.0 * best.fit.coef[best.fit.coef.size() - 1] * b.signature.sum() /
-                           std::max(1e-9, std::abs(sc.obs.measured_j.sum()));
+  set_finding_metrics(f, m, b.signature, best);
   f.parameters.push_back({w.name, w.unit, value, value - 1.96 * se, value + 1.96 * se});
   std::string when;
   if (prof) {
@@ -117,12 +116,11 @@ std::optional<Finding> describe_unexplained(const SelectionContext& sc, const st
     when = ", decaying from the start of the trip with a time constant of about " + fixed(b.decay_s / 60.0, 0) +
            " min: mostly (80 %) in the first " + fixed(minutes_to_80pct(sc.obs, cycles, b.signature), 0) + " min";
   }
-  f.description = w.what + ", " + w.size_text + when + "; " + fixed(share_pct, 1) +
+  f.description = w.what + ", " + w.size_text + when + "; " + fixed(f.energy_share_pct, 1) +
                   " % of the measured energy, beside a channel scale of " + fixed(s, 3);
   if (!sc.replayer.vehicle.is_electric() && b.decay_s == 0.0)
     f.description += ". The combustion engine is a Willans line with no efficiency map: efficiency changing with "
                      "load and speed (enrichment at high load, pumping loss at low load) has no module to name, and shows up this way";
-  set_heldout_metrics(f, m, best.heldout);
   m = extended(m, b.signature, best);
   return f;
 }

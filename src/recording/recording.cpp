@@ -181,6 +181,17 @@ ColumnMapping preset_mapping(const std::string& name) {
   throw InputError("recording preset '" + name + "'", "unknown; allowed: anl_d3, rsk_twizy");
 }
 
+ColumnMapping assemble_mapping(const std::string& preset, YamlMap& vehicle_file, const std::vector<std::string>& columns,
+                               const std::vector<std::string>& scales) {
+  ColumnMapping mapping;
+  if (!preset.empty()) mapping = preset_mapping(preset);
+  mapping = merge_mapping(mapping, column_mapping_from_yaml(vehicle_file));
+  ColumnMapping overrides;
+  for (const auto& c : columns) parse_column_option(c, overrides);
+  for (const auto& s : scales) parse_scale_option(s, overrides);
+  return merge_mapping(mapping, overrides);
+}
+
 ColumnMapping merge_mapping(ColumnMapping base, const ColumnMapping& overrides) {
   for (const auto& [k, v] : overrides.source_for_canonical) base.source_for_canonical[k] = v;
   for (const auto& [k, v] : overrides.scale_for_canonical) base.scale_for_canonical[k] = v;

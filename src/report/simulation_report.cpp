@@ -188,16 +188,44 @@ JsonObject to_json(const SimulationResult& r, const std::string& tyre_label) {
   return j;
 }
 
+std::vector<TraceColumn> trace_columns(const SimulationResult& r) {
+  using P = TracePoint;
+  const std::vector<std::pair<std::string, double (*)(const P&)>> columns{
+      {"time_s", [](const P& p) { return p.time_s; }},
+      {"target_speed_kmh", [](const P& p) { return units::mps_to_kmh(p.target_speed_mps); }},
+      {"speed_kmh", [](const P& p) { return units::mps_to_kmh(p.speed_mps); }},
+      {"accel_mps2", [](const P& p) { return p.accel_mps2; }},
+      {"grade_pct", [](const P& p) { return p.grade * 100.0; }},
+      {"gear", [](const P& p) { return static_cast<double>(p.gear); }},
+      {"rolling_force_n", [](const P& p) { return p.rolling_force_n; }},
+      {"aero_force_n", [](const P& p) { return p.aero_force_n; }},
+      {"grade_force_n", [](const P& p) { return p.grade_force_n; }},
+      {"wheel_force_n", [](const P& p) { return p.wheel_force_n; }},
+      {"traction_power_kw", [](const P& p) { return p.traction_power_w / 1e3; }},
+      {"battery_power_kw", [](const P& p) { return p.battery_power_w / 1e3; }},
+      {"battery_current_a", [](const P& p) { return p.battery_current_a; }},
+      {"fuel_rate_lph", [](const P& p) { return p.fuel_rate_m3_per_s / units::kM3PerLitre * units::kSPerHour; }},
+      {"tyre_rrc", [](const P& p) { return p.rrc; }},
+      {"soc_pct", [](const P& p) { return p.soc * 100.0; }},
+  };
+  std::vector<TraceColumn> out;
+  for (const auto& [name, value] : columns) {
+    TraceColumn c{name, {}};
+    c.values.reserve(r.trace.size());
+    for (const auto& p : r.trace) c.values.push_back(value(p));
+    out.push_back(std::move(c));
+  }
+  return out;
+}
+
 void write_trace_csv(std::ostream& out, const SimulationResult& r) {
-  out << "time_s,target_speed_kmh,speed_kmh,accel_mps2,grade_pct,gear,rolling_force_n,aero_force_n,grade_force_n,"
-         "wheel_force_n,traction_power_kw,battery_power_kw,battery_current_a,fuel_rate_lph,tyre_rrc,soc_pct\n";
+  const std::vector<TraceColumn> columns = trace_columns(r);
+  for (std::size_t c = 0; c < columns.size(); ++c) out << (c ? "," : "") << columns[c].name;
+  out << '\n';
   out.precision(8);
-  for (const auto& p : r.trace) {
-    out << p.time_s << ',' << units::mps_to_kmh(p.target_speed_mps) << ',' << units::mps_to_kmh(p.speed_mps) << ',' << p.accel_mps2 << ','
-        << p.grade * 100.0 << ',' << p.gear << ',' << p.rolling_force_n << ',' << p.aero_force_n << ','
-        << p.grade_force_n << ',' << p.wheel_force_n << ',' << p.traction_power_w / 1e3 << ','
-        << p.battery_power_w / 1e3 << ',' << p.battery_current_a << ',' << p.fuel_rate_m3_per_s / units::kM3PerLitre * units::kSPerHour << ','
-        << p.rrc << ',' << p.soc * 100.0 << '\n';
+  for (std::size_t i = 0; i < r.trace.size(); ++i) {
+    for (std::size_t c = 0; c < columns.size(); ++c) out << (c ? "," : "") << columns[c].values[i];
+    out << '\n';
   }
 }
 

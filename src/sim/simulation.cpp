@@ -761,7 +761,10 @@ SimulationResult simulate_replay(const VehicleModel& m, const DriveCycle& c, con
     scheduled_gear = m.powertrain->select_gear(v, scheduled_gear);
     EffectInputs in{t, v, a, grade, dist_m, 0.0, 0.0};
     eval.resistance(rl, in, x.data(), s);
-    const double request_n = m_eff * a + s.resistance_n();
+    // At rest and staying at rest the car is held on its brakes, as the forward simulation holds it: on a grade the
+    // powertrain does not hold it (a machine held at torque would draw its constant loss at every uphill stop).
+    const bool held = v == 0.0 && a == 0.0;
+    const double request_n = held ? 0.0 : m_eff * a + s.resistance_n();
     // Kick down, as in the forward simulation, where the scheduled gear cannot deliver the trace's demand.
     gear = scheduled_gear;
     auto max_force = [&](int g) { return m.powertrain->max_wheel_force_n(g, v, m.wheel_radius_m); };

@@ -282,8 +282,14 @@ TyreSize parse_tyre_size(const std::string& designation, const std::string& wher
   return out;
 }
 
-TyreSpec load_tyre_file(const std::string& path) {
-  YamlMap y = YamlMap::load_file(path);
+TyreSpec load_tyre_file(const std::string& path) { return load_tyre(YamlMap::load_file(path)); }
+
+TyreSpec load_tyre_text(const std::string& text, const std::string& name) {
+  return load_tyre(YamlMap::load_text(text, name));
+}
+
+TyreSpec load_tyre(YamlMap y) {
+  const std::string path = y.file();
   reject_unknown_keys(y, {"name", "description", "source", "size", "outer_radius_m", "section_width_m",
                           "rim_diameter_in", "rim_radius_m", "outer_diameter_mm", "pressure_bar", "max_load_kg",
                           "load_index", "model"});

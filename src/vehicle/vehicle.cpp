@@ -158,8 +158,14 @@ CombustionPowertrainParams read_combustion(YamlMap& pt) {
 
 }  // namespace
 
-Vehicle load_vehicle_file(const std::string& path) {
-  YamlMap root = YamlMap::load_file(path);
+Vehicle load_vehicle_file(const std::string& path) { return load_vehicle(YamlMap::load_file(path)); }
+
+Vehicle load_vehicle_text(const std::string& text, const std::string& name) {
+  return load_vehicle(YamlMap::load_text(text, name));
+}
+
+Vehicle load_vehicle(YamlMap root) {
+  const std::string path = root.file();
   Vehicle v;
   v.source = path;
   v.name = root.string_or("name", std::filesystem::path(path).stem().string());

@@ -30,6 +30,10 @@ struct Range {
   std::string describe_for(double v) const;
 };
 
+/// A number given as text on the command line or by the Python API: parsed whole and checked against `range`;
+/// throws InputError naming `option`, the text or value, and what is allowed (strtod alone would accept "nan").
+double parse_option_number(const std::string& text, const std::string& option, Range range);
+
 /// A view on one YAML mapping of a file, remembering its path ("vehicle.yaml: body.mass_kg") so that every
 /// error names file and key. Keys read are recorded; finish() rejects any key that was never asked for,
 /// which catches misspellings ("presure_bar") instead of silently using a default.

@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "rollsim/common/csv.hpp"
+
 namespace rollsim {
 
 /// A piecewise-linear speed trace. time_s is strictly increasing, speed_mps >= 0, grade (rise over run,
@@ -52,6 +54,10 @@ DriveCycle load_cycle(const std::string& name_or_path, const std::string& option
 
 /// Reads a cycle CSV at `path` (no name lookup); `name` becomes DriveCycle::name.
 DriveCycle read_cycle_csv(const std::string& path, const std::string& name);
+
+/// A cycle from a table already in memory (e.g. a user's arrays from Python), with the columns and checks of
+/// the CSV file; errors name table.file and the line numbers the table carries.
+DriveCycle cycle_from_table(const CsvTable& table, const std::string& name);
 
 /// Largest |grade| a cycle may hold: 30 %, steeper than any public road.
 inline constexpr double kMaxCycleGrade = 0.30;

@@ -1,6 +1,7 @@
 // Diagnosis of a recording against the model: locate the mismatch, name the missing catalogue effect, fit it.
 #pragma once
 
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -107,6 +108,9 @@ struct Finding {
   std::vector<ParameterEstimate> parameters;
   std::vector<std::string> confounded_with;
   double delta_bic = 0.0;
+  /// The fitted effect's energy over all windows (in-sample) as a share of the measured energy; negative when the
+  /// effect returns energy. Not a number for a finding that is no fitted effect (a residual left above the noise).
+  double energy_share_pct = std::numeric_limits<double>::quiet_NaN();
   double heldout_rmse_before_j = 0.0, heldout_rmse_after_j = 0.0;  ///< per window
   double heldout_energy_error_pct_before = 0.0, heldout_energy_error_pct_after = 0.0;
   /// Whiteness of the held-out window residual: its lag-1 autocorrelation (0 for white noise), before and after.

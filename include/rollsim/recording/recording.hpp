@@ -67,6 +67,10 @@ ColumnMapping preset_mapping(const std::string& name);
 std::vector<std::string> preset_mapping_names();
 /// Entries of `overrides` replace those of `base`.
 ColumnMapping merge_mapping(ColumnMapping base, const ColumnMapping& overrides);
+/// The mapping a diagnosis uses: the preset (if named), then the vehicle file's own logger blocks, then the
+/// `--column C=S` and `--scale C=F` options, each overriding the one before.
+ColumnMapping assemble_mapping(const std::string& preset, YamlMap& vehicle_file, const std::vector<std::string>& columns,
+                               const std::vector<std::string>& scales);
 
 /// Longest run of missing values (empty cell or NaN) bridged by linear interpolation; longer runs are errors.
 inline constexpr double kMaxBridgedRun_s = 5.0;

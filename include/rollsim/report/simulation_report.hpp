@@ -21,6 +21,15 @@ std::string summary_text(const SimulationResult& r, bool solver_stats);
 /// energy_breakdown_kwh, max_speed_error_kmh.
 JsonObject to_json(const SimulationResult& r, const std::string& tyre_label);
 
+/// One named column of the trace, in the units its name carries (as the --trace CSV writes it).
+struct TraceColumn {
+  std::string name;
+  std::vector<double> values;
+};
+
+/// The --trace columns in file order, one value per trace point.
+std::vector<TraceColumn> trace_columns(const SimulationResult& r);
+
 /// One row per trace point: speed, forces, powers, tyre RRC, battery current or fuel rate, state of charge.
 void write_trace_csv(std::ostream& out, const SimulationResult& r);
 

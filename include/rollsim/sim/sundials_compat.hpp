@@ -7,11 +7,12 @@
 #include <sundials/sundials_types.h>
 
 // SUNDIALS 6 (Debian 12 ships 6.4.1, which the project builds and tests against) and 7 (written from the 7.x
-// headers and release notes; not built here). 7 removed `realtype` (use `sunrealtype`, present since 6.0), takes a
+// headers and release notes; built and tested against 7.5.0 from source by hand, see the README). 7 removed `realtype` (use `sunrealtype`, present since 6.0), takes a
 // SUNComm instead of a void* in SUNContext_Create, and moved error handlers from each integrator
 // (CVodeSetErrHandlerFn) to the context (SUNContext_PushErrHandler), with a new handler signature.
 #if SUNDIALS_VERSION_MAJOR >= 7
 #include <sundials/sundials_errors.h>
+#include <sundials/sundials_logger.h>
 #endif
 
 namespace rollsim::sundials {
@@ -21,7 +22,14 @@ using real = sunrealtype;
 /// Creates a serial context; returns SUNDIALS' flag (0 on success).
 inline int create_context(SUNContext* ctx) {
 #if SUNDIALS_VERSION_MAJOR >= 7
-  return SUNContext_Create(SUN_COMM_NULL, ctx);
+  // 7 sends warnings (a step below round-off) to the context's logger, which prints them on stdout, where they
+  // would corrupt a --json or CSV output; 6 sent them to the error handler, which keeps them. An empty name leaves
+  // the logger's stdout in place, so the warnings go to the null device.
+  int flag = SUNContext_Create(SUN_COMM_NULL, ctx);
+  SUNLogger logger = nullptr;
+  if (flag == 0) flag = SUNContext_GetLogger(*ctx, &logger);
+  if (flag == 0) flag = SUNLogger_SetWarningFilename(logger, "/dev/null");
+  return flag;
 #else
   return SUNContext_Create(nullptr, ctx);
 #endif

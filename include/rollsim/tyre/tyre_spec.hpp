@@ -4,6 +4,7 @@
 #include <optional>
 #include <string>
 
+#include "rollsim/common/yaml_reader.hpp"
 #include "rollsim/tyre/tyre_model.hpp"
 
 namespace rollsim {
@@ -41,5 +42,9 @@ struct TyreSpec {
 
 /// Loads and validates a tyre YAML file (strict keys; see tyres/README.md for the format).
 TyreSpec load_tyre_file(const std::string& path);
+/// The same for YAML text in memory (e.g. a Python dict as JSON); `name` stands for the file in errors.
+TyreSpec load_tyre_text(const std::string& text, const std::string& name);
+/// The same for a mapping already read; its file() names the source.
+TyreSpec load_tyre(YamlMap y);
 
 }  // namespace rollsim

@@ -52,6 +52,11 @@ struct Vehicle {
 
 /// Loads a vehicle file; tyre files named in it are found beside it or in the shipped tyres/.
 Vehicle load_vehicle_file(const std::string& path);
+/// The same for YAML text in memory (e.g. a Python dict as JSON); `name` stands for the file in errors, and tyre
+/// files it names are found relative to the working folder or in the shipped tyres/.
+Vehicle load_vehicle_text(const std::string& text, const std::string& name);
+/// The same for a mapping already read; its file() names the source.
+Vehicle load_vehicle(YamlMap root);
 
 /// What the effect models need to know of this car (its test mass and air density x drag area).
 EffectContext effect_context(const Vehicle& vehicle);

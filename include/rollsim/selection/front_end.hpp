@@ -1,0 +1,44 @@
+// What `compare` and `sweep` are given and what their --json writes, shared by the CLI and the Python API.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "rollsim/common/json.hpp"
+#include "rollsim/selection/compare.hpp"
+#include "rollsim/selection/sweep.hpp"
+#include "rollsim/tyre/tyre_spec.hpp"
+
+namespace rollsim::selection {
+
+/// Candidate tyres: each of `tyres` (file or shipped name), then with `use_catalogue` (or no `tyres`) every *.yaml
+/// of `catalogue` (empty: the shipped tyres/catalogue). A broken catalogue file is skipped and its error kept.
+struct CandidateList {
+  std::vector<TyreSpec> tyres;
+  std::vector<std::string> broken;  ///< one error message per skipped file
+};
+CandidateList load_candidates(const std::vector<std::string>& tyres, bool use_catalogue, const std::string& catalogue);
+
+/// The outer-diameter tolerance given as text [%], checked to (0, 100].
+double parse_diameter_tolerance_pct(const std::string& text);
+
+/// "175/70 R14 84T", or "R305 W195" for a tyre given by geometry.
+std::string tyre_size_text(const TyreSpec& tyre);
+
+/// One object per tyre: the ranked ones best first, then the unfit ones (rank null).
+std::vector<JsonObject> comparison_json(const Comparison& comparison);
+
+/// A sweep as given: one --param, --from, --to (and optionally --steps) per axis; numbers as text.
+struct SweepRequest {
+  std::vector<std::string> params, from, to, steps;
+  std::string load_n;              ///< empty: 80 % of the maximum load
+  std::string speed_kmh = "80";
+  std::string threads;             ///< empty: every core
+};
+/// Parses and checks the axes, load, speed and threads (errors name the option, value and what is allowed).
+SweepOptions sweep_options_from_request(const SweepRequest& request);
+
+/// One object per valid point: the swept values (key_unit), load, speed, RRC, force, power, and the car's figure.
+std::vector<JsonObject> sweep_json(const SweepResult& result);
+
+}  // namespace rollsim::selection

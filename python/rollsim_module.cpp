@@ -1,0 +1,289 @@
+// The Python module `rollsim`: glue over rollsim_lib. Every figure comes from the library's own --json writers,
+// parsed by Python's json module, so the dicts hold the command line's keys and values by construction.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "rollsim/common/csv.hpp"
+#include "rollsim/common/error.hpp"
+#include "rollsim/common/format.hpp"
+#include "rollsim/common/units.hpp"
+#include "rollsim/common/yaml_reader.hpp"
+#include "rollsim/cycle/drive_cycle.hpp"
+#include "rollsim/diagnose/diagnose.hpp"
+#include "rollsim/recording/recording.hpp"
+#include "rollsim/report/simulation_report.hpp"
+#include "rollsim/selection/front_end.hpp"
+#include "rollsim/sim/vehicle_run.hpp"
+#include "rollsim/tyre/tyre_model.hpp"
+#include "rollsim/tyre/tyre_request.hpp"
+#include "rollsim/vehicle/vehicle.hpp"
+
+namespace py = pybind11;
+using namespace rollsim;
+using namespace pybind11::literals;
+
+namespace {
+
+py::object from_json(const std::string& text) { return py::module_::import("json").attr("loads")(text); }
+std::string to_json(py::handle obj) { return py::module_::import("json").attr("dumps")(obj).cast<std::string>(); }
+// What the CLI prints as "warning: ..." on stderr; raises if the user's warning filter turns it into an error.
+void warn(const std::string& text) {
+  if (PyErr_WarnEx(PyExc_UserWarning, text.c_str(), 1) != 0) throw py::error_already_set();
+}
+
+// A Python number as the text the command line would have been given (shortest round-trip form: exact).
+std::string number_text(py::handle x) {
+  if (x.is_none()) return "";
+  return format_value(x.cast<double>());
+}
+
+// A file or shipped name (str), or a Python dict with the keys of the YAML file.
+Vehicle vehicle_from(py::handle v) {
+  if (py::isinstance<py::dict>(v)) return load_vehicle_text(to_json(v), "vehicle dict");
+  return load_vehicle_file(resolve_data_file(v.cast<std::string>(), "vehicles", ".yaml", "--vehicle"));
+}
+std::optional<TyreSpec> tyre_from(py::handle t) {
+  if (t.is_none()) return std::nullopt;
+  if (py::isinstance<py::dict>(t)) return load_tyre_text(to_json(t), "tyre dict");
+  return load_tyre_file(resolve_data_file(t.cast<std::string>(), "tyres", ".yaml", "--tyre"));
+}
+
+// A shipped name or CSV path; a dict of arrays named like the CSV columns (time_s, speed_kmh or speed_mps,
+// optional grade_pct or elevation_m); or a pair (time_s, speed_kmh). Arrays pass the CSV file's checks,
+// their errors naming the sample index as the "line".
+DriveCycle cycle_from(py::handle c) {
+  if (py::isinstance<py::str>(c)) return load_cycle(c.cast<std::string>(), "--cycle");
+  CsvTable table;
+  table.file = "cycle arrays (line = sample index)";
+  std::vector<py::array_t<double>> columns;
+  if (py::isinstance<py::dict>(c)) {
+    for (auto item : c.cast<py::dict>()) {
+      table.header.push_back(item.first.cast<std::string>());
+      columns.push_back(py::array_t<double, py::array::forcecast>::ensure(item.second));
+    }
+  } else {
+    const py::sequence pair = c.cast<py::sequence>();
+    if (pair.size() != 2) throw InputError("cycle", "a pair (time_s, speed_kmh) of arrays is expected, or a dict of columns");
+    table.header = {"time_s", "speed_kmh"};
+    for (auto a : pair) columns.push_back(py::array_t<double, py::array::forcecast>::ensure(a));
+  }
+  for (std::size_t k = 0; k < columns.size(); ++k) {
+    if (!columns[k] || columns[k].ndim() != 1 || columns[k].size() != columns.front().size())
+      throw InputError("cycle column '" + table.header[k] + "'", "must be a 1-D array of numbers as long as the others");
+  }
+  const std::size_t n = columns.empty() ? 0 : static_cast<std::size_t>(columns.front().size());
+  for (std::size_t i = 0; i < n; ++i) {
+    std::vector<std::string> row;
+    for (const auto& col : columns) row.push_back(format_value(col.at(i)));
+    table.rows.push_back(std::move(row));
+    table.row_line.push_back(i);
+  }
+  return cycle_from_table(table, "user trace");
+}
+
+// Speed-indexed tyre results as one dict of arrays: numbers become arrays, text stays text.
+py::dict stack(const std::vector<py::dict>& points) {
+  auto np = py::module_::import("numpy");
+  py::dict out;
+  for (auto item : points.front()) {
+    py::list values;
+    for (const auto& p : points) values.append(p[item.first]);
+    const bool numeric = py::isinstance<py::float_>(item.second) || py::isinstance<py::int_>(item.second);
+    out[item.first] = numeric ? np.attr("asarray")(values, "dtype"_a = "float64") : py::reinterpret_borrow<py::object>(item.second);
+  }
+  return out;
+}
+
+py::object api_tyre(py::object file, py::object size, py::object outer_radius_m, py::object width_m, py::object pressure_bar,
+                py::object load_n, py::object load_pct, py::object speed_kmh) {
+  TyreRequest req;
+  if (!file.is_none()) req.file = file.cast<std::string>();
+  if (!size.is_none()) req.size = size.cast<std::string>();
+  req.outer_radius_m = number_text(outer_radius_m);
+  req.width_m = number_text(width_m);
+  req.pressure_bar = number_text(pressure_bar);
+  req.load_n = number_text(load_n);
+  req.load_pct = number_text(load_pct);
+  const TyreSpec spec = build_requested_tyre(req);
+  const TyreLoadChoice load = choose_requested_load(req, spec);
+  const auto speeds = py::array_t<double, py::array::forcecast>::ensure(speed_kmh);
+  if (!speeds || speeds.ndim() > 1) throw InputError("--speed-kmh", "must be a number or a 1-D array of numbers");
+  std::vector<py::dict> points;
+  for (py::ssize_t i = 0; i < speeds.size(); ++i) {
+    const double v_kmh = parse_requested_speed_kmh(format_value(speeds.data()[i]));
+    const RollingResistance r = named_tyre_request(req, spec, load, [&] {
+      return evaluate_rolling_resistance(spec.state, load.load_n, units::kmh_to_mps(v_kmh));
+    });
+    points.push_back(from_json(tyre_point_json(spec, load.load_n, v_kmh, r).str()).cast<py::dict>());
+  }
+  if (spec.max_load_n > 0.0 && load.load_n > spec.max_load_n)
+    warn("load " + fixed(load.load_n, 0) + " N is above the tyre's rated maximum " + fixed(spec.max_load_n, 0) + " N");
+  if (speeds.ndim() == 0) return points.front();
+  if (points.empty()) throw InputError("--speed-kmh", "an empty array: give at least one speed");
+  return stack(points);
+}
+
+py::dict api_simulate(py::object vehicle, py::object tyre, py::object cycle, bool replay, bool trace) {
+  const Vehicle base = vehicle_from(vehicle);
+  const std::optional<TyreSpec> tyre_set = tyre_from(tyre);
+  const DriveCycle c = cycle_from(cycle);
+  SimulationOptions opt;
+  opt.record_trace = trace;
+  VehicleRun run;
+  {
+    py::gil_scoped_release released;
+    run = run_vehicle(base, tyre_set, c, replay, opt);
+  }
+  for (const auto& w : run.warnings) warn(w);
+  py::dict out;
+  out["summary"] = from_json(report::to_json(run.result, run.tyre_label).str());
+  py::dict columns;
+  if (trace)
+    for (auto& col : report::trace_columns(run.result)) columns[py::str(col.name)] = py::array_t<double>(col.values.size(), col.values.data());
+  out["trace"] = columns;
+  return out;
+}
+
+py::list api_compare(py::object vehicle, std::vector<std::string> tyres, py::object cycle, py::object catalogue,
+                 double diameter_tolerance_pct) {
+  selection::CompareOptions copt;
+  copt.diameter_tolerance_pct = selection::parse_diameter_tolerance_pct(format_value(diameter_tolerance_pct));
+  const selection::CandidateList list =
+      selection::load_candidates(tyres, !catalogue.is_none(), catalogue.is_none() ? "" : catalogue.cast<std::string>());
+  for (const auto& b : list.broken) warn("skipped broken catalogue file: " + b);
+  const Vehicle v = vehicle_from(vehicle);
+  const DriveCycle c = cycle_from(cycle);
+  selection::Comparison cmp;
+  {
+    py::gil_scoped_release released;
+    cmp = selection::compare_tyres(v, list.tyres, c, copt);
+  }
+  py::list out;
+  for (const auto& j : selection::comparison_json(cmp)) out.append(from_json(j.str()));
+  return out;
+}
+
+py::list api_sweep(py::object tyre, std::vector<py::tuple> axes, py::object load_n, double speed_kmh, py::object vehicle,
+               py::object cycle, py::object threads) {
+  selection::SweepRequest req;
+  for (const auto& a : axes) {
+    if (a.size() < 3 || a.size() > 4) throw InputError("axes", "each axis is (param, from, to) or (param, from, to, steps)");
+    req.params.push_back(a[0].cast<std::string>());
+    req.from.push_back(number_text(a[1]));
+    req.to.push_back(number_text(a[2]));
+    if (a.size() == 4) req.steps.push_back(number_text(a[3]));
+  }
+  req.load_n = number_text(load_n);
+  req.speed_kmh = format_value(speed_kmh);
+  req.threads = number_text(threads);
+  const selection::SweepOptions so = selection::sweep_options_from_request(req);
+  const TyreSpec t = *tyre_from(tyre);
+  selection::SweepResult r;
+  if (!vehicle.is_none()) {
+    const Vehicle v = vehicle_from(vehicle);
+    const DriveCycle c = cycle_from(cycle);
+    py::gil_scoped_release released;
+    r = selection::sweep_vehicle(v, t, c, so);
+  } else {
+    py::gil_scoped_release released;
+    r = selection::sweep_tyre(t, so);
+  }
+  if (r.stopped) {
+    warn(*r.stopped + " (the " + std::to_string(r.points.size()) + " valid points of " +
+         std::to_string(r.planned_points) + " are returned)");
+  }
+  py::list out;
+  for (const auto& j : selection::sweep_json(r)) out.append(from_json(j.str()));
+  return out;
+}
+
+py::object api_diagnose(py::object vehicle, std::vector<std::string> recordings, py::dict columns, py::dict scales,
+                    std::string preset, py::object tyre) {
+  YamlMap vehicle_file = py::isinstance<py::dict>(vehicle)
+                             ? YamlMap::load_text(to_json(vehicle), "vehicle dict")
+                             : YamlMap::load_file(resolve_data_file(vehicle.cast<std::string>(), "vehicles", ".yaml", "--vehicle"));
+  Vehicle v = load_vehicle(vehicle_file);
+  if (const auto t = tyre_from(tyre)) fit_tyres(v, *t);
+  std::vector<std::string> column_options, scale_options;
+  for (auto item : columns) column_options.push_back(item.first.cast<std::string>() + "=" + item.second.cast<std::string>());
+  for (auto item : scales) scale_options.push_back(item.first.cast<std::string>() + "=" + number_text(item.second));
+  const ColumnMapping mapping = assemble_mapping(preset, vehicle_file, column_options, scale_options);
+  std::vector<Recording> recs;
+  for (const auto& r : recordings) recs.push_back(load_recording(r, mapping));
+  for (const auto& r : recs)
+    for (const auto& rep : r.repairs) warn(r.source + ": " + rep);
+  std::string json;
+  {
+    py::gil_scoped_release released;
+    json = diagnosis_json(diagnose(v, recs, DiagnoseOptions{}));
+  }
+  return from_json(json);
+}
+
+}  // namespace
+
+PYBIND11_MODULE(rollsim, m) {
+  using namespace pybind11::literals;
+  m.doc() = R"(rollsim: tyre rolling resistance and vehicle energy on drive cycles (C++ library, Python API).
+
+Results are the dicts `rollsim ... --json` prints, with the same keys and values. Units are SI unless a key or
+argument names its unit (speed_kmh, pressure_bar, aec_kwh_per_10km). Bad input raises rollsim.InputError
+carrying the command line's message (options are named as on the command line, e.g. '--pressure-bar').)";
+  py::register_exception<InputError>(m, "InputError", PyExc_ValueError);
+
+  m.def("tyre", &api_tyre, "tyre"_a = py::none(), py::kw_only(), "size"_a = py::none(), "outer_radius_m"_a = py::none(),
+        "width_m"_a = py::none(), "pressure_bar"_a = py::none(), "load_n"_a = py::none(), "load_pct"_a = py::none(),
+        "speed_kmh"_a = 80.0,
+        R"(Rolling resistance of one tyre at one load and one or more speeds (`rollsim tyre --json`).
+
+tyre: a tyre file or shipped name ('175-70R14'); or size='175/70 R14 84T'; or outer_radius_m [m] and width_m [m].
+pressure_bar [bar] (required without a file; overrides a file's), load_n [N] or load_pct [% of the maximum load,
+default 80], speed_kmh [km/h]: a number gives one dict of numbers, an array gives a dict of arrays (one per speed).
+Keys: rrc [-], rr_force_n [N], rr_power_w [W], stiffness_n_per_m, deflection_m, contact_length_m, offset_e_m,
+rrc_coulomb, rrc_viscous, rrc_rotational_drag, and the tyre's geometry, pressure and load.)");
+
+  m.def("simulate", &api_simulate, "vehicle"_a = "ev", "tyre"_a = py::none(), "cycle"_a = "nedc", "replay"_a = false,
+        "trace"_a = true,
+        R"(A car over a drive cycle (`rollsim simulate --json` and `--trace`); the GIL is released while it runs.
+
+vehicle: file or shipped name ('ev', 'ice') or a dict with the vehicle file's keys. tyre: None (the car's own),
+a file or shipped name ('nominal', 'low-rrc'), or a dict with the tyre file's keys, on all four wheels.
+cycle: a shipped name ('nedc', 'wltc', 'udds', ...), a CSV path, a pair (time_s [s], speed_kmh [km/h]) of arrays,
+or a dict of arrays named like the CSV columns (time_s, speed_kmh or speed_mps, optional grade_pct or elevation_m).
+replay: kinematic replay instead of driver + CVODE. Returns {'summary': dict (the --json keys: distance_km,
+aec_kwh_per_10km or fuel_l_per_100km, energy_breakdown_kwh, ...), 'trace': dict of numpy arrays (the --trace
+columns: time_s, speed_kmh, rolling_force_n, battery_power_kw, ...; empty with trace=False)}.)");
+
+  m.def("compare", &api_compare, "vehicle"_a, "tyres"_a = std::vector<std::string>{}, "cycle"_a = "nedc",
+        "catalogue"_a = py::none(), "diameter_tolerance_pct"_a = 3.0,
+        R"(Tyre selection (`rollsim compare --json`): the car on the cycle with each tyre on all four wheels.
+
+vehicle: file, shipped name or dict; tyres: files or shipped names; catalogue: a folder of tyre files (used when
+given, or when tyres is empty: the shipped tyres/catalogue); diameter_tolerance_pct [%]. Returns a list of dicts,
+the fitting tyres ranked best first (rank 1..), then the unfit ones (rank None, with the reason). Broken catalogue
+files are skipped with a warning.)");
+
+  m.def("sweep", &api_sweep, "tyre"_a, "axes"_a, py::kw_only(), "load_n"_a = py::none(), "speed_kmh"_a = 80.0,
+        "vehicle"_a = py::none(), "cycle"_a = "nedc", "threads"_a = py::none(),
+        R"(A sweep of one or two tyre parameters (`rollsim sweep --json`).
+
+tyre: file, shipped name or dict. axes: [(param, from, to[, steps])], param one of pressure [bar], diameter [mm],
+width [mm], load [N], load-pct [%], speed [km/h]; steps default 11. load_n [N] (default 80 % of the maximum
+load), speed_kmh [km/h]. With vehicle (and cycle) each point is a forward simulation of the car (on `threads`
+threads, default every core). Returns a list of dicts, one per point: the swept values (e.g. pressure_bar),
+load_n, speed_kmh, rrc, rr_force_n, rr_power_w, and the car's kwh_per_10km or l_per_100km. A range leaving the
+model's domain stops with a warning and returns the valid points.)");
+
+  m.def("diagnose", &api_diagnose, "vehicle"_a, "recordings"_a, "columns"_a = py::dict(), "scales"_a = py::dict(),
+        "preset"_a = "", "tyre"_a = py::none(),
+        R"(Diagnosis of recordings against the model (`rollsim diagnose --json FILE`).
+
+vehicle: file, shipped name or dict (its recording_columns/recording_scale blocks apply); recordings: CSV paths;
+columns: {canonical: source column} ('' drops one), scales: {canonical: factor}, preset: 'anl_d3' or
+'rsk_twizy'; tyre: on all four wheels. Returns the diagnosis dict (verdict, findings, located, ...).)");
+}

@@ -1,0 +1,247 @@
+"""The Python API against the command line (the built `rollsim` binary, --json), invariants and references.
+
+Run by ctest (Python.Api) with PYTHONPATH=build/python, ROLLSIM_BINARY and ROLLSIM_SHARED_DIR set.
+"""
+import csv
+import json
+import os
+import subprocess
+import tempfile
+import time
+import unittest
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+import rollsim
+
+BINARY = os.environ.get("ROLLSIM_BINARY", str(Path(__file__).resolve().parents[2] / "build" / "rollsim"))
+SHARED = Path(os.environ.get("ROLLSIM_SHARED_DIR", str(Path(__file__).resolve().parents[3] / "shared")))
+REPO = Path(__file__).resolve().parents[2]
+
+
+def cli(*args, expect_ok=True):
+    """Runs the rollsim binary; returns (stdout lines parsed as JSON objects, stderr)."""
+    p = subprocess.run([BINARY, *args], capture_output=True, text=True, cwd=REPO)
+    if expect_ok and p.returncode != 0:
+        raise AssertionError(f"rollsim {' '.join(args)} failed: {p.stderr}")
+    lines = [json.loads(line) for line in p.stdout.splitlines() if line.startswith("{")] if expect_ok else []
+    return lines, p.stderr, p.returncode
+
+
+class TyreApi(unittest.TestCase):
+    def test_shipped_file_matches_cli(self):
+        (expected,), _, _ = cli("tyre", "175-70R14", "--json")
+        self.assertEqual(rollsim.tyre("175-70R14"), expected)
+
+    def test_geometry_and_speeds_match_cli(self):
+        rows, _, _ = cli("tyre", "--outer-radius-m", "0.305", "--width-m", "0.195", "--pressure-bar", "2.1",
+                         "--load-n", "4000", "--speed-kmh", "50,100,130", "--json")
+        got = rollsim.tyre(outer_radius_m=0.305, width_m=0.195, pressure_bar=2.1, load_n=4000,
+                           speed_kmh=np.array([50.0, 100.0, 130.0]))
+        for key in ("rrc", "rr_force_n", "rr_power_w", "deflection_m", "contact_length_m", "speed_kmh", "load_n"):
+            np.testing.assert_array_equal(got[key], [r[key] for r in rows], err_msg=key)
+        self.assertEqual(got["tyre"], rows[0]["tyre"])
+
+    def test_size_designation_matches_cli(self):
+        (expected,), _, _ = cli("tyre", "--size", "205/55 R16 91V", "--pressure-bar", "2.3", "--load-pct", "70",
+                                "--json")
+        self.assertEqual(rollsim.tyre(size="205/55 R16 91V", pressure_bar=2.3, load_pct=70), expected)
+
+    def test_array_and_scalar_speeds_agree_and_power_is_force_times_speed(self):
+        speeds = np.linspace(0.0, 200.0, 41)
+        arrays = rollsim.tyre("nominal", load_n=3800, speed_kmh=speeds)
+        self.assertEqual(arrays["rrc"].shape, speeds.shape)
+        for i, v in enumerate(speeds):
+            one = rollsim.tyre("nominal", load_n=3800, speed_kmh=float(v))
+            self.assertEqual(one["rrc"], arrays["rrc"][i])
+            self.assertEqual(one["rr_power_w"], arrays["rr_power_w"][i])
+        # P = F v (analytic), and the model's limit: no rolling loss at standstill.
+        np.testing.assert_allclose(arrays["rr_power_w"], arrays["rr_force_n"] * speeds / 3.6, rtol=1e-12, atol=1e-9)
+        self.assertEqual(arrays["rrc"][0], 0.0)
+
+    def test_independent_reference_cases(self):
+        # ../shared/reference/tyre_cases.csv: inputs printed rounded (moves outputs by up to 3e-4 relative).
+        with open(SHARED / "reference" / "tyre_cases.csv") as f:
+            rows = list(csv.DictReader(f))
+        self.assertGreater(len(rows), 10)
+        for row in rows:
+            got = rollsim.tyre(outer_radius_m=float(row["outer_radius_m"]), width_m=float(row["section_width_m"]),
+                               pressure_bar=float(row["pressure_bar"]), load_n=float(row["load_n"]),
+                               speed_kmh=float(row["speed_kmh"]))
+            self.assertAlmostEqual(got["rrc"] / float(row["rrc"]), 1.0, delta=1e-3, msg=str(row))
+            self.assertAlmostEqual(got["rr_power_w"] / float(row["rr_power_w"]), 1.0, delta=1e-3, msg=str(row))
+
+
+class SimulateApi(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.ev = rollsim.simulate(vehicle="ev", tyre="nominal", cycle="nedc")
+
+    def test_summary_is_the_cli_json(self):
+        (expected,), _, _ = cli("simulate", "--vehicle", "ev", "--tyre", "nominal", "--json")
+        self.assertEqual(self.ev["summary"], expected)
+
+    def test_trace_is_the_cli_trace(self):
+        with tempfile.TemporaryDirectory() as d:
+            path = Path(d) / "trace.csv"
+            cli("simulate", "--vehicle", "ev", "--tyre", "nominal", "--trace", str(path))
+            with open(path) as f:
+                rows = list(csv.DictReader(f))
+        trace = self.ev["trace"]
+        self.assertEqual(list(trace.keys()), list(rows[0].keys()))
+        for name, values in trace.items():
+            # The CSV keeps 8 significant digits.
+            np.testing.assert_allclose(values, [float(r[name]) for r in rows], rtol=6e-8, atol=1e-9, err_msg=name)
+
+    def test_energy_balance_from_trace(self):
+        # Wheel energy of each force integrated over the trace (trapezoid on the solver's output points)
+        # against the run's own bookkeeping, and the summary's balance closure.
+        t = self.ev["trace"]
+        v_mps = t["speed_kmh"] / 3.6
+        breakdown = self.ev["summary"]["energy_breakdown_kwh"]
+        rolling_kwh = np.trapz(t["rolling_force_n"] * v_mps, t["time_s"]) / 3.6e6
+        self.assertAlmostEqual(rolling_kwh / breakdown["rolling_resistance"], 1.0, delta=5e-3)
+        aero_kwh = np.trapz(t["aero_force_n"] * v_mps, t["time_s"]) / 3.6e6
+        self.assertAlmostEqual(aero_kwh / breakdown["aerodynamic_drag"], 1.0, delta=5e-3)
+        # Distance: the integral of speed.
+        self.assertAlmostEqual(np.trapz(v_mps, t["time_s"]) / 1e3 / self.ev["summary"]["distance_km"], 1.0,
+                               delta=1e-3)
+
+    def test_replay_matches_cli(self):
+        (expected,), _, _ = cli("simulate", "--vehicle", "ice", "--replay", "--cycle", "udds", "--json")
+        got = rollsim.simulate(vehicle="ice", cycle="udds", replay=True, trace=False)
+        self.assertEqual(got["summary"], expected)
+        self.assertEqual(got["trace"], {})
+
+    def test_user_arrays_and_dicts_give_the_file_results(self):
+        # The shipped files read into Python objects as a user would (python3-yaml, numpy), against the CLI on
+        # the files themselves. Speeds given in m/s round differently in the last bit, which the adaptive solver carries to about 1e-9.
+        import yaml
+        (expected,), _, _ = cli("simulate", "--vehicle", "vehicles/ev.yaml", "--tyre", "tyres/nominal.yaml",
+                                "--cycle", "cycles/nedc.csv", "--json")
+        data = np.loadtxt(REPO / "cycles" / "nedc.csv", delimiter=",", skiprows=1)
+        with open(REPO / "vehicles" / "ev.yaml") as f:
+            vehicle = yaml.safe_load(f)
+        with open(REPO / "tyres" / "nominal.yaml") as f:
+            tyre = yaml.safe_load(f)
+        for cycle, tol in (((data[:, 0], data[:, 1]), 0.0), ({"time_s": data[:, 0], "speed_mps": data[:, 1] / 3.6}, 1e-7)):
+            got = rollsim.simulate(vehicle=vehicle, tyre=tyre, cycle=cycle, trace=False)["summary"]
+            self.assertEqual(got["cycle"], "user trace")
+            for key in ("distance_km", "aec_kwh_per_10km", "range_km"):
+                self.assertAlmostEqual(got[key] / expected[key], 1.0, delta=tol, msg=key)
+            for key, kwh in expected["energy_breakdown_kwh"].items():
+                self.assertAlmostEqual(got["energy_breakdown_kwh"][key], kwh, delta=tol * abs(kwh), msg=key)
+
+
+class SelectionApi(unittest.TestCase):
+    def test_compare_matches_cli(self):
+        expected, _, _ = cli("compare", "--vehicle", "ev", "--tyre", "low-rrc", "--tyre", "175-65R15", "--json")
+        self.assertEqual(rollsim.compare("ev", tyres=["low-rrc", "175-65R15"]), expected)
+
+    def test_sweep_matches_cli(self):
+        expected, _, _ = cli("sweep", "--tyre", "175-70R14", "--param", "pressure", "--from", "1.5", "--to", "3.5",
+                             "--steps", "5", "--param", "speed", "--from", "40", "--to", "120", "--steps", "3",
+                             "--json")
+        got = rollsim.sweep("175-70R14", [("pressure", 1.5, 3.5, 5), ("speed", 40, 120, 3)])
+        self.assertEqual(got, expected)
+        # RRC falls with pressure at each speed (the model's published trend).
+        for speed in (40, 80, 120):
+            rrc = [p["rrc"] for p in got if p["speed_kmh"] == speed]
+            self.assertTrue(all(a > b for a, b in zip(rrc, rrc[1:])), rrc)
+
+
+    def test_sweep_leaving_the_domain_warns_and_returns_the_cli_points(self):
+        p = subprocess.run([BINARY, "sweep", "--tyre", "175-70R14", "--param", "load", "--from", "2000", "--to", "60000",
+                            "--steps", "40", "--json"], capture_output=True, text=True, cwd=REPO)
+        self.assertEqual(p.returncode, 2, p.stderr)
+        expected = [json.loads(line) for line in p.stdout.splitlines()]
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            got = rollsim.sweep("175-70R14", [("load", 2000, 60000, 40)])
+        self.assertEqual(got, expected)
+        self.assertTrue(0 < len(got) < 40)
+        self.assertEqual(len(caught), 1)
+        self.assertIn(str(caught[0].message).split(" (the ")[0], p.stderr)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            with self.assertRaises(UserWarning):
+                rollsim.sweep("175-70R14", [("load", 2000, 60000, 40)])
+
+
+class DiagnoseApi(unittest.TestCase):
+    def test_diagnose_matches_cli(self):
+        rec = str(SHARED / "data" / "recordings" / "rsk_renault_twizy" / "T1_07_01_2021.csv")
+        with tempfile.TemporaryDirectory() as d:
+            out = Path(d) / "d.json"
+            cli("diagnose", "--vehicle", "twizy", "--preset", "rsk_twizy", "--recording", rec, "--json", str(out))
+            expected = json.loads(out.read_text())
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # the recording's repairs, as the CLI prints them
+            got = rollsim.diagnose(vehicle="twizy", recordings=[rec], preset="rsk_twizy")
+        self.assertEqual(got, expected)
+        self.assertIn(got["verdict"], ("nothing_missing", "missing_physics", "unexplained"))
+
+
+class GilRelease(unittest.TestCase):
+    def test_python_runs_while_a_simulation_runs(self):
+        # A worker thread runs NEDC simulations; the main thread notes the time at each turn of a loop while the
+        # worker is inside the call. With the GIL held for the call, the main thread would stand still throughout.
+        import threading
+        state = {"inside": False, "done": False, "t0": 0.0, "t1": 0.0}
+
+        def worker():
+            state["inside"] = True
+            state["t0"] = time.perf_counter()
+            rollsim.sweep("nominal", [("pressure", 1.8, 3.0, 30)], vehicle="ev", threads=1)
+            state["t1"] = time.perf_counter()
+            state["done"] = True
+
+        ticks = []
+        t = threading.Thread(target=worker)
+        t.start()
+        while not state["done"]:
+            if state["inside"]:
+                ticks.append(time.perf_counter())
+        t.join()
+        during = [x for x in ticks if state["t0"] <= x <= state["t1"]]
+        duration = state["t1"] - state["t0"]
+        self.assertGreater(len(during), 100, f"the main thread ran {len(during)} times in {duration:.3f} s")
+        edges = [state["t0"], *during, state["t1"]]
+        largest_gap = max(b - a for a, b in zip(edges, edges[1:]))
+        self.assertLess(largest_gap, 0.5 * duration, f"the main thread stood still {largest_gap:.3f} of {duration:.3f} s")
+
+
+class InputErrors(unittest.TestCase):
+    def assert_cli_message(self, call, *cli_args):
+        _, stderr, code = cli(*cli_args, expect_ok=False)
+        self.assertEqual(code, 2)
+        with self.assertRaises(rollsim.InputError) as ctx:
+            call()
+        self.assertEqual("error: " + str(ctx.exception), stderr.strip())
+
+    def test_messages_are_the_cli_messages(self):
+        self.assert_cli_message(lambda: rollsim.tyre(outer_radius_m=0.3, width_m=0.2, pressure_bar=-1),
+                                "tyre", "--outer-radius-m", "0.3", "--width-m", "0.2", "--pressure-bar", "-1")
+        self.assert_cli_message(lambda: rollsim.tyre("175-70R14", speed_kmh=[50, 600]),
+                                "tyre", "175-70R14", "--speed-kmh", "50,600")
+        self.assert_cli_message(lambda: rollsim.simulate(vehicle="no-such-car"),
+                                "simulate", "--vehicle", "no-such-car")
+        self.assert_cli_message(lambda: rollsim.sweep("175-70R14", [("presure", 1, 2)]),
+                                "sweep", "--tyre", "175-70R14", "--param", "presure", "--from", "1", "--to", "2")
+
+    def test_bad_user_data(self):
+        self.assertTrue(issubclass(rollsim.InputError, ValueError))
+        with self.assertRaisesRegex(rollsim.InputError, "strictly increasing"):
+            rollsim.simulate(cycle=([0, 1, 1, 2], [0, 5, 10, 5]))
+        with self.assertRaisesRegex(rollsim.InputError, "finite"):
+            rollsim.simulate(cycle=([0, 1, 2], [0, float("nan"), 5]))
+        with self.assertRaisesRegex(rollsim.InputError, "presure_bar"):
+            rollsim.simulate(tyre={"outer_radius_m": 0.3, "section_width_m": 0.2, "presure_bar": 2.1})
+        with self.assertRaisesRegex(rollsim.InputError, "speed_kmh"):
+            rollsim.simulate(cycle={"time_s": [0, 1, 2], "speed_kmh": [0, 5]})
+
+
+if __name__ == "__main__":
+    unittest.main()

@@ -1,0 +1,117 @@
+#include "rollsim/selection/front_end.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+#include "rollsim/common/error.hpp"
+#include "rollsim/common/format.hpp"
+#include "rollsim/common/units.hpp"
+#include "rollsim/common/yaml_reader.hpp"
+
+namespace rollsim::selection {
+
+CandidateList load_candidates(const std::vector<std::string>& tyres, bool use_catalogue, const std::string& catalogue) {
+  CandidateList out;
+  for (const auto& t : tyres) out.tyres.push_back(load_tyre_file(resolve_data_file(t, "tyres", ".yaml", "--tyre")));
+  if (!use_catalogue && !tyres.empty()) return out;
+  namespace fs = std::filesystem;
+  const std::string dir = catalogue.empty() ? data_root() + "/tyres/catalogue" : catalogue;
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) throw InputError("--catalogue " + dir, "not a folder");
+  std::vector<std::string> files;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    if (e.path().extension() == ".yaml" || e.path().extension() == ".yml") files.push_back(e.path().string());
+  }
+  std::sort(files.begin(), files.end());
+  if (files.empty()) throw InputError("--catalogue " + dir, "holds no *.yaml tyre files");
+  for (const auto& f : files) {
+    try {
+      out.tyres.push_back(load_tyre_file(f));
+    } catch (const std::exception& e) {
+      out.broken.push_back(e.what());
+    }
+  }
+  return out;
+}
+
+double parse_diameter_tolerance_pct(const std::string& text) {
+  return parse_option_number(text, "--diameter-tolerance-pct", Range::open_low(0.0, 100.0));
+}
+
+std::string tyre_size_text(const TyreSpec& t) {
+  if (t.size) return t.size->designation;
+  return "R" + fixed(t.state.geometry.outer_radius_m * 1e3, 0) + " W" +
+         fixed(t.state.geometry.section_width_m * 1e3, 0);
+}
+
+std::vector<JsonObject> comparison_json(const Comparison& c) {
+  std::vector<JsonObject> out;
+  auto emit = [&](const CandidateResult& r, int rank) {
+    JsonObject j;
+    j.add("vehicle", c.vehicle).add("cycle", c.cycle).add("tyre", r.tyre.name).add("source", r.tyre.source);
+    j.add("size", tyre_size_text(r.tyre)).add("own", r.is_own);
+    if (rank > 0) j.add("rank", rank); else j.add_null("rank");
+    j.add("pressure_bar", units::pa_to_bar(r.tyre.state.pressure_pa))
+        .add("wheel_load_n", r.fit.wheel_load_n)
+        .add("capacity_n", r.fit.capacity_n)
+        .add("diameter_change_pct", r.fit.diameter_change_pct)
+        .add("rrc_80kmh", r.rrc_80)
+        .add("rr_power_80kmh_w", r.rr_power_80_w)
+        .add(c.unit, r.value)
+        .add("diff_pct", r.diff_pct);
+    if (c.shows_range) j.add("range_km", r.range_km).add("range_change_km", r.range_change_km);
+    j.add("fits", r.fit.fits).add("reason", r.fit.reason);
+    out.push_back(j);
+  };
+  for (std::size_t i = 0; i < c.ranked.size(); ++i) emit(c.ranked[i], static_cast<int>(i + 1));
+  for (const auto& r : c.unfit) emit(r, 0);
+  return out;
+}
+
+SweepOptions sweep_options_from_request(const SweepRequest& o) {
+  if (o.params.empty()) throw InputError("--param", "missing: pressure, diameter, width, load, load-pct or speed");
+  if (o.params.size() > 2) throw InputError("--param", "at most two parameters (a grid)");
+  if (o.from.size() != o.params.size() || o.to.size() != o.params.size()) {
+    throw InputError("--from/--to", "give one --from and one --to per --param");
+  }
+  if (o.steps.size() > o.params.size()) throw InputError("--steps", "more --steps than --param");
+  SweepOptions so;
+  for (std::size_t i = 0; i < o.params.size(); ++i) {
+    const auto p = parse_sweep_param(o.params[i]);
+    const std::string opt = "--param " + o.params[i];
+    if (!p) throw InputError(opt, "unknown: must be pressure, diameter, width, load, load-pct or speed");
+    SweepAxis a;
+    a.param = *p;
+    a.from = parse_option_number(o.from[i], "--from", Range{});
+    a.to = parse_option_number(o.to[i], "--to", Range{});
+    if (i < o.steps.size()) {
+      const double n = parse_option_number(o.steps[i], "--steps", Range::closed(-1e9, 1e6));
+      if (n != std::floor(n)) throw InputError("--steps", format_value(n) + " is not allowed: must be a whole number >= 2");
+      a.steps = static_cast<int>(n);
+    }
+    check_axis(a, opt);
+    so.axes.push_back(a);
+  }
+  if (!o.load_n.empty()) so.load_n = parse_option_number(o.load_n, "--load-n", Range::open_low(0.0, 1e6));
+  so.speed_kmh = parse_option_number(o.speed_kmh, "--speed-kmh", Range::closed(0.0, 500.0));
+  if (!o.threads.empty()) so.threads = static_cast<unsigned>(parse_option_number(o.threads, "--threads", Range::closed(1, 1024)));
+  return so;
+}
+
+std::vector<JsonObject> sweep_json(const SweepResult& r) {
+  std::vector<JsonObject> out;
+  for (const auto& p : r.points) {
+    JsonObject j;
+    for (std::size_t i = 0; i < r.axes.size(); ++i) {
+      j.add(sweep_param_key(r.axes[i].param) + "_" + sweep_param_unit(r.axes[i].param), p.values[i]);
+    }
+    j.add("load_n", p.load_n).add("speed_kmh", p.speed_kmh).add("rrc", p.rr.rrc).add("rr_force_n", p.rr.rr_force_n)
+        .add("rr_power_w", p.rr.rr_power_w);
+    if (r.vehicle) j.add(r.energy_unit, p.energy);
+    out.push_back(j);
+  }
+  return out;
+}
+
+}  // namespace rollsim::selection
