@@ -22,6 +22,7 @@ struct DiagnoseCliOptions {
   std::string vehicle, tyre, preset, json, write_vehicle, report;
   std::vector<std::string> recordings, columns, scales;
   double window_s = 0.0;  // 0: the library default
+  bool road_profile = false;
 };
 
 void run_diagnose(const DiagnoseCliOptions& o) {
@@ -42,6 +43,7 @@ void run_diagnose(const DiagnoseCliOptions& o) {
     for (const auto& rep : r.repairs) (rep.rfind("warning:", 0) == 0 ? std::cerr : std::cout) << r.source << ": " << rep << "\n";
   DiagnoseOptions dopt;
   if (o.window_s > 0.0) dopt.window_s = o.window_s;
+  dopt.infer_road_profile = o.road_profile;
   const Diagnosis d = diagnose(v, recs, dopt);
   std::cout << diagnosis_text(d);
   std::vector<OutputFile> files;
@@ -75,6 +77,8 @@ void register_diagnose_command(CLI::App& app) {
   sub->add_option("--json", o->json, "Write the diagnosis as JSON")->type_name("FILE");
   sub->add_option("--window-s", o->window_s, "Energy window length [s] (default 60; SOC channels lengthen it by the quantum)")
       ->check(CLI::Range(5.0, 3600.0));
+  sub->add_flag("--road-profile", o->road_profile, "Where elevation is not recorded, try an elevation profile along the "
+                "route as an explanation (opt-in: on one pass it also absorbs slow drifts in time; README)");
   sub->add_option("--report", o->report, "Write figures (SVG, gnuplot) and report.html into this folder")->type_name("DIR");
   sub->add_option("--write-vehicle", o->write_vehicle, "Write the vehicle with the fitted effects switched on")->type_name("FILE");
   sub->callback([o] { run_diagnose(*o); });

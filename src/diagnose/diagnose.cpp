@@ -101,7 +101,9 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
   std::vector<EffectId> chosen;
   out.findings = select_effects(sc, sig.candidates, m, chosen);
   out.detection_limits = detection_limits(sig.candidates, chosen, m, opt);
-  if (auto f = infer_road_profile(sc, cycles, sig, out.findings, chosen, floor, m, out.notes)) out.findings.push_back(std::move(*f));
+  if (sc.opt.infer_road_profile) {
+    if (auto f = infer_road_profile(sc, cycles, sig, out.findings, chosen, floor, m, out.notes)) out.findings.push_back(std::move(*f));
+  }
   if (auto f = describe_unexplained(sc, cycles, sig.basis, m)) out.findings.push_back(std::move(*f));
   const Adequacy after = test_adequacy(obs, recordings, per_recording_residual(m, obs, recordings.size()), floor, opt);
   out.final_residual_to_noise_ratio = after.ratio, out.final_residual_to_noise_z = after.z;

@@ -292,7 +292,9 @@ BenchResult run_discovery_bench(const Vehicle& vehicle, const BenchOptions& opt)
       } else {
         recs.push_back(generate_case(car, s));
       }
-      const Diagnosis d = diagnose(car, recs);
+      DiagnoseOptions dopt;
+      dopt.infer_road_profile = opt.infer_road_profile;
+      const Diagnosis d = diagnose(car, recs, dopt);
       Outcome& o = out[k];
       for (const auto& f : d.findings)
         o.findings.push_back({f.effect, f.confounded_with, f.parameters.empty() ? 0.0 : f.parameters.front().value});
