@@ -15,7 +15,6 @@ namespace {
 
 Vehicle vehicle(const std::string& name) { return load_vehicle_file(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/" + name); }
 
-EffectContext context(const Vehicle& v) { return effect_context(v); }
 
 SimulationResult run(const Vehicle& v, std::shared_ptr<const Effect> e, bool forward = false) {
   VehicleModel m = VehicleModel::assemble(v);
@@ -31,7 +30,7 @@ TEST(EffectCatalogue, NeutralParametersLeaveEnergyUnchanged) {
     const Vehicle v = vehicle(file);
     const double base = source_j(run(v, nullptr));
     for (const auto& info : effect_catalogue()) {
-      const double e = source_j(run(v, make_effect(info.id, {}, context(v))));
+      const double e = source_j(run(v, make_effect(info.id, {}, effect_context(v))));
       EXPECT_NEAR(e, base, 1e-9 * base) << file << " " << info.name;
     }
   }
@@ -40,7 +39,7 @@ TEST(EffectCatalogue, NeutralParametersLeaveEnergyUnchanged) {
 TEST(EffectCatalogue, EachEffectMovesEnergyInThePhysicalDirection) {
   for (const char* file : {"ev.yaml", "ice.yaml"}) {
     const Vehicle v = vehicle(file);
-    const auto ctx = context(v);
+    const auto ctx = effect_context(v);
     const SimulationResult base = run(v, nullptr);
     auto more = [&](const std::string& id, EffectParameters p) { return source_j(run(v, make_effect(id, p, ctx))) - source_j(base); };
     EXPECT_GT(more("tyre_warmup", {{"cold_rrc_excess", 0.2}}), 0.0) << file;      // a cold tyre rolls harder
@@ -62,8 +61,8 @@ TEST(EffectCatalogue, RotationalInertiaCostsLessThanTheSameMass) {
   // The same kilograms as rotating mass act on acceleration only; as payload they also roll: mass costs more.
   const Vehicle v = vehicle("ev.yaml");
   const double base = source_j(run(v, nullptr));
-  const double rot = source_j(run(v, make_effect("rotational_inertia", {{"extra_rotating_mass_kg", 100}}, context(v)))) - base;
-  const double mass = source_j(run(v, make_effect("mass", {{"extra_mass_kg", 100}}, context(v)))) - base;
+  const double rot = source_j(run(v, make_effect("rotational_inertia", {{"extra_rotating_mass_kg", 100}}, effect_context(v)))) - base;
+  const double mass = source_j(run(v, make_effect("mass", {{"extra_mass_kg", 100}}, effect_context(v)))) - base;
   EXPECT_GT(rot, 0.0);
   EXPECT_GT(mass, rot);
 }
@@ -75,7 +74,7 @@ TEST(EffectCatalogue, BatteryResistanceDrainsTheCellsNotTheTerminals) {
   SimulationOptions so;
   so.record_trace = true;
   VehicleModel m0 = VehicleModel::assemble(v), m1 = m0;
-  m1.effects.push_back(make_effect("battery_resistance", {{"extra_resistance_ohm", 0.1}, {"pack_voltage_v", 360}}, context(v)));
+  m1.effects.push_back(make_effect("battery_resistance", {{"extra_resistance_ohm", 0.1}, {"pack_voltage_v", 360}}, effect_context(v)));
   const DriveCycle c = load_cycle("wltc");
   const SimulationResult a = simulate_replay(m0, c, so), b = simulate_replay(m1, c, so);
   EXPECT_NEAR(b.energy.battery_terminal_j, a.energy.battery_terminal_j, 1e-9 * a.energy.battery_terminal_j);
@@ -89,26 +88,26 @@ TEST(EffectCatalogue, BatteryResistanceDrainsTheCellsNotTheTerminals) {
   EXPECT_LT(b.battery->final_soc, a.battery->final_soc);
   // A combustion car has no traction battery: nothing changes.
   const Vehicle ice = vehicle("ice.yaml");
-  EXPECT_NEAR(source_j(run(ice, make_effect("battery_resistance", {{"extra_resistance_ohm", 0.1}}, context(ice)))),
+  EXPECT_NEAR(source_j(run(ice, make_effect("battery_resistance", {{"extra_resistance_ohm", 0.1}}, effect_context(ice)))),
               source_j(run(ice, nullptr)), 1e-9 * source_j(run(ice, nullptr)));
 }
 
 TEST(EffectCatalogue, RegenLimitCostsOnlyAnElectricCarAndOnlyWhenBraking) {
   const Vehicle ev = vehicle("ev.yaml");
   const SimulationResult base = run(ev, nullptr);
-  const SimulationResult lim = run(ev, make_effect("regen_limit", {{"friction_share_above_limit", 1.0}, {"regen_limit_w", 3000}}, context(ev)));
+  const SimulationResult lim = run(ev, make_effect("regen_limit", {{"friction_share_above_limit", 1.0}, {"regen_limit_w", 3000}}, effect_context(ev)));
   EXPECT_GT(lim.energy.battery_terminal_j, base.energy.battery_terminal_j);  // less recovered
   EXPECT_LT(lim.energy.regen_wheel_j, base.energy.regen_wheel_j);
   EXPECT_NEAR(lim.energy.traction_j, base.energy.traction_j, 1e-9 * base.energy.traction_j);  // driving untouched
   // The recovered braking energy cannot exceed what a 3 kW cap lets through over the braking time.
   // A lower limit costs more.
-  const SimulationResult lower = run(ev, make_effect("regen_limit", {{"friction_share_above_limit", 1.0}, {"regen_limit_w", 1000}}, context(ev)));
+  const SimulationResult lower = run(ev, make_effect("regen_limit", {{"friction_share_above_limit", 1.0}, {"regen_limit_w", 1000}}, effect_context(ev)));
   EXPECT_GT(lower.energy.battery_terminal_j, lim.energy.battery_terminal_j);
 }
 
 TEST(EffectCatalogue, EngineWarmupCostsFuelEarlyAndNothingOnAnElectricCar) {
   const Vehicle ice = vehicle("ice.yaml"), ev = vehicle("ev.yaml");
-  const auto warm = [](const Vehicle& v, double k) { return make_effect("engine_warmup", {{"cold_fuel_excess", k}}, context(v)); };
+  const auto warm = [](const Vehicle& v, double k) { return make_effect("engine_warmup", {{"cold_fuel_excess", k}}, effect_context(v)); };
   const double base = run(ice, nullptr).energy.fuel_j;
   const double cold = run(ice, warm(ice, 0.2)).energy.fuel_j;
   EXPECT_GT(cold, base);
@@ -131,7 +130,7 @@ TEST(EffectCatalogue, AuxLoadOnAnElectricCarCostsExactlyItsEnergy) {
   // A constant consumer drawn at the terminals adds P x duration to terminal energy (its I^2 R is neglected).
   const Vehicle v = vehicle("ev.yaml");
   const SimulationResult base = run(v, nullptr);
-  const SimulationResult with = run(v, make_effect("aux_load", {{"power_w", 400}}, context(v)));
+  const SimulationResult with = run(v, make_effect("aux_load", {{"power_w", 400}}, effect_context(v)));
   EXPECT_NEAR(with.energy.battery_terminal_j - base.energy.battery_terminal_j, 400.0 * base.duration_s, 1e-6 * base.energy.battery_terminal_j);
 }
 
@@ -139,7 +138,7 @@ TEST(EffectCatalogue, TyreWarmupRollingExcessFadesAsTheTyreHeats) {
   // Over a long trip the cold excess fades: the rolling energy rises by much less than the full excess.
   const Vehicle v = vehicle("ev.yaml");
   const SimulationResult base = run(v, nullptr);
-  const SimulationResult w = run(v, make_effect("tyre_warmup", {{"cold_rrc_excess", 0.2}}, context(v)));
+  const SimulationResult w = run(v, make_effect("tyre_warmup", {{"cold_rrc_excess", 0.2}}, effect_context(v)));
   const double rise = w.energy.rolling_j / base.energy.rolling_j - 1.0;
   EXPECT_GT(rise, 0.0);
   EXPECT_LT(rise, 0.2);
@@ -150,7 +149,7 @@ TEST(EffectCatalogue, EnergyBalancesCloseWithEveryEffectOn) {
   // wheel residual, ~0.4 % on WLTC before any effect, belongs to the base model and is compared against).
   for (const char* file : {"ev.yaml", "ice.yaml"}) {
     const Vehicle v = vehicle(file);
-    const auto ctx = context(v);
+    const auto ctx = effect_context(v);
     const SimulationResult base_replay = run(v, nullptr, false), base_forward = run(v, nullptr, true);
     for (const auto& info : effect_catalogue()) {
       EffectParameters p;
