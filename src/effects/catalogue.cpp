@@ -49,7 +49,8 @@ struct RegenLimitParams {
   double friction_share_above_limit, regen_limit_w;
 };
 struct EngineWarmupParams {
-  double cold_fuel_excess, heat_capacity_j_per_k, idle_heat_w, heat_per_wheel_work, heat_loss_w_per_k, warm_excess_k;
+  double cold_fuel_excess, heat_capacity_j_per_k, idle_heat_w, heat_per_wheel_work, heat_loss_w_per_k, warm_excess_k,
+      soak_cooling_s, initial_excess_k;
 };
 struct RoadGradeParams {
   double grade_offset, profile_wavelength_m;
@@ -222,15 +223,24 @@ class RegenLimit final : public Effect {
 // Cold engine: hidden oil/block temperature above ambient T [K]; friction raises the fuel power by a factor
 // 1 + k max(0, 1 - T / T_warm). Heat balance C dT/dt = Q_idle + q max(0, F v) - h T: the hooks carry no fuel power,
 // so the fuel loss reaching the oil is taken as an idle part plus a share q of the wheel work (a Willans engine's
-// loss grows with its work). Neutral on an electric car: there is no fuel power to scale.
+// loss grows with its work). Switched off (a soak), it makes no heat and cools towards ambient by Newton's law with
+// its own time constant (the bonnet closed, no coolant flow: far slower than h / C running). It starts at
+// initial_excess_k (0: cold at ambient), or warm on a trace that starts hot. Neutral on an electric car: there is no
+// fuel power to scale.
 class EngineWarmup final : public Effect {
  public:
   EngineWarmup(const EngineWarmupParams& p, const EffectContext&)
-      : k_(p.cold_fuel_excess), c_(p.heat_capacity_j_per_k), idle_(p.idle_heat_w),
-        q_(p.heat_per_wheel_work), h_(p.heat_loss_w_per_k), warm_(p.warm_excess_k) {}
+      : k_(p.cold_fuel_excess), c_(p.heat_capacity_j_per_k), idle_(p.idle_heat_w), q_(p.heat_per_wheel_work),
+        h_(p.heat_loss_w_per_k), warm_(p.warm_excess_k), soak_s_(p.soak_cooling_s), initial_(p.initial_excess_k) {}
   std::string id() const override { return "engine_warmup"; }
   int num_states() const override { return 1; }
+  void initial_states(double* x) const override { x[0] = initial_; }
+  void hot_start_states(double* x) const override { x[0] = std::max(x[0], warm_); }
   void state_derivatives(const EffectInputs& in, const double* x, double* xdot) const override {
+    if (in.engine_off) {
+      xdot[0] = -x[0] / soak_s_;
+      return;
+    }
     const double work_w = std::max(0.0, in.wheel_force_demand_n * std::max(in.speed_mps, 0.0));
     xdot[0] = (idle_ + q_ * work_w - h_ * x[0]) / c_;
   }
@@ -239,7 +249,7 @@ class EngineWarmup final : public Effect {
   }
 
  private:
-  double k_, c_, idle_, q_, h_, warm_;
+  double k_, c_, idle_, q_, h_, warm_, soak_s_, initial_;
 };
 
 // Missing or wrong road grade: a grade offset theta(s) = g0 (constant, wavelength 0) or g0 cos(2 pi s / L) (an
@@ -341,14 +351,17 @@ std::vector<EffectInfo> build_catalogue() {
        {&RegenLimitParams::regen_limit_w, {"regen_limit_w", "W", 10000.0, 10000.0, 0.0, 200000.0, false}}}));
   c.push_back(row<EngineWarmup, EngineWarmupParams>(
       I::engine_warmup, "engine_warmup",
-      "cold engine: fuel power x (1 + k max(0, 1 - T_oil / T_warm)), oil heated by the engine's losses",
+      "cold engine: fuel power x (1 + k max(0, 1 - T_oil / T_warm)), oil heated by the engine's losses, cooling to "
+      "ambient (time constant soak_cooling_s) while switched off",
       "fuel rate rising over the trip (the opposite of an engine warm-up)",
       {{&EngineWarmupParams::cold_fuel_excess, {"cold_fuel_excess", "1", 0.0, 0.2, 0.0, 2.0, true}},
        {&EngineWarmupParams::heat_capacity_j_per_k, {"heat_capacity_j_per_k", "J/K", 100000.0, 100000.0, 5000.0, 2000000.0, false}},
        {&EngineWarmupParams::idle_heat_w, {"idle_heat_w", "W", 2000.0, 2000.0, 0.0, 50000.0, false}},
        {&EngineWarmupParams::heat_per_wheel_work, {"heat_per_wheel_work", "1", 0.6, 0.6, 0.0, 5.0, false}},
        {&EngineWarmupParams::heat_loss_w_per_k, {"heat_loss_w_per_k", "W/K", 40.0, 40.0, 1.0, 2000.0, false}},
-       {&EngineWarmupParams::warm_excess_k, {"warm_excess_k", "K", 60.0, 60.0, 1.0, 150.0, false}}}));
+       {&EngineWarmupParams::warm_excess_k, {"warm_excess_k", "K", 60.0, 60.0, 1.0, 150.0, false}},
+       {&EngineWarmupParams::soak_cooling_s, {"soak_cooling_s", "s", 3600.0, 3600.0, 60.0, 86400.0, false}},
+       {&EngineWarmupParams::initial_excess_k, {"initial_excess_k", "K", 0.0, 0.0, 0.0, 150.0, false}}}));
   c.push_back(row<RoadGrade, RoadGradeParams>(
       I::road_grade, "road_grade",
       "missing grade: constant offset or a cosine elevation-profile error along distance, force m g sin(theta)", "",

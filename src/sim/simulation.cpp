@@ -143,6 +143,11 @@ struct Evaluator {
     in.wheel_force_demand_n = force_request_n;
     const double v = std::max(in.speed_mps, 0.0);
     out.wheel_loss_w = 0.0;
+    if (in.engine_off && m.powertrain->fuel()) {
+      // Switched off standing (a soak, start-stop): no fuel and no alternator, so no auxiliaries either.
+      out.flow = PowerFlow{};
+      return;
+    }
     double fuel_factor = 1.0;
     for (std::size_t i = 0; i < m.effects.size(); ++i) {
       out.wheel_loss_w += m.effects[i]->wheel_loss_w(in, x + effect_state_offset[i]);
@@ -374,7 +379,7 @@ class ForwardSystem final : public OdeSystem {
     const double dt = c_.time_s[i + 1] - c_.time_s[i];
     const double a_ref = (c_.speed_mps[i + 1] - c_.speed_mps[i]) / dt;
     const double v_ref = c_.speed_mps[i] + a_ref * (t - c_.time_s[i]);
-    EffectInputs in{t, v_ref, a_ref, c_.grade.empty() ? 0.0 : c_.grade[i], y[kDistance], 0.0, 0.0};
+    EffectInputs in{t, v_ref, a_ref, c_.grade.empty() ? 0.0 : c_.grade[i], y[kDistance], 0.0, 0.0, c_.engine_off_at(i)};
     Instant ff;
     eval_.resistance(loads_[i], in, y + kBaseStates, ff);
     return m_.inertial_mass_kg() * (a_ref + o_.driver_kp_per_s * (v_ref - y[kSpeed]) + o_.driver_ki_per_s2 * y[kDriverIntegral]) +
@@ -407,7 +412,7 @@ class ForwardSystem final : public OdeSystem {
     const double m_eff = m_.inertial_mass_kg();
 
     // Feed-forward: what the trace needs at its own speed; feedback: PI on the speed error.
-    EffectInputs in{t, v_ref, a_ref, grade, y[kDistance], 0.0, 0.0};
+    EffectInputs in{t, v_ref, a_ref, grade, y[kDistance], 0.0, 0.0, standstill_[i] && c_.engine_off_at(i)};
     Instant ff;
     eval_.resistance(rl, in, x, ff);
     const double error_mps = v_ref - v;
@@ -493,6 +498,7 @@ SimulationResult simulate_forward(const VehicleModel& m, const DriveCycle& c, co
     std::size_t off = 0;
     for (const auto& eff : m.effects) {
       eff->initial_states(y0.data() + kBaseStates + off);
+      if (c.engine_hot_start) eff->hot_start_states(y0.data() + kBaseStates + off);
       off += eff->num_states();
     }
   }
@@ -736,6 +742,7 @@ SimulationResult simulate_replay(const VehicleModel& m, const DriveCycle& c, con
     std::size_t off = 0;
     for (const auto& eff : m.effects) {
       eff->initial_states(x.data() + off);
+      if (c.engine_hot_start) eff->hot_start_states(x.data() + off);
       off += eff->num_states();
     }
   }
@@ -750,6 +757,7 @@ SimulationResult simulate_replay(const VehicleModel& m, const DriveCycle& c, con
   SegmentMemo seen(stateless ? c.time_s.size() : 0);
   bool cruise_valid = false, cruise_limited = false;
   double cruise_v = -1.0, cruise_grade = 0.0;
+  bool cruise_engine_off = false;
   SimulationResult r;
   r.mode = "replay";
   bool limited = false;
@@ -757,9 +765,10 @@ SimulationResult simulate_replay(const VehicleModel& m, const DriveCycle& c, con
 
   // Powers at one point of a segment into `rate` (and the effects' state rates into `xdot`).
   Instant s;
+  bool engine_off = false;  // the segment being evaluated switches the engine off (set per segment below)
   auto evaluate_at = [&](double t, double v, double a, double grade, const RoadLoadCoeffs& rl, double dist_m) {
     scheduled_gear = m.powertrain->select_gear(v, scheduled_gear);
-    EffectInputs in{t, v, a, grade, dist_m, 0.0, 0.0};
+    EffectInputs in{t, v, a, grade, dist_m, 0.0, 0.0, engine_off && v == 0.0 && a == 0.0};
     eval.resistance(rl, in, x.data(), s);
     // At rest and staying at rest the car is held on its brakes, as the forward simulation holds it: on a grade the
     // powertrain does not hold it (a machine held at torque would draw its constant loss at every uphill stop).
@@ -806,6 +815,7 @@ SimulationResult simulate_replay(const VehicleModel& m, const DriveCycle& c, con
     const double a = (c.speed_mps[i + 1] - v0) / dt;
     const double grade = c.grade.empty() ? 0.0 : c.grade[i];
     const RoadLoadCoeffs& rl = loads[i];
+    engine_off = c.engine_off_at(i);
     bool segment_limited = false;
     double soc_before_ramp = 0.0;
     std::array<double, kAccumulators> segment_energy_j{};  // a ramp's integral (for the trace)
@@ -817,13 +827,14 @@ SimulationResult simulate_replay(const VehicleModel& m, const DriveCycle& c, con
     }
     if (a == 0.0) {
       // Same speed, grade and (so, with hysteresis) gear as the cruise before: same powers, nothing to evaluate.
-      if (!(stateless && cruise_valid && v0 == cruise_v && grade == cruise_grade)) {
+      if (!(stateless && cruise_valid && v0 == cruise_v && grade == cruise_grade && engine_off == cruise_engine_off)) {
         book_cruise();
         evaluate_at(t0 + 0.5 * dt, v0, 0.0, grade, rl, distance_m);
         cruise_limited = s.flow.force_limited;
         cruise_rate = rate;
         cruise_v = v0;
         cruise_grade = grade;
+        cruise_engine_off = engine_off;
         cruise_valid = true;
         xdot_sum = xdot;
       }

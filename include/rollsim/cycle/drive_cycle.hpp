@@ -18,7 +18,14 @@ struct DriveCycle {
   std::vector<double> time_s;
   std::vector<double> speed_mps;
   std::vector<double> grade;
+  /// Per sample: the engine is switched off over the segment starting here (a soak between two tests, start-stop
+  /// at a light), so it burns no fuel; empty when the engine runs throughout (every shipped cycle and CSV file).
+  std::vector<bool> engine_off;
+  /// The engine is warm when the trace starts (a hot start, e.g. the second half of a test after a short soak);
+  /// otherwise it starts cold, at ambient.
+  bool engine_hot_start = false;
 
+  bool engine_off_at(std::size_t segment) const { return segment < engine_off.size() && engine_off[segment]; }
   double duration_s() const;  ///< last time minus first time
   double distance_m() const;  ///< trapezoid integral of speed, exact for the piecewise-linear trace
 

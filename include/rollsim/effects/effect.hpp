@@ -14,6 +14,7 @@ struct EffectInputs {
   double distance_m = 0.0;
   double base_rolling_force_n = 0.0;  ///< rolling resistance of the base tyre model at this speed
   double wheel_force_demand_n = 0.0;  ///< force the driver asks of the wheels (feed-forward), + propels
+  bool engine_off = false;  ///< the trace switches the engine off here (a soak, start-stop): no fuel, no heat
 };
 
 /// A physical effect with its own parameters and, optionally, hidden states integrated with the vehicle's
@@ -25,6 +26,9 @@ class Effect {
   virtual std::string id() const = 0;
   virtual int num_states() const { return 0; }
   virtual void initial_states(double* /*x*/) const {}
+  /// States at the start of a trace whose engine is already warm (a hot start, DriveCycle::engine_hot_start),
+  /// applied over initial_states; effects without an engine state keep theirs.
+  virtual void hot_start_states(double* /*x*/) const {}
   virtual void state_derivatives(const EffectInputs&, const double* /*x*/, double* /*xdot*/) const {}
   /// Factor on the tyre model's rolling resistance (tyre temperature, ambient temperature).
   virtual double rolling_resistance_factor(const EffectInputs&, const double* /*x*/) const { return 1.0; }
