@@ -20,7 +20,7 @@ namespace {
 
 struct DiagnoseCliOptions {
   std::string vehicle, tyre, preset, json, write_vehicle, report;
-  std::vector<std::string> recordings, columns, scales;
+  std::vector<std::string> recordings, columns, scales, engine_start;
   double window_s = 0.0;  // 0: the library default
   bool road_profile = false;
 };
@@ -44,6 +44,13 @@ void run_diagnose(const DiagnoseCliOptions& o) {
   DiagnoseOptions dopt;
   if (o.window_s > 0.0) dopt.window_s = o.window_s;
   dopt.infer_road_profile = o.road_profile;
+  if (o.engine_start.size() > recs.size())
+    throw InputError("--engine-start", std::to_string(o.engine_start.size()) + " start states given for " +
+                                           std::to_string(recs.size()) + " recordings: give at most one per --recording");
+  for (const auto& s : o.engine_start) {
+    if (s != "cold" && s != "hot") throw InputError("--engine-start", "'" + s + "' is not allowed: cold or hot");
+    dopt.engine_start.push_back(s == "hot" ? EngineStart::hot : EngineStart::cold);
+  }
   const Diagnosis d = diagnose(v, recs, dopt);
   std::cout << diagnosis_text(d);
   std::vector<OutputFile> files;
@@ -79,6 +86,9 @@ void register_diagnose_command(CLI::App& app) {
       ->check(CLI::Range(5.0, 3600.0));
   sub->add_flag("--road-profile", o->road_profile, "Where elevation is not recorded, try an elevation profile along the "
                 "route as an explanation (opt-in: on one pass it also absorbs slow drifts in time; README)");
+  sub->add_option("--engine-start", o->engine_start,
+                  "cold or hot per --recording, in order (default cold, at ambient): a hot test is not warmed up again")
+      ->type_name("STATE");
   sub->add_option("--report", o->report, "Write figures (SVG, gnuplot) and report.html into this folder")->type_name("DIR");
   sub->add_option("--write-vehicle", o->write_vehicle, "Write the vehicle with the fitted effects switched on")->type_name("FILE");
   sub->callback([o] { run_diagnose(*o); });

@@ -61,14 +61,16 @@ class SignatureForce final : public Effect {
 
 // Shapes tested for each effect (each refined by a profile once found): hidden-state effects one per time constant,
 // the regen limit one per limit. A single shape would lose to a neighbour with a grid: an engine warming in minutes
-// looked more like a fast tyre warm-up than like the one slow engine shape, and a 4 kW regen cap needed a friction
+// looked more like a fast tyre warm-up than like the one slow engine shape (and a cold-start test's 3-minute one
+// like a decaying constant power until the 15 kJ/K shape was added), and a 4 kW regen cap needed a friction
 // share above 1 at the one 10 kW limit, out of bounds, so a force-squared loss took its place.
 std::vector<EffectParameters> shapes_of(const EffectInfo& info, ChannelKind channel) {
   if (info.id == EffectId::tyre_warmup)
     return {{{"heat_capacity_j_per_k", 20000.0}}, {{"heat_capacity_j_per_k", 50000.0}}, {{"heat_capacity_j_per_k", 120000.0}}};
   if (info.id == EffectId::engine_warmup) {
     if (channel != ChannelKind::fuel_rate) return {};  // no fuel power to scale: its signature is zero
-    return {{{"heat_capacity_j_per_k", 40000.0}}, {{"heat_capacity_j_per_k", 100000.0}}, {{"heat_capacity_j_per_k", 250000.0}}};
+    return {{{"heat_capacity_j_per_k", 15000.0}}, {{"heat_capacity_j_per_k", 40000.0}}, {{"heat_capacity_j_per_k", 100000.0}},
+            {{"heat_capacity_j_per_k", 250000.0}}};
   }
   if (info.id == EffectId::regen_limit)
     return {{{"regen_limit_w", 3000.0}}, {{"regen_limit_w", 6000.0}}, {{"regen_limit_w", 12000.0}}};

@@ -3,6 +3,8 @@
 // unexplained -> adequacy -> output.
 #include "rollsim/diagnose/diagnose.hpp"
 
+#include <algorithm>
+
 #include "pipeline.hpp"
 #include "rollsim/common/error.hpp"
 #include "rollsim/diagnose/elevation.hpp"
@@ -10,10 +12,30 @@
 namespace rollsim {
 namespace {
 
-std::vector<DriveCycle> cycles_of(const std::vector<Recording>& recordings, std::vector<std::string>& notes) {
+// What the replay takes from the fuel channel about the engine: its switched-off runs and its start state.
+void note_engine_state(const DriveCycle& c, const Recording& r, std::vector<std::string>& notes) {
+  if (!r.fuel_rate_m3ps) return;
+  int runs = 0;
+  double off_s = 0.0;
+  for (std::size_t i = 0; i + 1 < c.time_s.size(); ++i) {
+    if (!c.engine_off_at(i)) continue;
+    if (i == 0 || !c.engine_off_at(i - 1)) ++runs;
+    off_s += c.time_s[i + 1] - c.time_s[i];
+  }
+  notes.push_back(r.source + ": engine " + (c.engine_hot_start ? "hot" : "cold (at ambient)") + " at the start; " +
+                  (runs == 0 ? std::string("never switched off")
+                             : "switched off " + std::to_string(runs) + " times for " + fixed(off_s, 0) +
+                                   " s in all (standing with zero fuel flow): no fuel there, and a cold engine cools"));
+}
+
+std::vector<DriveCycle> cycles_of(const std::vector<Recording>& recordings, const DiagnoseOptions& opt,
+                                  std::vector<std::string>& notes) {
   std::vector<DriveCycle> cycles;
-  for (const Recording& r : recordings) {
-    cycles.push_back(cycle_of_recording(r));
+  for (std::size_t k = 0; k < recordings.size(); ++k) {
+    const Recording& r = recordings[k];
+    const EngineStart start = k < opt.engine_start.size() ? opt.engine_start[k] : EngineStart::cold;
+    cycles.push_back(cycle_of_recording(r, opt.engine_off_min_s, start));
+    note_engine_state(cycles.back(), r, notes);
     if (!r.grade && r.elevation_m)
       notes.push_back(r.source + ": grade from recorded elevation (" +
                       std::to_string(grade_from_elevation(r.time_s, r.speed_mps, *r.elevation_m).rejected_steps) +
@@ -47,8 +69,36 @@ void report_calibration(const diag::Calibration& c, const diag::Observations& o,
 
 }  // namespace
 
-DriveCycle cycle_of_recording(const Recording& r) {
+std::vector<bool> engine_off_samples(const Recording& r, double min_s) {
+  const std::size_t n = r.time_s.size();
+  std::vector<bool> off(n, false);
+  if (!r.fuel_rate_m3ps || !(min_s > 0.0)) return off;
+  const auto& fuel = *r.fuel_rate_m3ps;
+  std::size_t i = 0;
+  while (i < n) {
+    if (!(r.speed_mps[i] == 0.0 && fuel[i] == 0.0)) {
+      ++i;
+      continue;
+    }
+    std::size_t j = i;
+    while (j + 1 < n && r.speed_mps[j + 1] == 0.0 && fuel[j + 1] == 0.0) ++j;
+    if (r.time_s[j] - r.time_s[i] >= min_s)
+      for (std::size_t k = i; k <= j; ++k) off[k] = true;
+    i = j + 1;
+  }
+  return off;
+}
+
+DriveCycle cycle_of_recording(const Recording& r, double engine_off_min_s, EngineStart start) {
   DriveCycle c;
+  c.engine_hot_start = start == EngineStart::hot;
+  if (r.fuel_rate_m3ps && engine_off_min_s > 0.0) {
+    c.engine_off = engine_off_samples(r, engine_off_min_s);
+    // A segment is off when it starts in a run and the run goes on past it (the run's last sample restarts).
+    for (std::size_t i = 0; i + 1 < c.engine_off.size(); ++i) c.engine_off[i] = c.engine_off[i] && c.engine_off[i + 1];
+    if (!c.engine_off.empty()) c.engine_off.back() = false;
+    if (std::none_of(c.engine_off.begin(), c.engine_off.end(), [](bool b) { return b; })) c.engine_off.clear();
+  }
   c.name = r.source;
   c.source = r.source;
   // Time from the start of the recording: effects that decay from the start of a trip read it.
@@ -68,7 +118,7 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
   using namespace diag;
   if (recordings.empty()) throw InputError("--recording", "at least one recording is needed");
   Diagnosis out;
-  const std::vector<DriveCycle> cycles = cycles_of(recordings, out.notes);
+  const std::vector<DriveCycle> cycles = cycles_of(recordings, opt, out.notes);
   const Observations obs = build_windows(vehicle, recordings, opt.window_s, opt, out.notes);
   out.channel = to_string(obs.channel);
   out.windows = static_cast<int>(obs.n());

@@ -36,6 +36,9 @@ struct CalibrationPriors {
 CalibrationPriors calibration_priors_from_yaml(YamlMap& file);
 
 /// Fixed in advance (not tuned per recording), so that the null case's false-discovery rate is what it is.
+/// A recording's engine at its start: cold at ambient (a cold-start test, the first trip of the day) or hot.
+enum class EngineStart { cold, hot };
+
 struct DiagnoseOptions {
   double window_s = 60.0;          ///< energy windows
   int block_windows = 3;           ///< one recording: held-out folds alternate in blocks of this many windows
@@ -77,6 +80,13 @@ struct DiagnoseOptions {
   /// named it wrongly on most such recordings (README, "Road profile"), so a user who knows the route is hilly
   /// and its elevation unknown turns it on (`--road-profile`) and reads the finding as one explanation.
   bool infer_road_profile = false;
+  /// A fuel-channel recording's engine is taken as switched off where it stands still with exactly zero fuel
+  /// flow for at least this long (a soak between two tests, start-stop at a light): the replay burns no fuel there
+  /// and a cold engine cools instead of idling warm. Shorter runs of zeros are read as the flow meter's noise.
+  double engine_off_min_s = 5.0;
+  /// Each recording's engine at its start, in the recordings' order (missing entries: cold at ambient): a hot
+  /// test pooled with a cold one is not warmed up again.
+  std::vector<EngineStart> engine_start;
 };
 
 struct ParameterEstimate {
@@ -190,7 +200,12 @@ std::string separating_test(const std::string& a, const std::string& b);
 
 /// The trace a recording is replayed on: its speed, time from the recording's start (effects that decay from
 /// the start of a trip read it), and its grade, or one derived robustly from its elevation, quantised to 0.05 %.
-DriveCycle cycle_of_recording(const Recording& r);
+/// With `engine_off_min_s` > 0, a fuel-rate recording's engine-off runs (standing with exactly zero fuel flow
+/// for at least that long) become the cycle's engine_off segments; `start` sets its engine_hot_start.
+DriveCycle cycle_of_recording(const Recording& r, double engine_off_min_s = 0.0, EngineStart start = EngineStart::cold);
+/// Per sample of `r`: standing with exactly zero fuel flow in a run lasting at least `min_s` (all false without a
+/// fuel channel).
+std::vector<bool> engine_off_samples(const Recording& r, double min_s);
 
 /// Replays each recording's speed (and grade) through the vehicle, compares energies per window, calibrates,
 /// and tests each catalogue effect (see docs/diagnose.md for the method).
