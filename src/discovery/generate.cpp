@@ -312,6 +312,10 @@ const std::vector<ConcealedTruthInfo>& concealed_truths() {
       {"engine_oil_coolant", "engine_warmup", "1 (cold fuel excess)",
        "oil + coolant nodes heated by the fuel losses, thermostat, friction ~ exp(b (T_ref - T_oil)) (fuel channel)",
        {0.1, 0.2, 0.4}, SyntheticChannel::fuel_rate, false, +1},
+      {"engine_cold_soak", "engine_warmup", "1 (cold fuel excess)",
+       "cold start: oil and block nodes, friction ~ exp(b (T_ref - T_oil)), a 3-10 min warm-up; UDDS, 10 min engine-off "
+       "soak (zero fuel), UDDS (fuel channel)",
+       {0.2, 0.25, 0.3}, SyntheticChannel::fuel_rate, false, +1, false, "", "udds", 600.0},
       {"battery_r_of_soc", "battery_resistance", "ohm (extra at full charge)",
        "extra cell resistance rising as SOC falls, OCV(SOC), loss I^2 R (SOC channel, 0.1 % quantum)",
        {0.05, 0.1, 0.2}, SyntheticChannel::soc, false, +1},
@@ -357,13 +361,27 @@ Recording generate_case(const Vehicle& vehicle, const SyntheticCase& o) {
     const DriveCycle one = load_cycle(o.cycle);
     c.name = o.cycle + " x" + std::to_string(o.repeats);
     for (int k = 0; k < o.repeats; ++k) {
+      if (k > 0 && o.soak_s > 0.0) {
+        // The engine is switched off from the last sample of the run before to the soak's last sample.
+        c.engine_off.resize(c.time_s.size(), false);
+        c.engine_off.back() = true;
+        for (double t = 1.0; t <= o.soak_s; t += 1.0) {
+          c.time_s.push_back(c.time_s.back() + 1.0);
+          c.speed_mps.push_back(0.0);
+          c.grade.push_back(0.0);
+          c.engine_off.push_back(true);
+        }
+        c.engine_off.back() = false;  // the soak's last sample starts the next run's first segment: restarted
+      }
       const double t0 = c.time_s.empty() ? 0.0 : c.time_s.back() + 1.0;
       for (std::size_t i = 0; i < one.time_s.size(); ++i) {
         c.time_s.push_back(t0 + one.time_s[i] - one.time_s.front());
         c.speed_mps.push_back(one.speed_mps[i]);
         c.grade.push_back(0.0);
+        if (!c.engine_off.empty()) c.engine_off.push_back(false);
       }
     }
+    if (o.soak_s > 0.0) c.name += " with " + std::to_string(static_cast<int>(o.soak_s)) + " s soaks";
   }
   Vehicle truth_vehicle = vehicle;
   DriveCycle truth_cycle = c;
@@ -382,11 +400,15 @@ Recording generate_case(const Vehicle& vehicle, const SyntheticCase& o) {
   }
   const double weight_n = vehicle.body.test_mass_kg * kG;
   double engine_cold_excess = 0.0, battery_extra_ohm = 0.0;  // post-run truths, applied to the channel below
+  std::optional<EngineThermalTruth> engine_soak;
   for (const auto& e : o.effects) {
     const std::string& t = concealed_truth(e.truth).truth;
     if (t == "engine_oil_coolant") {
       if (o.channel != SyntheticChannel::fuel_rate) throw InputError("concealed truth 'engine_oil_coolant'", "needs the fuel channel");
       engine_cold_excess = e.size;
+    } else if (t == "engine_cold_soak") {
+      if (o.channel != SyntheticChannel::fuel_rate) throw InputError("concealed truth 'engine_cold_soak'", "needs the fuel channel");
+      engine_soak = cold_start_engine(e.size, truth_rng);
     } else if (t == "battery_r_of_soc") {
       if (o.channel != SyntheticChannel::soc) throw InputError("concealed truth 'battery_r_of_soc'", "needs the SOC channel");
       battery_extra_ohm = e.size;
@@ -500,7 +522,16 @@ Recording generate_case(const Vehicle& vehicle, const SyntheticCase& o) {
     const auto* cp = std::get_if<CombustionPowertrainParams>(&truth_vehicle.powertrain);
     if (!cp) throw InputError("synthetic fuel channel", "needs a combustion vehicle");
     const double j_per_m3 = cp->fuel.density_kg_per_m3 * cp->fuel.lower_heating_value_j_per_kg;
-    truth_w = delayed(rec.time_s, oil_coolant_fuel_power_w(r, j_per_m3, engine_cold_excess), lag_s);
+    if (engine_soak) {
+      std::vector<double> fuel_w(n), traction_w(n);
+      for (std::size_t i = 0; i < n; ++i) {
+        fuel_w[i] = r.trace[i].segment_fuel_rate_m3_per_s * j_per_m3;
+        traction_w[i] = r.trace[i].traction_power_w;
+      }
+      truth_w = delayed(rec.time_s, engine_thermal_fuel_power_w(rec.time_s, fuel_w, traction_w, c.engine_off, *engine_soak), lag_s);
+    } else {
+      truth_w = delayed(rec.time_s, oil_coolant_fuel_power_w(r, j_per_m3, engine_cold_excess), lag_s);
+    }
     std::normal_distribution<double> noise(0.0, o.fuel_noise_w);
     std::vector<double> f(n);
     for (std::size_t i = 0; i < n; ++i) {

@@ -72,8 +72,11 @@ std::vector<Case> build_cases(const BenchOptions& o) {
       SyntheticCase s;
       s.effects = {{t.truth, size}};
       s.channel = t.channel;
+      if (!t.cycle.empty()) s.cycle = t.cycle, s.soak_s = t.soak_s;
       if (t.real_logger) s = real_logger(s);
-      const char* where = t.channel == SyntheticChannel::fuel_rate ? " (ice, fuel)" : t.channel == SyntheticChannel::soc ? " (SOC)" : "";
+      std::string where = t.channel == SyntheticChannel::fuel_rate ? " (ice, fuel" : t.channel == SyntheticChannel::soc ? " (SOC" : "";
+      if (!t.cycle.empty()) where += (where.empty() ? " (" : ", ") + t.cycle + " x2, " + num(t.soak_s) + " s soak";
+      if (!where.empty()) where += ")";
       const std::string logger = t.real_logger ? ", real logger" : "";
       if (t.never_called.empty()) {
         // A withheld net climb with hills is a road profile too: road_profile carries the net climb with the hills.
@@ -125,6 +128,11 @@ std::vector<Case> build_cases(const BenchOptions& o) {
     SyntheticCase f;
     f.channel = SyntheticChannel::fuel_rate;
     add("null", "null, fuel channel (ice.yaml)", f, {}, channel_null_seeds, 52000);
+    cases.back().combustion = true;
+    // A hot engine switched off for a 10-minute soak between two UDDS (as a cold-start test's, without the cold).
+    f.cycle = "udds";
+    f.soak_s = 600.0;
+    add("null", "null, fuel channel (ice.yaml), udds x2, 600 s soak", f, {}, o.null_seeds, 58000);
     cases.back().combustion = true;
     SyntheticCase q;
     q.channel = SyntheticChannel::soc;

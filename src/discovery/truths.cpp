@@ -118,6 +118,40 @@ std::shared_ptr<const Effect> rising_rrc_truth(double rise, double duration_s, d
   return std::make_shared<RisingRrcTruth>(rise, duration_s, power);
 }
 
+EngineThermalTruth cold_start_engine(double cold_excess, std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  EngineThermalTruth e;
+  e.cold_excess = cold_excess;
+  e.oil_j_per_k = 5000.0 * std::pow(16.0 / 5.0, u(rng));
+  e.block_j_per_k = e.oil_j_per_k * (4.0 + 2.0 * u(rng));
+  return e;
+}
+
+std::vector<double> engine_thermal_fuel_power_w(const std::vector<double>& time_s, const std::vector<double>& fuel_w,
+                                                const std::vector<double>& traction_w, const std::vector<bool>& engine_off,
+                                                const EngineThermalTruth& e) {
+  constexpr double kToBlock = 0.30, kToOil = 0.10, kOilBlockWPerK = 80.0, kBlockWPerK = 20.0, kRadiatorWPerK = 800.0;
+  constexpr double kThermostatK = 85.0, kSumpWPerK = 6.0, kSoakBlockWPerK = 12.0, kViscosityPerK = 0.035, kRefK = 70.0;
+  const double norm = std::exp(kViscosityPerK * kRefK) - 1.0;
+  double oil_k = e.hot_start ? kRefK + 10.0 : 0.0, block_k = e.hot_start ? kThermostatK : 0.0;
+  std::vector<double> p(fuel_w.size());
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const double rise = oil_k < kRefK ? (std::exp(kViscosityPerK * (kRefK - oil_k)) - 1.0) / norm : 0.0;
+    p[i] = fuel_w[i] * (1.0 + e.cold_excess * rise);
+    if (i + 1 == p.size()) break;
+    const double dt = time_s[i + 1] - time_s[i];
+    const bool off = i < engine_off.size() && engine_off[i];
+    const double loss_w = off ? 0.0 : std::max(0.0, p[i] - std::max(0.0, traction_w[i]));
+    const double exchange_w = kOilBlockWPerK * (block_k - oil_k);
+    double cooling_w = (off ? kSoakBlockWPerK : kBlockWPerK) * block_k;
+    if (!off && block_k > kThermostatK) cooling_w += kRadiatorWPerK * (block_k - kThermostatK);
+    // Explicit steps of the segment length: stable while dt is well under C / G (oil: 60 s and more).
+    block_k += dt * (kToBlock * loss_w - exchange_w - cooling_w) / e.block_j_per_k;
+    oil_k += dt * (kToOil * loss_w + exchange_w - kSumpWPerK * oil_k) / e.oil_j_per_k;
+  }
+  return p;
+}
+
 std::vector<double> delayed(const std::vector<double>& time_s, const std::vector<double>& x, double lag_s) {
   std::vector<double> out(x.size());
   std::size_t j = 0;  // x's interval [j, j + 1] holding t - lag, advancing with i

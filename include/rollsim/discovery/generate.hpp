@@ -47,6 +47,10 @@ struct ConcealedTruthInfo {
   /// A null for this catalogue id (e.g. an RRC rising over the trip for tyre_warmup): catalogue_id is empty, and
   /// any finding of this id, of either sign, is the mistake the row counts.
   std::string never_called;
+  /// The trip the truth is concealed in when it needs its own (empty: the bench's WLTC x2): a shipped cycle, twice,
+  /// with an engine-off standstill of soak_s between the two (a cold-start test's soak).
+  std::string cycle;
+  double soak_s = 0.0;
 };
 const std::vector<ConcealedTruthInfo>& concealed_truths();
 const ConcealedTruthInfo& concealed_truth(const std::string& truth);  ///< throws InputError when unknown
@@ -60,6 +64,9 @@ struct SyntheticCase {
   /// is dropped, so the truth drives a flat road at the recorded speeds. `repeats` is ignored.
   std::optional<DriveCycle> trace;
   int repeats = 2;
+  /// Between repeats, a standstill of this long with the engine switched off (fuel exactly zero), as the 10-minute
+  /// soak between a cold-start test's two UDDS; 0: the repeats follow each other directly.
+  double soak_s = 0.0;
   std::vector<ConcealedEffect> effects;
   double rrc_level_jitter = 0.03;  ///< truth's RRC level, uniform +- (calibration, not a discovery)
   double scale_jitter = 0.02;      ///< measured channel scale, uniform +-

@@ -41,6 +41,29 @@ std::shared_ptr<const Effect> cabin_load_truth(double initial_w, double decay_s,
 /// RRC rising over the trip (rain, a road surface turning rough, a slow puncture): factor 1 + rise (t / T)^p.
 std::shared_ptr<const Effect> rising_rrc_truth(double rise, double duration_s, double power);
 
+/// A petrol engine's warm-up as two thermal nodes above ambient, oil and block (with its coolant), for the fuel
+/// channel: the fuel power's losses (fuel minus positive traction power) heat the block (30 %) and the oil (10 %,
+/// the friction), the two exchange 80 W/K; the block loses 20 W/K below its thermostat (85 K above ambient) and
+/// a radiator's 800 W/K above it, the sump 6 W/K; switched off (a soak) nothing heats, the radiator's fan is off
+/// and the block loses 12 W/K to still air. Friction follows oil viscosity, ~ exp(b (T_ref - T_oil)), b = 0.035 /K,
+/// T_ref = 70 K, so the fuel power is multiplied by 1 + k (exp(b (T_ref - T_oil)) - 1) / (exp(b T_ref) - 1): exactly
+/// 1 + k at ambient, 1 once the oil is warm; the extra fuel's losses heat the engine too.
+struct EngineThermalTruth {
+  double cold_excess = 0.0;      ///< k: the fuel power's excess of an engine at ambient
+  double oil_j_per_k = 10000.0;  ///< oil and the parts it wets
+  double block_j_per_k = 50000.0;
+  bool hot_start = false;        ///< both nodes at their warm running temperature at the start
+};
+/// Draws an engine whose friction warm-up (the oil reaching its warm viscosity on a UDDS) takes about 3-10 minutes:
+/// oil 5-16 kJ/K (log-uniform), block 4-6 times the oil.
+EngineThermalTruth cold_start_engine(double cold_excess, std::mt19937& rng);
+/// The truth's fuel power per sample from the cold-free simulated fuel power `fuel_w` and positive traction power
+/// `traction_w` (per sample, held over the segment that starts there), with the engine off where `engine_off`
+/// says (segment flags, as DriveCycle::engine_off).
+std::vector<double> engine_thermal_fuel_power_w(const std::vector<double>& time_s, const std::vector<double>& fuel_w,
+                                                const std::vector<double>& traction_w, const std::vector<bool>& engine_off,
+                                                const EngineThermalTruth& e);
+
 /// A channel as a logger with a lag behind the truth records it: x(t - lag_s), linearly interpolated between the
 /// samples (a lag need not be a whole number of samples); held at the first value before the start.
 std::vector<double> delayed(const std::vector<double>& time_s, const std::vector<double>& x, double lag_s);
