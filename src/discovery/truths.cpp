@@ -122,7 +122,7 @@ EngineThermalTruth cold_start_engine(double cold_excess, std::mt19937& rng) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
   EngineThermalTruth e;
   e.cold_excess = cold_excess;
-  e.oil_j_per_k = 5000.0 * std::pow(16.0 / 5.0, u(rng));
+  e.oil_j_per_k = 5000.0 * std::pow(12.0 / 5.0, u(rng));
   e.block_j_per_k = e.oil_j_per_k * (4.0 + 2.0 * u(rng));
   return e;
 }

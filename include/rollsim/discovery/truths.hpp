@@ -55,7 +55,7 @@ struct EngineThermalTruth {
   bool hot_start = false;        ///< both nodes at their warm running temperature at the start
 };
 /// Draws an engine whose friction warm-up (the oil reaching its warm viscosity on a UDDS) takes about 3-10 minutes:
-/// oil 5-16 kJ/K (log-uniform), block 4-6 times the oil.
+/// oil 5-12 kJ/K (log-uniform), block 4-6 times the oil.
 EngineThermalTruth cold_start_engine(double cold_excess, std::mt19937& rng);
 /// The truth's fuel power per sample from the cold-free simulated fuel power `fuel_w` and positive traction power
 /// `traction_w` (per sample, held over the segment that starts there), with the engine off where `engine_off`
