@@ -52,6 +52,9 @@ struct EngineWarmupParams {
   double cold_fuel_excess, heat_capacity_j_per_k, idle_heat_w, heat_per_wheel_work, heat_loss_w_per_k, warm_excess_k,
       soak_cooling_s, initial_excess_k;
 };
+struct WindHeadingParams {
+  double wind_speed_mps, wind_from_deg;
+};
 struct RoadGradeParams {
   double grade_offset, profile_wavelength_m;
 };
@@ -113,6 +116,25 @@ class Wind final : public Effect {
 
  private:
   double u_, k_;
+};
+
+// A steady wind of speed w blowing from the bearing theta (clockwise from north, as a weather report gives it): the
+// headwind on a car heading psi is u = w cos(theta - psi), so it turns with the road. Where the trace has no
+// heading the effect is off (a steady wind is a headwind only relative to the heading; `wind` is the headwind).
+class WindHeading final : public Effect {
+ public:
+  WindHeading(const WindHeadingParams& p, const EffectContext& c)
+      : w_(p.wind_speed_mps), from_rad_(units::deg_to_rad(p.wind_from_deg)), k_(0.5 * c.rho_cda_kg_per_m) {}
+  std::string id() const override { return "wind_heading"; }
+  double extra_resistance_n(const EffectInputs& in, const double*) const override {
+    const double v = std::max(in.speed_mps, 0.0);
+    if (v <= 0.0 || !in.heading_known) return 0.0;
+    const double rel = v + w_ * std::cos(from_rad_ - in.heading_rad);
+    return k_ * (rel * std::abs(rel) - v * v);
+  }
+
+ private:
+  double w_, from_rad_, k_;
 };
 
 // Mass (payload) error dm: inertia, grade and the rolling share, dm (a + g sin theta + g RRC).
@@ -374,6 +396,12 @@ std::vector<EffectInfo> build_catalogue() {
       "",
       {{&RoadProfileParams::profile_scale, {"profile_scale", "1", 0.0, 1.0, 0.0, 3.0, true}},
        {&RoadProfileParams::knot_spacing_m, {"knot_spacing_m", "m", 100.0, 100.0, 10.0, 10000.0, false}}}));
+  c.push_back(row<WindHeading, WindHeadingParams>(
+      I::wind_heading, "wind_heading",
+      "steady wind from a bearing: headwind w cos(theta - heading) on a route whose heading is recorded (latitude, "
+      "longitude); a negative speed blows from the opposite bearing",
+      "", {{&WindHeadingParams::wind_speed_mps, {"wind_speed_mps", "m/s", 0.0, 3.0, -30.0, 30.0, true}},
+           {&WindHeadingParams::wind_from_deg, {"wind_from_deg", "deg", 0.0, 0.0, 0.0, 360.0, false}}}));
   return c;
 }
 

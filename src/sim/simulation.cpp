@@ -102,6 +102,13 @@ class SegmentRoadLoads {
   std::vector<int> of_segment_;
 };
 
+// The trace's direction of travel on segment i, where it is known.
+void set_heading(const DriveCycle& c, std::size_t i, EffectInputs& in) {
+  if (i >= c.heading_rad.size()) return;
+  in.heading_rad = c.heading_rad[i];
+  in.heading_known = true;
+}
+
 // Everything at one instant, shared by the forward RHS, the replay and the trace so the three agree.
 struct Instant {
   PowerFlow flow;
@@ -380,6 +387,7 @@ class ForwardSystem final : public OdeSystem {
     const double a_ref = (c_.speed_mps[i + 1] - c_.speed_mps[i]) / dt;
     const double v_ref = c_.speed_mps[i] + a_ref * (t - c_.time_s[i]);
     EffectInputs in{t, v_ref, a_ref, c_.grade.empty() ? 0.0 : c_.grade[i], y[kDistance], 0.0, 0.0, c_.engine_off_at(i)};
+    set_heading(c_, i, in);
     Instant ff;
     eval_.resistance(loads_[i], in, y + kBaseStates, ff);
     return m_.inertial_mass_kg() * (a_ref + o_.driver_kp_per_s * (v_ref - y[kSpeed]) + o_.driver_ki_per_s2 * y[kDriverIntegral]) +
@@ -413,6 +421,7 @@ class ForwardSystem final : public OdeSystem {
 
     // Feed-forward: what the trace needs at its own speed; feedback: PI on the speed error.
     EffectInputs in{t, v_ref, a_ref, grade, y[kDistance], 0.0, 0.0, standstill_[i] && c_.engine_off_at(i)};
+    set_heading(c_, i, in);
     Instant ff;
     eval_.resistance(rl, in, x, ff);
     const double error_mps = v_ref - v;
@@ -766,9 +775,11 @@ SimulationResult simulate_replay(const VehicleModel& m, const DriveCycle& c, con
   // Powers at one point of a segment into `rate` (and the effects' state rates into `xdot`).
   Instant s;
   bool engine_off = false;  // the segment being evaluated switches the engine off (set per segment below)
+  std::size_t segment_now = 0;
   auto evaluate_at = [&](double t, double v, double a, double grade, const RoadLoadCoeffs& rl, double dist_m) {
     scheduled_gear = m.powertrain->select_gear(v, scheduled_gear);
     EffectInputs in{t, v, a, grade, dist_m, 0.0, 0.0, engine_off && v == 0.0 && a == 0.0};
+    set_heading(c, segment_now, in);
     eval.resistance(rl, in, x.data(), s);
     // At rest and staying at rest the car is held on its brakes, as the forward simulation holds it: on a grade the
     // powertrain does not hold it (a machine held at torque would draw its constant loss at every uphill stop).
@@ -816,6 +827,7 @@ SimulationResult simulate_replay(const VehicleModel& m, const DriveCycle& c, con
     const double grade = c.grade.empty() ? 0.0 : c.grade[i];
     const RoadLoadCoeffs& rl = loads[i];
     engine_off = c.engine_off_at(i);
+    segment_now = i;
     bool segment_limited = false;
     double soc_before_ramp = 0.0;
     std::array<double, kAccumulators> segment_energy_j{};  // a ramp's integral (for the trace)

@@ -18,6 +18,9 @@ inline constexpr double kM3PerCm3 = 1.0e-6;
 inline constexpr double kMpsPerMph = kMPerMile / kSPerHour;
 inline constexpr double kNPerLbf = 4.4482216152605;
 
+inline constexpr double kPi = 3.14159265358979323846;
+constexpr double deg_to_rad(double angle_deg) { return angle_deg * kPi / 180.0; }
+constexpr double rad_to_deg(double angle_rad) { return angle_rad * 180.0 / kPi; }
 constexpr double kmh_to_mps(double speed_kmh) { return speed_kmh * kMpsPerKmh; }
 constexpr double mps_to_kmh(double speed_mps) { return speed_mps / kMpsPerKmh; }
 constexpr double bar_to_pa(double pressure_bar) { return pressure_bar * kPaPerBar; }

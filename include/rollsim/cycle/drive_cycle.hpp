@@ -24,6 +24,9 @@ struct DriveCycle {
   /// The engine is warm when the trace starts (a hot start, e.g. the second half of a test after a short soak);
   /// otherwise it starts cold, at ambient.
   bool engine_hot_start = false;
+  /// Per sample: the direction of travel over the segment starting here, clockwise from north [rad] (from a
+  /// recording's latitude and longitude); empty where the route's heading is unknown.
+  std::vector<double> heading_rad;
 
   bool engine_off_at(std::size_t segment) const { return segment < engine_off.size() && engine_off[segment]; }
   double duration_s() const;  ///< last time minus first time

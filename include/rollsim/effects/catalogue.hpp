@@ -27,6 +27,7 @@ enum class EffectId {
   engine_warmup,
   road_grade,
   road_profile,
+  wind_heading,
 };
 
 /// What an effect needs to know about the car it is fitted to (set from the vehicle description).

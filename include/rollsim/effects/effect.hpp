@@ -15,6 +15,9 @@ struct EffectInputs {
   double base_rolling_force_n = 0.0;  ///< rolling resistance of the base tyre model at this speed
   double wheel_force_demand_n = 0.0;  ///< force the driver asks of the wheels (feed-forward), + propels
   bool engine_off = false;  ///< the trace switches the engine off here (a soak, start-stop): no fuel, no heat
+  /// Direction of travel, clockwise from north [rad], where the trace knows it (recorded latitude and longitude).
+  double heading_rad = 0.0;
+  bool heading_known = false;
 };
 
 /// A physical effect with its own parameters and, optionally, hidden states integrated with the vehicle's
