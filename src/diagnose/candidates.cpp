@@ -78,6 +78,35 @@ std::vector<EffectParameters> shapes_of(const EffectInfo& info, ChannelKind chan
   return {{}};
 }
 
+// A steady wind's bearing is a shape on a circle, not on a log grid: candidates every 30 degrees over a half circle
+// (a negative speed is the opposite bearing; the headwind's error at the nearest is under 1 - cos 15 = 3.4 %),
+// mixed from two runs (north, east) at the nominal speed.
+constexpr double kBearingStep_deg = 30.0;
+
+void add_bearing_candidates(const EffectInfo& info, const EffectContext& ctx, std::vector<EffectList>& extras,
+                            std::vector<Candidate>& out) {
+  const EffectParameterInfo& amp = info.amplitude();
+  for (double from : {0.0, 90.0}) extras.push_back({make_effect(info.id, {{amp.name, amp.nominal}, {"wind_from_deg", from}}, ctx)});
+  for (double from = 0.0; from < 180.0; from += kBearingStep_deg) {
+    Candidate c;
+    c.id = info.id;
+    c.shape = {{"wind_from_deg", from}};
+    c.amplitude = &amp;
+    c.mixed_bearing = true;
+    c.label = info.name + " (wind_from_deg " + num(from) + ")";
+    out.push_back(std::move(c));
+  }
+}
+
+void mix_bearing(Candidate& c, const Variant& base, const Variant& north, const Variant& east) {
+  const double th = units::deg_to_rad(c.shape.at("wind_from_deg")), cn = std::cos(th), ce = std::sin(th);
+  c.signature = (cn * (north.window_j - base.window_j) + ce * (east.window_j - base.window_j)) / c.amplitude->nominal;
+  c.power_w = base.power_w;
+  for (std::size_t r = 0; r < c.power_w.size(); ++r)
+    for (std::size_t i = 0; i < c.power_w[r].size(); ++i)
+      c.power_w[r][i] += cn * (north.power_w[r][i] - base.power_w[r][i]) + ce * (east.power_w[r][i] - base.power_w[r][i]);
+}
+
 }  // namespace
 
 std::shared_ptr<const Effect> signature_force(ForceShape shape, double decay_s) {
@@ -146,6 +175,11 @@ Signatures compute_signatures(const Replayer& rp, const Observations& o, const V
       s.candidates.push_back(std::move(c));
       continue;
     }
+    if (info.id == EffectId::wind_heading) {
+      if (!rp.cycles.empty() && std::all_of(rp.cycles.begin(), rp.cycles.end(), [](const DriveCycle& c) { return !c.heading_rad.empty(); }))
+        add_bearing_candidates(info, ctx, extras, s.candidates);
+      continue;
+    }
     for (const auto& shape : shapes_of(info, o.channel)) {
       Candidate c;
       c.id = info.id;
@@ -182,6 +216,16 @@ Signatures compute_signatures(const Replayer& rp, const Observations& o, const V
         c.signature[w] = (amb.reference_k - amb.ambient_k[o.windows[static_cast<std::size_t>(w)].rec]) *
                          (s.rrc.window_j[w] - base.window_j[w]) / 0.1;
       kept.push_back(std::move(c));
+      continue;
+    }
+    if (c.mixed_bearing) {
+      // The north and east runs are the next two; every bearing's candidate (consecutive) mixes them.
+      const Variant& north = vars[k];
+      const Variant& east = vars[k + 1];
+      mix_bearing(c, base, north, east);
+      const bool last = &c == &s.candidates.back() || !(&c + 1)->mixed_bearing;
+      if (last) k += 2;
+      if (c.signature.norm() > 0.0) kept.push_back(std::move(c));
       continue;
     }
     c.signature = (vars[k].window_j - base.window_j) / c.amplitude->nominal;

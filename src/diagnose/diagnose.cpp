@@ -4,9 +4,11 @@
 #include "rollsim/diagnose/diagnose.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "pipeline.hpp"
 #include "rollsim/common/error.hpp"
+#include "rollsim/common/units.hpp"
 #include "rollsim/diagnose/elevation.hpp"
 
 namespace rollsim {
@@ -42,6 +44,37 @@ std::vector<DriveCycle> cycles_of(const std::vector<Recording>& recordings, cons
                       " elevation steps rejected as glitches, Savitzky-Golay slope over 300 m)");
   }
   return cycles;
+}
+
+// A steady wind is a head- or tailwind only relative to the heading: with it recorded, the wind's speed and bearing;
+// without it, a headwind along the trace, said so.
+void describe_wind(const std::vector<DriveCycle>& cycles, std::vector<Finding>& findings, std::vector<std::string>& notes) {
+  const bool heading = std::all_of(cycles.begin(), cycles.end(), [](const DriveCycle& c) { return !c.heading_rad.empty(); });
+  if (!heading) notes.push_back("wind_heading not tested: the route's heading is unknown (no latitude and longitude recorded)");
+  for (Finding& f : findings) {
+    if (f.effect == "wind" && !heading)
+      f.description += std::string(f.description.empty() ? "" : "; ") +
+                       "the route's heading is unknown (no latitude and longitude recorded): a headwind along the trace, "
+                       "not a wind's speed and direction";
+    if (f.effect == "wind_heading" && f.fitted.count("wind_speed_mps") && f.fitted.count("wind_from_deg") &&
+        f.fitted.at("wind_speed_mps") < 0.0) {
+      // Candidates cover half the compass with a signed speed: report the wind blowing from where it blows.
+      f.fitted["wind_speed_mps"] = -f.fitted.at("wind_speed_mps");
+      f.fitted["wind_from_deg"] = std::fmod(f.fitted.at("wind_from_deg") + 180.0, 360.0);
+      for (auto& p : f.parameters) {
+        if (p.name == "wind_speed_mps") {
+          const double low = -p.ci_high;
+          p.ci_high = -p.ci_low, p.ci_low = low, p.value = -p.value;
+        } else if (p.name == "wind_from_deg") {
+          p.value = std::fmod(p.value + 180.0, 360.0), p.ci_low = p.ci_high = p.value;
+        }
+      }
+    }
+    if (f.effect == "wind_heading" && f.fitted.count("wind_speed_mps") && f.fitted.count("wind_from_deg"))
+      f.description += std::string(f.description.empty() ? "" : "; ") + "a steady wind of " +
+                       fixed(f.fitted.at("wind_speed_mps"), 1) + " m/s from " + fixed(f.fitted.at("wind_from_deg"), 0) +
+                       " deg (clockwise from north, to 30 deg), its headwind turning with the recorded heading";
+  }
 }
 
 void report_calibration(const diag::Calibration& c, const diag::Observations& o, const diag::LagEstimate& lag, Diagnosis& out) {
@@ -89,8 +122,35 @@ std::vector<bool> engine_off_samples(const Recording& r, double min_s) {
   return off;
 }
 
+std::vector<double> heading_from_gps(const std::vector<double>& latitude_deg, const std::vector<double>& longitude_deg,
+                                     double baseline_m) {
+  constexpr double kEarthRadius_m = 6371000.0;
+  const std::size_t n = std::min(latitude_deg.size(), longitude_deg.size());
+  std::vector<double> heading(n, 0.0);
+  if (n == 0) return heading;
+  const double east_m_per_deg = kEarthRadius_m * std::cos(units::deg_to_rad(latitude_deg.front())) * units::deg_to_rad(1.0);
+  const double north_m_per_deg = kEarthRadius_m * units::deg_to_rad(1.0);
+  auto east = [&](std::size_t i) { return (longitude_deg[i] - longitude_deg.front()) * east_m_per_deg; };
+  auto north = [&](std::size_t i) { return (latitude_deg[i] - latitude_deg.front()) * north_m_per_deg; };
+  std::size_t j = 0;
+  bool any = false;
+  for (std::size_t i = 0; i < n; ++i) {
+    j = std::max(j, i + 1);
+    while (j < n && std::hypot(east(j) - east(i), north(j) - north(i)) < baseline_m) ++j;
+    if (j < n) {
+      heading[i] = std::atan2(east(j) - east(i), north(j) - north(i));
+      any = true;
+    } else {
+      heading[i] = i > 0 ? heading[i - 1] : 0.0;
+    }
+  }
+  if (!any) return {};
+  return heading;
+}
+
 DriveCycle cycle_of_recording(const Recording& r, double engine_off_min_s, EngineStart start) {
   DriveCycle c;
+  if (r.latitude_deg && r.longitude_deg) c.heading_rad = heading_from_gps(*r.latitude_deg, *r.longitude_deg);
   c.engine_hot_start = start == EngineStart::hot;
   if (r.fuel_rate_m3ps && engine_off_min_s > 0.0) {
     c.engine_off = engine_off_samples(r, engine_off_min_s);
@@ -150,6 +210,7 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
   Model m = cal.model;
   std::vector<EffectId> chosen;
   out.findings = select_effects(sc, sig.candidates, m, chosen);
+  describe_wind(cycles, out.findings, out.notes);
   out.detection_limits = detection_limits(sig.candidates, chosen, m, opt);
   if (sc.opt.infer_road_profile) {
     if (auto f = infer_road_profile(sc, cycles, sig, out.findings, chosen, floor, m, out.notes)) out.findings.push_back(std::move(*f));

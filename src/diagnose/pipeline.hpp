@@ -162,6 +162,9 @@ struct Candidate {
   const EffectParameterInfo* amplitude = nullptr;
   Eigen::VectorXd signature;  // window energy per unit amplitude
   bool across_trips = false;  // ambient_rrc: a per-recording level from the RRC-level variant (no own run)
+  /// wind_heading: mixed from the two runs with the wind from the north and from the east (no own run), as
+  /// cos(theta) x north + sin(theta) x east: the headwind w cos(theta - psi) is linear in them.
+  bool mixed_bearing = false;
   std::vector<std::vector<double>> power_w;  // its variant's per-sample channel power at the nominal amplitude
   double min() const { return amplitude->min; }
   double max() const { return amplitude->max; }

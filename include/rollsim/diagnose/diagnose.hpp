@@ -202,6 +202,11 @@ std::string separating_test(const std::string& a, const std::string& b);
 /// With `engine_off_min_s` > 0, a fuel-rate recording's engine-off runs (standing with exactly zero fuel flow
 /// for at least that long) become the cycle's engine_off segments; `start` sets its engine_hot_start.
 DriveCycle cycle_of_recording(const Recording& r, double engine_off_min_s = 0.0, EngineStart start = EngineStart::cold);
+/// Per sample: the direction of travel clockwise from north [rad], from recorded latitude and longitude [deg]: the
+/// bearing to the first later point at least `baseline_m` away (a local flat-earth projection; GPS jitter of a few
+/// metres turns a shorter chord at random), held at the end of the route.
+std::vector<double> heading_from_gps(const std::vector<double>& latitude_deg, const std::vector<double>& longitude_deg,
+                                     double baseline_m = 20.0);
 /// Per sample of `r`: standing with exactly zero fuel flow in a run lasting at least `min_s` (all false without a
 /// fuel channel).
 std::vector<bool> engine_off_samples(const Recording& r, double min_s);
