@@ -316,6 +316,10 @@ const std::vector<ConcealedTruthInfo>& concealed_truths() {
        "cold start: oil and block nodes, friction ~ exp(b (T_ref - T_oil)), a 3-10 min warm-up; UDDS, 10 min engine-off "
        "soak (zero fuel), UDDS (fuel channel)",
        {0.2, 0.25, 0.3}, SyntheticChannel::fuel_rate, false, +1, false, "", "udds", 600.0},
+      {"wind_steady_gps", "wind_heading", "m/s (steady wind, from a bearing drawn per seed)",
+       "steady wind w cos(theta - psi(s)) on a winding route (three 1-4 km bends, +-70-100 deg), latitude and "
+       "longitude recorded (2 m GPS noise)",
+       {4.0}, SyntheticChannel::battery_power, false, 0, false, "", "", 0.0, true},
       {"battery_r_of_soc", "battery_resistance", "ohm (extra at full charge)",
        "extra cell resistance rising as SOC falls, OCV(SOC), loss I^2 R (SOC channel, 0.1 % quantum)",
        {0.05, 0.1, 0.2}, SyntheticChannel::soc, false, +1},
@@ -401,6 +405,11 @@ Recording generate_case(const Vehicle& vehicle, const SyntheticCase& o) {
   const double weight_n = vehicle.body.test_mass_kg * kG;
   double engine_cold_excess = 0.0, battery_extra_ohm = 0.0;  // post-run truths, applied to the channel below
   std::optional<EngineThermalTruth> engine_soak;
+  std::optional<WindingRoute> route;
+  if (o.gps) {
+    std::mt19937 route_rng(o.seed * 2246822519u + 29u);  // its own stream: the other truths' draws stay put
+    route = winding_route(route_rng);
+  }
   for (const auto& e : o.effects) {
     const std::string& t = concealed_truth(e.truth).truth;
     if (t == "engine_oil_coolant") {
@@ -409,6 +418,10 @@ Recording generate_case(const Vehicle& vehicle, const SyntheticCase& o) {
     } else if (t == "engine_cold_soak") {
       if (o.channel != SyntheticChannel::fuel_rate) throw InputError("concealed truth 'engine_cold_soak'", "needs the fuel channel");
       engine_soak = cold_start_engine(e.size, truth_rng);
+    } else if (t == "wind_steady_gps") {
+      if (!route) throw InputError("concealed truth 'wind_steady_gps'", "needs a route with GPS (SyntheticCase::gps)");
+      const double from = o.wind_from_deg.value_or(360.0 * std::uniform_real_distribution<double>(0.0, 1.0)(truth_rng));
+      truths.push_back(steady_wind_truth(e.size, from, *route, rho_cda));
     } else if (t == "battery_r_of_soc") {
       if (o.channel != SyntheticChannel::soc) throw InputError("concealed truth 'battery_r_of_soc'", "needs the SOC channel");
       battery_extra_ohm = e.size;
@@ -502,6 +515,22 @@ Recording generate_case(const Vehicle& vehicle, const SyntheticCase& o) {
     std::vector<double> t(n);
     for (auto& x : t) x = 0.5 * std::round((*o.ambient_temp_c + units::kKelvinOffset + sensor(sensor_rng)) / 0.5);
     rec.ambient_temp_k = t;
+  }
+  if (route) {
+    // GPS at the trace's distances (the truth's replay follows the trace), with 2 m of noise per axis.
+    std::vector<double> dist(n, 0.0);
+    for (std::size_t i = 1; i < n; ++i) dist[i] = dist[i - 1] + 0.5 * (c.speed_mps[i - 1] + c.speed_mps[i]) * (c.time_s[i] - c.time_s[i - 1]);
+    std::vector<double> lat, lon;
+    route_gps(*route, dist, 48.1, 11.6, lat, lon);
+    std::mt19937 gps_rng(o.seed * 40503u + 5u);
+    std::normal_distribution<double> jitter_m(0.0, 2.0);
+    const double m_per_deg = 6371000.0 * kTwoPi / 360.0;
+    for (std::size_t i = 0; i < n; ++i) {
+      lat[i] += jitter_m(gps_rng) / m_per_deg;
+      lon[i] += jitter_m(gps_rng) / (m_per_deg * std::cos(48.1 * kTwoPi / 360.0));
+    }
+    rec.latitude_deg = lat;
+    rec.longitude_deg = lon;
   }
   // no grade column in any channel: the diagnosis sees a flat road
   if (o.channel == SyntheticChannel::soc) {

@@ -59,6 +59,14 @@ bool has(const std::vector<std::string>& v, const std::string& s) { return std::
 
 std::string num(double v) { return significant(v, 6); }
 
+// The steady-wind truth's bearing per seed: golden-angle steps, spread evenly round the compass over any run of seeds.
+double truth_bearing_deg(unsigned seed) { return std::fmod(137.50776405 * seed, 360.0); }
+
+double bearing_error_deg(double a_deg, double b_deg) {
+  const double d = std::fmod(std::abs(a_deg - b_deg), 360.0);
+  return std::min(d, 360.0 - d);
+}
+
 std::vector<Case> build_cases(const BenchOptions& o) {
   std::vector<Case> cases;
   auto add = [&](std::string group, std::string label, SyntheticCase s, std::vector<std::string> expected, int seeds, unsigned seed0) {
@@ -73,9 +81,11 @@ std::vector<Case> build_cases(const BenchOptions& o) {
       s.effects = {{t.truth, size}};
       s.channel = t.channel;
       if (!t.cycle.empty()) s.cycle = t.cycle, s.soak_s = t.soak_s;
+      s.gps = t.gps;
       if (t.real_logger) s = real_logger(s);
       std::string where = t.channel == SyntheticChannel::fuel_rate ? " (ice, fuel" : t.channel == SyntheticChannel::soc ? " (SOC" : "";
       if (!t.cycle.empty()) where += (where.empty() ? " (" : ", ") + t.cycle + " x2, " + num(t.soak_s) + " s soak";
+      if (t.gps) where += where.empty() ? " (GPS" : ", GPS";
       if (!where.empty()) where += ")";
       const std::string logger = t.real_logger ? ", real logger" : "";
       if (t.never_called.empty()) {
@@ -134,6 +144,9 @@ std::vector<Case> build_cases(const BenchOptions& o) {
     f.soak_s = 600.0;
     add("null", "null, fuel channel (ice.yaml), udds x2, 600 s soak", f, {}, o.null_seeds, 58000);
     cases.back().combustion = true;
+    SyntheticCase g;
+    g.gps = true;
+    add("null", "null, GPS on a winding route", g, {}, o.null_seeds, 59000);
     SyntheticCase q;
     q.channel = SyntheticChannel::soc;
     add("null", "null, SOC channel (ev.yaml)", q, {}, channel_null_seeds, 54000);
@@ -291,6 +304,7 @@ BenchResult run_discovery_bench(const Vehicle& vehicle, const BenchOptions& opt)
       const Case& c = cases[tasks[k].c];
       SyntheticCase s = c.synth;
       s.seed = c.seed0 + static_cast<unsigned>(tasks[k].s);
+      if (s.gps) s.wind_from_deg = truth_bearing_deg(s.seed);
       const Vehicle& car = c.combustion ? *combustion : vehicle;
       std::vector<Recording> recs;
       if (c.trips) {
@@ -304,8 +318,11 @@ BenchResult run_discovery_bench(const Vehicle& vehicle, const BenchOptions& opt)
       dopt.infer_road_profile = opt.infer_road_profile;
       const Diagnosis d = diagnose(car, recs, dopt);
       Outcome& o = out[k];
-      for (const auto& f : d.findings)
-        o.findings.push_back({f.effect, f.confounded_with, f.parameters.empty() ? 0.0 : f.parameters.front().value});
+      for (const auto& f : d.findings) {
+        const auto from = f.fitted.find("wind_from_deg");
+        o.findings.push_back({f.effect, f.confounded_with, f.parameters.empty() ? 0.0 : f.parameters.front().value,
+                              from == f.fitted.end() ? -1.0 : from->second});
+      }
       // The sparse regression sees one trip at a time (its library has no trip-level term): every trip's terms.
       o.sparse.assign(sparse_thresholds().size() + 1, {});
       for (const auto& rec : recs) {
@@ -343,6 +360,13 @@ BenchResult run_discovery_bench(const Vehicle& vehicle, const BenchOptions& opt)
     bool wrong_sign = false;
     count_into(row.rollsim, score_findings(rule, r.findings, &wrong_sign));
     if (wrong_sign) ++row.rollsim_wrong_sign;
+    if (c.synth.gps && has(c.expected, "wind_heading")) {
+      row.scores_direction = true;
+      const auto& f = r.findings;
+      if (!f.empty() && f.front().effect == "wind_heading" && f.front().confounded_with.empty() &&
+          bearing_error_deg(f.front().wind_from_deg, truth_bearing_deg(c.seed0 + static_cast<unsigned>(tasks[k].s))) <= 45.0)
+        ++row.rollsim_direction_right;
+    }
     if (!r.findings.empty() && r.findings.front().effect == "unexplained") ++row.rollsim_unexplained;
     // Parameter-only calibration fits scale, RRC level and CdA and can say nothing else: "nothing missing".
     ++row.calibration.missed;
@@ -436,6 +460,12 @@ std::string bench_text(const BenchResult& r) {
     os << std::left << std::setw(lw) << row.label << std::setw(18) << exp << std::right << std::setw(14) << cell(row.rollsim)
        << std::setw(8) << row.rollsim_unexplained << std::setw(6) << row.rollsim_wrong_sign << std::setw(18) << named.str()
        << std::setw(12) << cell(row.calibration) << std::setw(14) << cell(row.sparse) << "\n";
+    if (row.scores_direction) {
+      const auto [dlo, dhi] = wilson_interval(row.rollsim_direction_right, row.rollsim.n());
+      os << "    named with the wind's bearing within 45 deg: " << row.rollsim_direction_right << "/" << row.rollsim.n()
+         << std::fixed << std::setprecision(0) << " (" << 100.0 * row.rollsim_direction_right / std::max(1, row.rollsim.n())
+         << " %, Wilson 95 % " << 100 * dlo << "-" << 100 * dhi << " %)\n" << std::defaultfloat;
+    }
   }
   os << "\n";
   for (const auto& row : r.rows) {

@@ -45,7 +45,70 @@ class RisingRrcTruth final : public Effect {
   double rise_, t_, p_;
 };
 
+class SteadyWindTruth final : public Effect {
+ public:
+  SteadyWindTruth(double speed_mps, double from_deg, WindingRoute route, double rho_cda)
+      : w_(speed_mps), from_rad_(from_deg * kTwoPi / 360.0), route_(std::move(route)), k_(0.5 * rho_cda) {}
+  std::string id() const override { return "truth_steady_wind"; }
+  double extra_resistance_n(const EffectInputs& in, const double*) const override {
+    const double v = std::max(in.speed_mps, 0.0);
+    if (v <= 0.0) return 0.0;
+    const double rel = v + w_ * std::cos(from_rad_ - route_.heading_rad(in.distance_m));
+    return k_ * (rel * std::abs(rel) - v * v);
+  }
+
+ private:
+  double w_, from_rad_;
+  WindingRoute route_;
+  double k_;
+};
+
 }  // namespace
+
+double WindingRoute::heading_rad(double s) const {
+  double h = heading0_rad;
+  for (std::size_t k = 0; k < amplitude_rad.size(); ++k) h += amplitude_rad[k] * std::sin(kTwoPi * s / wavelength_m[k] + phase_rad[k]);
+  return h;
+}
+
+WindingRoute winding_route(std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  WindingRoute r;
+  r.heading0_rad = kTwoPi * u(rng);
+  const double total = 1.2 + 0.6 * u(rng);
+  std::vector<double> w(3);
+  double sum = 0.0;
+  for (double& x : w) sum += (x = 0.5 + u(rng));
+  for (int k = 0; k < 3; ++k) {
+    r.amplitude_rad.push_back(total * w[k] / sum);
+    r.wavelength_m.push_back(1000.0 * std::pow(4.0, u(rng)));
+    r.phase_rad.push_back(kTwoPi * u(rng));
+  }
+  return r;
+}
+
+std::shared_ptr<const Effect> steady_wind_truth(double speed_mps, double from_deg, WindingRoute route, double rho_cda_kg_per_m) {
+  return std::make_shared<SteadyWindTruth>(speed_mps, from_deg, std::move(route), rho_cda_kg_per_m);
+}
+
+void route_gps(const WindingRoute& route, const std::vector<double>& distance_m, double lat0_deg, double lon0_deg,
+               std::vector<double>& latitude_deg, std::vector<double>& longitude_deg) {
+  constexpr double kEarthRadius_m = 6371000.0;
+  const double north_m_per_deg = kEarthRadius_m * kTwoPi / 360.0;
+  const double east_m_per_deg = north_m_per_deg * std::cos(lat0_deg * kTwoPi / 360.0);
+  latitude_deg.assign(distance_m.size(), lat0_deg);
+  longitude_deg.assign(distance_m.size(), lon0_deg);
+  double s = 0.0, north = 0.0, east = 0.0;
+  for (std::size_t i = 0; i < distance_m.size(); ++i) {
+    while (s + 1.0 <= distance_m[i]) {  // 1 m steps at the step's middle heading
+      const double h = route.heading_rad(s + 0.5);
+      north += std::cos(h), east += std::sin(h), s += 1.0;
+    }
+    const double rest = distance_m[i] - s, h = route.heading_rad(s + 0.5 * rest);
+    latitude_deg[i] = lat0_deg + (north + rest * std::cos(h)) / north_m_per_deg;
+    longitude_deg[i] = lon0_deg + (east + rest * std::sin(h)) / east_m_per_deg;
+  }
+}
 
 double RollingHills::elevation_m(double s) const {
   double h = 0.0;

@@ -51,6 +51,8 @@ struct ConcealedTruthInfo {
   /// with an engine-off standstill of soak_s between the two (a cold-start test's soak).
   std::string cycle;
   double soak_s = 0.0;
+  /// The trip is driven on a winding route whose latitude and longitude the recording carries.
+  bool gps = false;
 };
 const std::vector<ConcealedTruthInfo>& concealed_truths();
 const ConcealedTruthInfo& concealed_truth(const std::string& truth);  ///< throws InputError when unknown
@@ -68,6 +70,11 @@ struct SyntheticCase {
   /// soak between a cold-start test's two UDDS; 0: the repeats follow each other directly.
   double soak_s = 0.0;
   std::vector<ConcealedEffect> effects;
+  /// Driven on a winding route (winding_route, drawn per seed), recorded with latitude and longitude (GPS noise
+  /// 2 m sd per axis); the steady-wind truth needs it.
+  bool gps = false;
+  /// The steady-wind truth's bearing (clockwise from north, where it blows from) [deg]; unset: drawn per seed.
+  std::optional<double> wind_from_deg;
   double rrc_level_jitter = 0.03;  ///< truth's RRC level, uniform +- (calibration, not a discovery)
   double scale_jitter = 0.02;      ///< measured channel scale, uniform +-
   double noise_w = 400.0;          ///< white sensor noise, standard deviation

@@ -41,6 +41,7 @@ struct FindingSummary {
   std::string effect;
   std::vector<std::string> confounded_with;
   double size = 0.0;
+  double wind_from_deg = -1.0;  ///< wind_heading's fitted bearing (negative: none)
 };
 
 /// What a row asks of a diagnosis. `group` as BenchRow's; `sign` +1 where the truth's physics has a sign (the
@@ -73,6 +74,9 @@ struct BenchRow {
   std::vector<Score> sparse_by_threshold;  ///< per sparse_thresholds() entry
   Score sparse_bic;                        ///< at the threshold BIC picks per recording
   int rollsim_unexplained = 0;  ///< seeds whose first finding was an unexplained signature
+  /// Steady-wind rows (GPS): seeds named with the truth's bearing within 45 deg (of rollsim.named), and the cases.
+  int rollsim_direction_right = 0;
+  bool scores_direction = false;
   /// Seeds counted mistaken for a size of the wrong sign (effect rows), or a never_called finding of negative size
   /// ("reversed" rows; the rest of that row's mistakes had a positive size).
   int rollsim_wrong_sign = 0;

@@ -64,6 +64,22 @@ std::vector<double> engine_thermal_fuel_power_w(const std::vector<double>& time_
                                                 const std::vector<double>& traction_w, const std::vector<bool>& engine_off,
                                                 const EngineThermalTruth& e);
 
+/// A winding route: the heading along the distance, psi(s) = psi0 + sum_k a_k sin(2 pi s / L_k + phi_k), three
+/// bends of 1-4 km (log-uniform) whose amplitudes sum to 1.2-1.8 rad, so the road turns through +-70-100 degrees.
+struct WindingRoute {
+  double heading0_rad = 0.0;
+  std::vector<double> amplitude_rad, wavelength_m, phase_rad;
+  double heading_rad(double distance_m) const;  ///< clockwise from north
+};
+WindingRoute winding_route(std::mt19937& rng);
+/// A steady wind of `speed_mps` from the bearing `from_deg` on that route: headwind w cos(theta - psi(s)), the aero
+/// force 0.5 rho CdA ((v + u)|v + u| - v^2) while moving.
+std::shared_ptr<const Effect> steady_wind_truth(double speed_mps, double from_deg, WindingRoute route, double rho_cda_kg_per_m);
+/// Latitude and longitude [deg] of the points at these distances along the route from (lat0, lon0), integrated on a
+/// local flat earth in 1 m steps.
+void route_gps(const WindingRoute& route, const std::vector<double>& distance_m, double lat0_deg, double lon0_deg,
+               std::vector<double>& latitude_deg, std::vector<double>& longitude_deg);
+
 /// A channel as a logger with a lag behind the truth records it: x(t - lag_s), linearly interpolated between the
 /// samples (a lag need not be a whole number of samples); held at the first value before the start.
 std::vector<double> delayed(const std::vector<double>& time_s, const std::vector<double>& x, double lag_s);

@@ -1,0 +1,80 @@
+// Wind with heading: the direction of travel from GPS, the wind_heading module's headwind w cos(theta - psi), and a
+// steady wind named with its bearing on a winding route (issue 10).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "rollsim/common/units.hpp"
+#include "rollsim/diagnose/diagnose.hpp"
+#include "rollsim/discovery/generate.hpp"
+#include "rollsim/effects/catalogue.hpp"
+#include "rollsim/vehicle/vehicle_file.hpp"
+
+namespace rollsim {
+namespace {
+
+Vehicle ev() { return load_vehicle_file(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/ev.yaml"); }
+
+TEST(WindHeading, HeadingFromGpsIsTheBearingOfTheTrack) {
+  // 100 points 5 m apart going east at 48 degN, then 100 going north: headings pi/2 then 0.
+  const double m_per_deg_lat = 6371000.0 * units::deg_to_rad(1.0);
+  const double m_per_deg_lon = m_per_deg_lat * std::cos(units::deg_to_rad(48.0));
+  std::vector<double> lat, lon;
+  for (int i = 0; i < 100; ++i) lat.push_back(48.0), lon.push_back(11.0 + 5.0 * i / m_per_deg_lon);
+  for (int i = 1; i <= 100; ++i) lat.push_back(48.0 + 5.0 * i / m_per_deg_lat), lon.push_back(lon[99]);
+  const std::vector<double> h = heading_from_gps(lat, lon, 20.0);
+  ASSERT_EQ(h.size(), lat.size());
+  EXPECT_NEAR(h[10], units::kPi / 2.0, 1e-6);
+  EXPECT_NEAR(h[150], 0.0, 1e-6);
+  EXPECT_TRUE(heading_from_gps(std::vector<double>(5, 48.0), std::vector<double>(5, 11.0)).empty());  // never moved
+}
+
+TEST(WindHeading, HeadwindIsTheWindsComponentAgainstTheHeading) {
+  const Vehicle v = ev();
+  const EffectContext ctx = effect_context(v);
+  const double k = 0.5 * ctx.rho_cda_kg_per_m, speed = 20.0, w = 4.0;
+  auto force = [&](double from_deg, double heading_deg, bool known) {
+    const auto e = make_effect("wind_heading", {{"wind_speed_mps", w}, {"wind_from_deg", from_deg}}, ctx);
+    EffectInputs in;
+    in.speed_mps = speed;
+    in.heading_rad = units::deg_to_rad(heading_deg);
+    in.heading_known = known;
+    return e->extra_resistance_n(in, nullptr);
+  };
+  EXPECT_NEAR(force(0.0, 0.0, true), k * ((speed + w) * (speed + w) - speed * speed), 1e-9);   // from ahead
+  EXPECT_NEAR(force(180.0, 0.0, true), k * ((speed - w) * (speed - w) - speed * speed), 1e-9);  // from behind
+  EXPECT_NEAR(force(90.0, 0.0, true), 0.0, 1e-9);                                              // across
+  const double u = w * std::cos(units::deg_to_rad(60.0 - 10.0));
+  EXPECT_NEAR(force(60.0, 10.0, true), k * ((speed + u) * (speed + u) - speed * speed), 1e-9);
+  EXPECT_EQ(force(0.0, 0.0, false), 0.0);  // no heading: no direction to blow against
+}
+
+TEST(WindHeading, SteadyWindOnAWindingRouteIsNamedWithItsBearing) {
+  const Vehicle v = ev();
+  SyntheticCase c;
+  c.gps = true;
+  c.effects = {{"wind_steady_gps", 4.0}};
+  c.wind_from_deg = 250.0;
+  c.seed = 5;
+  const Diagnosis d = diagnose(v, {generate_case(v, c)});
+  ASSERT_FALSE(d.findings.empty());
+  const Finding& f = d.findings.front();
+  ASSERT_EQ(f.effect, "wind_heading");
+  const double from = f.fitted.at("wind_from_deg");
+  EXPECT_LE(std::min(std::abs(from - 250.0), 360.0 - std::abs(from - 250.0)), 45.0) << from;
+  EXPECT_NEAR(f.fitted.at("wind_speed_mps"), 4.0, 1.5);
+  EXPECT_NE(f.description.find("from"), std::string::npos);
+}
+
+TEST(WindHeading, WithoutGpsTheDiagnosisSaysTheHeadingIsUnknown) {
+  const Vehicle v = ev();
+  SyntheticCase c;
+  c.seed = 2;
+  const Diagnosis d = diagnose(v, {generate_case(v, c)});
+  bool said = false;
+  for (const auto& n : d.notes) said = said || n.find("the route's heading is unknown") != std::string::npos;
+  EXPECT_TRUE(said);
+}
+
+}  // namespace
+}  // namespace rollsim
