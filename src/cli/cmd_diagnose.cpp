@@ -64,7 +64,7 @@ void run_diagnose(const DiagnoseCliOptions& o) {
 
 }  // namespace
 
-void register_diagnose_command(CLI::App& app) {
+void register_diagnose_command(CLI::App& app, const ProcessGroup& /*group: the fleet diagnosis*/) {
   auto o = std::make_shared<DiagnoseCliOptions>();
   CLI::App* sub = app.add_subcommand("diagnose", "Compare recordings with the model: locate the mismatch, name and fit missing physics");
   sub->add_option("--vehicle", o->vehicle, "Vehicle YAML file or shipped name")->required()->type_name("FILE");
