@@ -3,6 +3,7 @@
 
 #include <cstdio>
 #include <iostream>
+#include <optional>
 #include <string>
 
 #include "commands.hpp"
@@ -23,7 +24,14 @@ int report(const rollsim::ProcessGroup& group, const std::exception& e, bool sam
 }  // namespace
 
 int main(int argc, char** argv) {
-  const rollsim::ProcessGroup group(argc, argv);
+  std::optional<rollsim::ProcessGroup> started;
+  try {
+    started.emplace(argc, argv);
+  } catch (const rollsim::InputError& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 2;
+  }
+  const rollsim::ProcessGroup& group = *started;
   if (!group.is_root()) {
     std::cout.rdbuf(nullptr);
     std::cerr.rdbuf(nullptr);
