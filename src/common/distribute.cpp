@@ -35,8 +35,9 @@ std::vector<CaseBytes> map_cases_locally(std::size_t tasks, unsigned threads, co
       if (progress) progress(n, tasks);
     });
   } catch (const std::exception&) {
-    throw CaseFailure(failed_case, "case " + std::to_string(failed_case + 1) + " of " + std::to_string(tasks) +
-                                       " failed: " + failure);
+    throw CaseFailure(failed_case,
+                      "case " + std::to_string(failed_case + 1) + " of " + std::to_string(tasks) + " failed: " + failure,
+                      failure);
   }
   return out;
 }

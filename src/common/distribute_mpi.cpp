@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <climits>
 #include <limits>
-#include <mutex>
 #include <thread>
 
 #include "rollsim/common/distribute.hpp"
@@ -38,32 +37,18 @@ std::string local_blob(std::size_t tasks, unsigned threads, int rank, int size, 
                        const CaseProgress& progress) {
   const auto r = static_cast<std::size_t>(rank), n = static_cast<std::size_t>(size);
   const std::size_t mine = tasks > r ? (tasks - 1 - r) / n + 1 : 0;
-  std::mutex m;
-  std::size_t failed = std::numeric_limits<std::size_t>::max();
-  std::string why;
-  auto global_body = [&](std::size_t j) {
-    const std::size_t k = r + j * n;
-    try {
-      return body(k);
-    } catch (const std::exception& e) {
-      const std::lock_guard<std::mutex> lock(m);
-      if (k < failed) {
-        failed = k;
-        why = e.what();
-      }
-      throw;
-    }
-  };
+  // Local case j is case r + j n: the lowest failing j is this rank's lowest failing case.
+  const auto global_body = [&](std::size_t j) { return body(r + j * n); };
   // Rank 0's share stands for the whole run's progress: the shares are equal to one case.
   CaseProgress share_progress;
   if (progress) share_progress = [&](std::size_t d, std::size_t t) { progress(std::min(tasks, d * tasks / t), tasks); };
   std::string blob(1, '\0');
   try {
     for (auto& bytes : map_cases_locally(mine, threads, global_body, share_progress)) put(blob, bytes);
-  } catch (const CaseFailure&) {
+  } catch (const CaseFailure& e) {
     blob.assign(1, '\1');
-    put(blob, failed);
-    put(blob, why);
+    put(blob, r + e.case_index() * n);
+    put(blob, e.reason());
   }
   return blob;
 }
@@ -116,8 +101,10 @@ std::vector<CaseBytes> ProcessGroup::map(std::size_t tasks, unsigned threads, co
     for (std::size_t k = static_cast<std::size_t>(q); k < tasks; k += static_cast<std::size_t>(size_)) take(in, out[k]);
   }
   if (failed != std::numeric_limits<std::size_t>::max()) {
-    throw CaseFailure(failed, "case " + std::to_string(failed + 1) + " of " + std::to_string(tasks) + " failed (rank " +
-                                  std::to_string(failed % static_cast<std::size_t>(size_)) + "): " + why);
+    throw CaseFailure(failed,
+                      "case " + std::to_string(failed + 1) + " of " + std::to_string(tasks) + " failed (rank " +
+                          std::to_string(failed % static_cast<std::size_t>(size_)) + "): " + why,
+                      why);
   }
   return out;
 }

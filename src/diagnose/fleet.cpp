@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <map>
 #include <sstream>
+#include <type_traits>
 
 #include "rollsim/common/csv.hpp"
 #include "rollsim/common/error.hpp"
@@ -106,35 +107,30 @@ FleetEntry diagnose_group(const FleetGroup& g, const DiagnoseOptions& o) {
   return e;
 }
 
+// Every field of an entry, in one order, for both directions of the gather's serialisation.
+template <class Entry, class Field>
+void each_field(Entry& e, Field&& field) {
+  for (auto* s : {&e.group, &e.vehicle, &e.verdict, &e.channel}) field(*s);
+  field(e.recordings);
+  std::size_t n = e.findings.size();
+  field(n);
+  if constexpr (!std::is_const_v<Entry>) e.findings.resize(n);
+  for (auto& f : e.findings) {
+    for (auto* s : {&f.effect, &f.parameter, &f.unit}) field(*s);
+    field(f.value);
+    field(f.energy_share_pct);
+  }
+}
+
 std::string to_bytes(const FleetEntry& e) {
   std::string b;
-  for (const auto* s : {&e.group, &e.vehicle, &e.verdict, &e.channel}) put(b, *s);
-  put(b, e.recordings);
-  put(b, e.findings.size());
-  for (const auto& f : e.findings) {
-    put(b, f.effect);
-    put(b, f.parameter);
-    put(b, f.unit);
-    put(b, f.value);
-    put(b, f.energy_share_pct);
-  }
+  each_field(e, [&](const auto& x) { put(b, x); });
   return b;
 }
 
 FleetEntry from_bytes(std::string_view in) {
   FleetEntry e;
-  for (auto* s : {&e.group, &e.vehicle, &e.verdict, &e.channel}) take(in, *s);
-  take(in, e.recordings);
-  std::size_t n = 0;
-  take(in, n);
-  e.findings.resize(n);
-  for (auto& f : e.findings) {
-    take(in, f.effect);
-    take(in, f.parameter);
-    take(in, f.unit);
-    take(in, f.value);
-    take(in, f.energy_share_pct);
-  }
+  each_field(e, [&](auto& x) { take(in, x); });
   return e;
 }
 

@@ -27,11 +27,14 @@ using CaseMap =
 /// A case whose body threw: every process throws the same one (the lowest failing case), so all of them end.
 class CaseFailure : public std::runtime_error {
  public:
-  CaseFailure(std::size_t case_index, const std::string& what) : std::runtime_error(what), case_index_(case_index) {}
+  CaseFailure(std::size_t case_index, const std::string& what, const std::string& reason)
+      : std::runtime_error(what), case_index_(case_index), reason_(reason) {}
   std::size_t case_index() const { return case_index_; }
+  const std::string& reason() const { return reason_; }  ///< the body's own message
 
  private:
   std::size_t case_index_;
+  std::string reason_;
 };
 
 /// The map on this process alone (parallel_for over its threads).
