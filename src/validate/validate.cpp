@@ -8,7 +8,7 @@
 #include <tuple>
 
 #include "rollsim/common/error.hpp"
-#include "rollsim/common/parallel.hpp"
+#include "rollsim/common/distribute.hpp"
 #include "rollsim/common/units.hpp"
 #include "rollsim/cycle/drive_cycle.hpp"
 
@@ -216,7 +216,7 @@ bool in_fitting_half(const EpaTestRow& row) {
   return h % 2 == 0;
 }
 
-Validation validate_epa_list(const std::vector<EpaTestRow>& rows, unsigned threads) {
+Validation validate_epa_list(const std::vector<EpaTestRow>& rows, unsigned threads, const CaseMap& map) {
   Validation v;
   v.rows.resize(rows.size());
   const auto facts = vehicle_facts(rows);
@@ -224,16 +224,32 @@ Validation validate_epa_list(const std::vector<EpaTestRow>& rows, unsigned threa
 
   const Cycles cycles = shipped_cycles();
   const EpaDefaults nominal;
-  std::vector<Raw> raw(rows.size());
-  parallel_for(rows.size(), threads, [&](std::size_t i) {
-    if (v.rows[i].skip != SkipReason::none) return;
+  // Each row's raw figures (or its failure) travel as bytes: the row may be simulated on another MPI rank.
+  const auto results = map_cases(map, rows.size(), threads, [&](std::size_t i) {
+    std::string bytes;
+    if (v.rows[i].skip != SkipReason::none) return bytes;
+    Raw w;
+    std::string failure;
     try {
-      raw[i] = simulate_row(rows[i], cycles, nominal);
+      w = simulate_row(rows[i], cycles, nominal);
     } catch (const std::exception& e) {  // a row's model outside its domain is that row's skip, not the run's end
-      v.rows[i].skip = SkipReason::simulation_failed;
-      v.rows[i].skip_detail = e.what();
+      failure = e.what();
     }
-  });
+    put(bytes, w);
+    put(bytes, failure);
+    return bytes;
+  }, {});
+  std::vector<Raw> raw(rows.size());
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    if (results[i].empty()) continue;
+    std::string_view in = results[i];
+    std::string failure;
+    take(in, raw[i]);
+    take(in, failure);
+    if (failure.empty()) continue;
+    v.rows[i].skip = SkipReason::simulation_failed;
+    v.rows[i].skip_detail = failure;
+  }
 
   // Fit 1: the cold-start excess, from bag 1 against bag 3 (same trace, cold and hot) of the fitting half's
   // petrol FTPs: measured fuel ratio - 1 = k x (extra fuel per unit k) / hot bag-1 fuel.

@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "rollsim/common/distribute.hpp"
 #include "rollsim/validate/epa_car.hpp"
 #include "rollsim/validate/epa_test_car.hpp"
 
@@ -40,8 +41,9 @@ struct Validation {
 
 /// Classifies every row (skips with reasons, hybrids by rule), simulates the rest by kinematic replay with the
 /// nominal constants, fits the four constants of EpaDefaults on the fitting half, and predicts every row with
-/// them. `threads`: 0 for the hardware's concurrency.
-Validation validate_epa_list(const std::vector<EpaTestRow>& rows, unsigned threads);
+/// them. `threads`: 0 for the hardware's concurrency; `map`: how the rows are spread (over MPI ranks by the CLI;
+/// empty: this process's threads).
+Validation validate_epa_list(const std::vector<EpaTestRow>& rows, unsigned threads, const CaseMap& map = {});
 
 /// FTP-75 fuel economy [mpg] from its bags (40 CFR 600.113): 0.43 x the cold UDDS (bags 1 + 2) and 0.57 x the hot
 /// UDDS (bags 3 + 2), weighted in gallons per mile. Bag 3 drives the same trace as bag 1.
