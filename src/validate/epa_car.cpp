@@ -135,7 +135,7 @@ TransmissionParams transmission_of(const EpaTestRow& row, double top_ratio, cons
   t.converter.k_factor_radps_per_sqrt_nm = 2400.0 * kRadpsPerRpm / std::sqrt(max_torque_nm);
   t.converter.stall_torque_ratio = 2.0;
   t.converter.coupling_speed_ratio = 0.85;
-  t.converter.lockup_min_gear = t.kind == TransmissionKind::cvt || gears >= 6 ? 1 : 3;
+  t.converter.lockup_min_gear = t.kind == TransmissionKind::cvt ? 1 : gears >= 6 ? 2 : 3;
   t.converter.lockup_min_speed_radps = 1000.0 * kRadpsPerRpm;
   return t;
 }
