@@ -133,7 +133,7 @@ TransmissionParams transmission_of(const EpaTestRow& row, double top_ratio, cons
   t.efficiency = (t.kind == TransmissionKind::cvt ? 0.93 : 0.96) * (row.all_wheel_drive ? 0.98 : 1.0);
   t.spin_loss_nm = t.kind == TransmissionKind::clutch ? 2.0 : 4.0;
   t.min_engine_speed_radps = (t.kind == TransmissionKind::clutch ? 1400.0 : 1250.0) * kRadpsPerRpm;
-  t.max_torque_fraction = 0.75;
+  t.max_torque_fraction = 0.6;
   // Torque converter: stall at 2400 rpm against full-load torque; stall torque ratio 2.0, coupling at 0.85;
   // lock-up in every gear of a 6-or-more-speed automatic (third up for 4- and 5-speeds) above 1000 rpm turbine
   // speed, as 2015-2022 automatics do for economy (ZF 8HP: lock-up in all gears shortly after launch).
