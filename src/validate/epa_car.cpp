@@ -167,12 +167,11 @@ std::shared_ptr<const Powertrain> electric_of(const EpaTestRow& row) {
   p.motor.max_power_w = power_w;
   p.motor.max_speed_radps = *row.engine_radps_per_mps * units::kmh_to_mps(200.0);
   p.motor.max_torque_nm = 3.0 * power_w / p.motor.max_speed_radps;
-  // The shipped 80 kW machine's loss model (vehicles/ev.yaml, after ORNL's 2012 Leaf benchmark: copper 4 % of
-  // rated power at peak torque, iron 2.5 % at top speed, windage 0.16 %) scaled to the row's rating: the no-load
-  // iron and switching loss grows with the machine's size and speed, which is what light-load UDDS driving
-  // sees. (This used 1 % iron, below the machine it names.) A 150 W constant for the inverter's standby.
+  // The shipped 80 kW machine's loss model (vehicles/ev.yaml: copper 4 % of rated power at peak torque, iron
+  // 2.5 % at top speed, windage 0.16 %) scaled to the row's rating; the standing loss (inverter, pumps) grows
+  // less than the rating: 400 W + 0.5 %.
   p.motor.losses.copper_w_per_nm2 = 0.04 * power_w / (p.motor.max_torque_nm * p.motor.max_torque_nm);
-  p.motor.losses.iron_w_s_per_rad = 0.025 * power_w / p.motor.max_speed_radps;
+  p.motor.losses.iron_w_s_per_rad = 0.01 * power_w / p.motor.max_speed_radps;
   p.motor.losses.windage_w_s3_per_rad3 = 0.0016 * power_w / std::pow(p.motor.max_speed_radps, 3);
   p.motor.losses.constant_w = 150.0;
   // A 400 V class pack whose I^2 R is 4 % of rated power at rated power (R = 0.04 V^2 / P).
