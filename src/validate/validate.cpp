@@ -158,12 +158,24 @@ double gallons(double m3) { return m3 / kM3PerGallon; }
 // torque ramp lasts ~0.3 s at ~40 % lower efficiency, so ~0.15 s. Set by that reasoning, not fitted.
 constexpr double kTransientFuelTime_s = 0.15;
 
-double fuel_with_transients_m3(const SimulationResult& s) {
+// Deceleration fuel cut-off is not free either (the same paper): the controller waits ~1-2 s after the pedal
+// lifts before cutting (1.5 s at the idle rate here), and when fuelling resumes the three-way catalyst's oxygen
+// store, filled with air during the cut, is purged rich: ~1 g of O2 at 3.4 g of O2 per g of fuel, ~0.3 g of
+// fuel. Counted per entry into cut-off in the trace; the model enters it as often as the Argonne Camry does on
+// the same traces (hot UDDS 67 against 63 measured, HWFET 16 against 14 a run, US06 35 against 20 a run).
+constexpr double kCutOffDelay_s = 1.5;
+constexpr double kCatalystPurgeFuel_kg = 0.3e-3;
+
+double fuel_with_transients_m3(const SimulationResult& s, double idle_fuel_m3_per_s, double fuel_density_kg_per_m3) {
   if (!s.fuel) return 0.0;
   double rises_m3_per_s = 0.0;
-  for (std::size_t i = 1; i < s.trace.size(); ++i)
+  int cut_offs = 0;
+  for (std::size_t i = 1; i < s.trace.size(); ++i) {
     rises_m3_per_s += std::max(0.0, s.trace[i].segment_fuel_rate_m3_per_s - s.trace[i - 1].segment_fuel_rate_m3_per_s);
-  return s.fuel->volume_m3 + kTransientFuelTime_s * rises_m3_per_s;
+    if (s.trace[i].segment_fuel_rate_m3_per_s <= 0.0 && s.trace[i - 1].segment_fuel_rate_m3_per_s > 0.0) ++cut_offs;
+  }
+  return s.fuel->volume_m3 + kTransientFuelTime_s * rises_m3_per_s +
+         cut_offs * (kCutOffDelay_s * idle_fuel_m3_per_s + kCatalystPurgeFuel_kg / fuel_density_kg_per_m3);
 }
 
 double ftp_composite_mpg(const Raw& w, double cold_fuel_excess) {
@@ -183,7 +195,9 @@ Raw simulate_row(const EpaTestRow& r, const Cycles& c, const EpaDefaults& d) {
     w.mpg_or_mpge = kKwhPerGallonEquivalent / (wall_kwh / miles(s.distance_m));
     return w;
   }
-  auto fuel_m3 = fuel_with_transients_m3;
+  const double idle_m3_per_s = car.powertrain->deliver(0.0, 0.0, 0, car.wheel_radius_m).fuel_rate_m3_per_s;
+  const double density = car.powertrain->fuel()->density_kg_per_m3;
+  auto fuel_m3 = [&](const SimulationResult& s) { return fuel_with_transients_m3(s, idle_m3_per_s, density); };
   SimulationOptions traced;
   traced.record_trace = true;
   if (r.cycle == EpaCycle::ftp75) {
