@@ -66,7 +66,7 @@ bool name_says_hybrid(const EpaTestRow& r) {
   for (const char* word : {"hybrid", "plug-in", "prime", "4xe", "recharge", "tfsie"}) {
     if (m.find(word) != std::string::npos) return true;
   }
-  // Whole tokens: HEV, FHEV, PHEV, MHEV, and Volvo's T8 (its plug-in).
+  // Whole tokens: HEV, FHEV, PHEV, MHEV, Volvo's T8 (its plug-in), and Lexus's numbers ending in h.
   std::string token;
   for (std::size_t i = 0; i <= m.size(); ++i) {
     if (i < m.size() && std::isalnum(static_cast<unsigned char>(m[i]))) {
@@ -74,6 +74,9 @@ bool name_says_hybrid(const EpaTestRow& r) {
       continue;
     }
     if (token == "t8" || (token.size() >= 3 && token.compare(token.size() - 3, 3, "hev") == 0)) return true;
+    // Lexus names its hybrids by a number and an h: ES 300h, NX 350h, RX 450h, LC 500h, LS 500h.
+    if (token.size() == 4 && token.back() == 'h' && std::all_of(token.begin(), token.end() - 1, [](char c) { return std::isdigit(static_cast<unsigned char>(c)); }))
+      return true;
     token.clear();
   }
   return false;
