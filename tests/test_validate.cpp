@@ -312,13 +312,19 @@ TEST(EpaList, WholeListSkipsByNameAndAgreesAsReportedOnTheHeldOutHalf) {
   // The split keeps every test of a model on one side.
   for (const auto& o : v.rows) EXPECT_EQ(o.fitting_half, validate::in_fitting_half(*o.row));
 
-  // Judged on the half the constants were not fitted on (README, "Validation"): what the model does today, as a
-  // floor that catches a regression, not the targets (which it does not all meet; see README).
+  // Judged on the half the constants were not fitted on (README, "Validation"). The targets where they
+  // are met (petrol HWFET: median |error| <= 5 %, 90th percentile <= 12 %; electric highway <= 6 %); elsewhere
+  // what the model does today, as a floor that catches a regression (README says what is not met).
   const auto c = validate::coverage(v, false);
   EXPECT_GE(c.simulated, 0.8 * c.eligible);
   for (const auto& s : validate::summarise(v)) {
     if (s.half != "held-out" || s.count < 30) continue;
-    if (s.powertrain == "petrol") EXPECT_LT(s.median_abs_error_pct, 10.0) << s.cycle;
+    if (s.powertrain == "petrol" && s.cycle == "HWFET") {
+      EXPECT_LE(s.median_abs_error_pct, 5.0);
+      EXPECT_LE(s.p90_abs_error_pct, 12.0);
+    }
+    if (s.powertrain == "petrol") EXPECT_LT(s.median_abs_error_pct, 7.0) << s.cycle;
+    if (s.powertrain == "electric" && s.cycle == "CD HWFET") EXPECT_LE(s.median_abs_error_pct, 6.0);
     if (s.powertrain == "electric") EXPECT_LT(s.median_abs_error_pct, 13.0) << s.cycle;
   }
   // The fitted constants stay physical: gross indicated efficiency 0.3-0.5, charge efficiency below 1.
