@@ -17,12 +17,13 @@ namespace {
 
 constexpr double kG = 9.80665;
 
-// The stage is opt-in (DiagnoseOptions::infer_road_profile); these tests are about what it does when asked.
+// The stage is on by default (DiagnoseOptions::infer_road_profile); said here so the tests do not depend on it.
 DiagnoseOptions profile_on() {
   DiagnoseOptions o;
   o.infer_road_profile = true;
   return o;
 }
+
 
 Vehicle ev() { return load_vehicle_file(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/ev.yaml"); }
 
@@ -30,6 +31,11 @@ const Finding* find(const Diagnosis& d, const std::string& effect) {
   for (const auto& f : d.findings)
     if (f.effect == effect) return &f;
   return nullptr;
+}
+
+bool names_a_road(const Vehicle& v, const SyntheticCase& c) {
+  const Diagnosis d = diagnose(v, {generate_case(v, c)}, profile_on());
+  return find(d, "road_profile") != nullptr;
 }
 
 SyntheticCase hills_case(double amplitude_m, unsigned seed) {
@@ -158,12 +164,33 @@ TEST(RoadProfile, NotCalledWhereElevationIsRecordedOrNothingIsMissing) {
 
 // Measurement, not a check (run with --gtest_also_run_disabled_tests): how often the recovered profile of 25 m hills
 // correlates >= 0.8 with the truth, raw and detrended, over 100 seeds of the benchmark's row.
-// Off by default: without the option, withheld hills are left to the unexplained stage, not named a profile.
-TEST(RoadProfile, IsOnlyTriedWhenAsked) {
+TEST(RoadProfile, IsOnByDefaultAndCanBeSwitchedOff) {
   const Vehicle v = ev();
   const Recording rec = generate_case(v, hills_case(25.0, 3u));
-  EXPECT_EQ(find(diagnose(v, {rec}), "road_profile"), nullptr);
-  EXPECT_NE(find(diagnose(v, {rec}, profile_on()), "road_profile"), nullptr);
+  EXPECT_NE(find(diagnose(v, {rec}), "road_profile"), nullptr);
+  DiagnoseOptions off;
+  off.infer_road_profile = false;
+  EXPECT_EQ(find(diagnose(v, {rec}, off), "road_profile"), nullptr);
+}
+
+// On one pass a profile along distance absorbs any loss that drifts along the trip as well as it absorbs hills. Only
+// a road can push the force below zero loss, so these are not named a road (each was, in most seeds, before the
+// descent rule: the scorecard of 2026-11-23 with the stage on, docs/scorecard-road-profile-on-100-seeds.txt).
+TEST(RoadProfile, LossesDriftingAlongTheTripAreNotARoad) {
+  const Vehicle v = ev();
+  for (unsigned seed : {60001u, 60002u, 60003u}) {  // an RRC rising towards the end (a warm-up run backwards)
+    SyntheticCase c = SyntheticCase{};
+    c.effects = {{"tyre_two_node", 0.3}};
+    c.time_reversed = true;
+    c.seed = seed;
+    EXPECT_FALSE(names_a_road(v, c)) << "reversed warm-up, seed " << seed;
+  }
+  for (unsigned seed : {61001u, 61002u}) {  // a gusting headwind
+    SyntheticCase c = SyntheticCase{};
+    c.effects = {{"wind_gusty", 1.5}};
+    c.seed = seed;
+    EXPECT_FALSE(names_a_road(v, c)) << "gusty wind, seed " << seed;
+  }
 }
 
 TEST(RoadProfile, DISABLED_ProfileCorrelationOver100Seeds) {

@@ -22,7 +22,7 @@ struct DiagnoseCliOptions {
   std::string vehicle, tyre, preset, json, write_vehicle, report;
   std::vector<std::string> recordings, columns, scales;
   double window_s = 0.0;  // 0: the library default
-  bool road_profile = false;
+  bool road_profile = true;
 };
 
 void run_diagnose(const DiagnoseCliOptions& o) {
@@ -77,8 +77,9 @@ void register_diagnose_command(CLI::App& app) {
   sub->add_option("--json", o->json, "Write the diagnosis as JSON")->type_name("FILE");
   sub->add_option("--window-s", o->window_s, "Energy window length [s] (default 60; SOC channels lengthen it by the quantum)")
       ->check(CLI::Range(5.0, 3600.0));
-  sub->add_flag("--road-profile", o->road_profile, "Where elevation is not recorded, try an elevation profile along the "
-                "route as an explanation (opt-in: on one pass it also absorbs slow drifts in time; README)");
+  sub->add_flag("--road-profile,!--no-road-profile", o->road_profile, "Where elevation is not recorded, try an elevation "
+                "profile along the route as an explanation (default on; named only with a descent steeper than the rolling "
+                "resistance; README)");
   sub->add_option("--report", o->report, "Write figures (SVG, gnuplot) and report.html into this folder")->type_name("DIR");
   sub->add_option("--write-vehicle", o->write_vehicle, "Write the vehicle with the fitted effects switched on")->type_name("FILE");
   sub->callback([o] { run_diagnose(*o); });

@@ -36,7 +36,8 @@ void register_diagnose_bench_command(CLI::App& app) {
                   "concealed tyre warm-up (repeatable)")->type_name("CSV");
   sub->add_option("--only", o->bench.only, "Only the rows whose label contains this text (repeatable), e.g. 'real logger'")
       ->type_name("TEXT");
-  sub->add_flag("--road-profile", o->bench.infer_road_profile, "Diagnose with the road_profile stage on, on every row");
+  sub->add_flag("--road-profile,!--no-road-profile", o->bench.infer_road_profile,
+                "Diagnose with the road_profile stage on (default) or off, on every row");
   sub->add_option("--real-trace-preset", o->real_trace_preset, "Column preset of the --real-trace files (default rsk_twizy)")
       ->type_name("NAME");
   sub->callback([o] {

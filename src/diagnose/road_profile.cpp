@@ -156,6 +156,52 @@ Standing standing_check(const Observations& sw, const DriveCycle& c, const Eigen
   return st;
 }
 
+// The car's rolling resistance as a grade (force over m g), at its calibrated level, averaged over the trip the way
+// the channel sees it: its whole RRC is 10 x the calibration's +10 % signature, a grade the unit force times m g.
+double rolling_grade(const Signatures& sig, const BasisShape& unit, const Eigen::VectorXd& k, double m_g) {
+  double rrc_w = 0.0, per_newton_w = 0.0;
+  const std::vector<double>& base = sig.base.power_w.front();
+  for (std::size_t i = 0; i < base.size(); ++i) {
+    rrc_w += 10.0 * (sig.rrc.power_w.front()[i] - base[i]);
+    per_newton_w += unit.power_w.front()[i] - base[i];
+  }
+  if (!(std::abs(per_newton_w) > 0.0)) return 0.0;
+  return (1.0 + 0.1 * k[1] / k[0]) * rrc_w / (per_newton_w * m_g);
+}
+
+// A road is the one explanation in the catalogue whose force can fall below zero loss: a descent steeper than the
+// car's whole rolling resistance. Losses that vary along the trip (an RRC rising with rain or warm-up run
+// backwards, an auxiliary load, a payload, wind gusts about a headwind) move the force by a fraction of it, and a
+// one-pass profile absorbs them as well as it absorbs hills. So a profile is a road only where some knot's grade is
+// below minus the rolling grade by more than the knots' family-wise 95 % bound (Bonferroni over the knots).
+// z with P(Z > z) = p for a standard normal, by bisection on erfc (a handful of calls per diagnosis).
+double normal_upper_quantile(double p) {
+  double lo = 0.0, hi = 40.0;
+  for (int i = 0; i < 200 && hi - lo > 1e-9; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (0.5 * std::erfc(mid / std::sqrt(2.0)) > p ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+struct Descent {
+  double grade = 0.0, rolling_grade = 0.0, z = 0.0, z_needed = 0.0;
+  bool road_only = false;
+};
+Descent steepest_descent(const Eigen::VectorXd& grade, const Eigen::MatrixXd& cov, double rolling_grade) {
+  Descent d;
+  d.rolling_grade = rolling_grade;
+  d.z = -1e300;
+  for (Eigen::Index i = 0; i < grade.size(); ++i) {
+    const double sd = std::sqrt(std::max(1e-300, cov(i, i)));
+    const double z = (-rolling_grade - grade[i]) / sd;
+    if (z > d.z) d.z = z, d.grade = grade[i];
+  }
+  d.z_needed = normal_upper_quantile(0.025 / static_cast<double>(std::max<Eigen::Index>(1, grade.size())));
+  d.road_only = d.z >= d.z_needed;
+  return d;
+}
+
 struct Competitor {
   std::string name;
   Eigen::VectorXd column;
@@ -348,13 +394,18 @@ std::optional<Finding> infer_road_profile(const SelectionContext& sc, const std:
   const bool quiet = still.windows < 3 || still.z < sc.opt.adequacy_z || still.ratio < sc.opt.adequacy_min_ratio ||
                      still.ratio < kStandingShare * still.moving_ratio;
   const double thr = sc.opt.bic_threshold;
-  const bool named = dbic >= thr && rmse_after < rmse_before && dbic - rival_dbic >= thr && quiet;
+  const double sigma2 = rss / std::max(1.0, n - best.edf) * n / n_eff;
+  const Eigen::MatrixXd cov = sigma2 * best.a_inv * xtx * best.a_inv;
+  const Descent descent = steepest_descent(grade, cov, rolling_grade(sig, *unit, k, m_g));
+  const bool named = dbic >= thr && rmse_after < rmse_before && dbic - rival_dbic >= thr && quiet && descent.road_only;
   notes.push_back("road_profile (elevation withheld): Delta BIC " + fixed(dbic, 1) + " at " + fixed(best.edf, 1) +
                   " effective parameters on " + std::to_string(sw.n()) + " windows of " + fixed(kShortWindowS, 0) +
                   " s, best single shape (" + (rival ? rival->name : std::string("none")) + ") " + fixed(rival_dbic, 1) +
                   ", held-out RMSE " + fixed(rmse_before / 1e3, 1) + " -> " + fixed(rmse_after / 1e3, 1) + " kJ, standing residual " +
                   fixed(still.ratio, 2) + " x the floor (" + std::to_string(still.windows) + " windows; moving " + fixed(still.moving_ratio, 1) + " x)" +
-                  (loop ? ", a loop (net climb held at 0)" : "") + (named ? ": named" : ": not named"));
+                  (loop ? ", a loop (net climb held at 0)" : "") + ", steepest descent " + fixed(100.0 * descent.grade, 1) + " % (" +
+                  fixed(descent.z, 1) + " sd beyond the rolling resistance's " + fixed(-100.0 * descent.rolling_grade, 1) + " %, " +
+                  fixed(descent.z_needed, 1) + " needed)" + (named ? ": named" : ": not named"));
   if (!named) return std::nullopt;
 
   // The profile: elevations at the knots, relative to the start, with a 95 % band from the sandwich covariance
@@ -365,8 +416,6 @@ std::optional<Finding> infer_road_profile(const SelectionContext& sc, const std:
     cum.row(i) = cum.row(i - 1);
     cum(i, i - 1) = std::min(bins.spacing_m, bins.total_m - static_cast<double>(i - 1) * bins.spacing_m);
   }
-  const double sigma2 = rss / std::max(1.0, n - best.edf) * n / n_eff;
-  const Eigen::MatrixXd cov = sigma2 * best.a_inv * xtx * best.a_inv;
   const Eigen::VectorXd elev = cum * grade;
   const Eigen::VectorXd var = (cum * cov * cum.transpose()).diagonal();
   for (Eigen::Index i = 0; i <= kb; ++i) {

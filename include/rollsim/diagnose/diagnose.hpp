@@ -71,12 +71,11 @@ struct DiagnoseOptions {
   /// Where ambient_rrc is tested, each recording is replayed with the air density of its recorded ambient.
   bool air_density_from_ambient = true;
   unsigned threads = 0;  ///< simulator runs in parallel (0: hardware concurrency)
-  /// Invert the residual into a road profile where elevation is not recorded (road_profile). Off unless asked:
-  /// on one pass over a route, distance grows with time, so a profile along distance also absorbs a slow drift
-  /// in time (a gusty headwind, an RRC rising or falling over the trip). The 100-seed scorecard on 2026-11-23
-  /// named it wrongly on most such recordings (README, "Road profile"), so a user who knows the route is hilly
-  /// and its elevation unknown turns it on (`--road-profile`) and reads the finding as one explanation.
-  bool infer_road_profile = false;
+  /// Invert the residual into a road profile where elevation is not recorded (road_profile). On one pass a profile
+  /// along distance also absorbs a drift in time (a gusty headwind, an RRC rising over the trip), so it is named
+  /// only with a descent steeper than the car's whole rolling resistance, which no loss can mimic (README, "Road
+  /// profile"). `--no-road-profile` switches the stage off.
+  bool infer_road_profile = true;
 };
 
 struct ParameterEstimate {

@@ -23,7 +23,7 @@ struct BenchOptions {
   std::string combustion_vehicle = "ice";
   /// Only the rows whose label contains one of these (empty: every row), e.g. {"real logger"}.
   std::vector<std::string> only;
-  bool infer_road_profile = false;  ///< diagnose with the road_profile stage on (DiagnoseOptions), on every row
+  bool infer_road_profile = true;  ///< diagnose with the road_profile stage (DiagnoseOptions), on every row
 };
 
 /// How one method fared on one case, over its seeds.
