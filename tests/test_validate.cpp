@@ -4,7 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
+#include <iostream>
 #include <numbers>
 
 #include "rollsim/powertrain/conventional.hpp"
@@ -71,6 +73,67 @@ TEST(EngineMap, PumpingVanishesAtTheUnthrottledLoadAndEnrichmentAtFullLoad) {
   lean.enrichment_max = 0.0;
   const double full = m.max_torque_nm(w);
   EXPECT_NEAR(m.fuel_power_w(w, full) / EngineMap(lean).fuel_power_w(w, full), 1.15, 1e-12);
+}
+
+TEST(EngineMap, KnockRetardCostsEfficiencyFromItsStartToFullLoad) {
+  EngineMapParams p = petrol_map();
+  p.knock_start_fraction = 0.6;
+  p.knock_efficiency_loss_max = 0.10;
+  EngineMapParams clean = p;
+  clean.knock_efficiency_loss_max = 0.0;
+  const EngineMap m(p), c(clean);
+  const double w = 300.0, full = m.max_torque_nm(w);
+  // Below the start nothing; at full load the indicated efficiency is 10 % lower, so 1 / 0.9 the fuel; halfway
+  // between start and full load half of it.
+  EXPECT_DOUBLE_EQ(m.fuel_power_w(w, 0.5 * full), c.fuel_power_w(w, 0.5 * full));
+  EXPECT_NEAR(m.fuel_power_w(w, full) / c.fuel_power_w(w, full), 1.0 / 0.9, 1e-12);
+  EXPECT_NEAR(m.fuel_power_w(w, 0.8 * full) / c.fuel_power_w(w, 0.8 * full), 1.0 / 0.95, 1e-12);
+}
+
+validate::EpaTestRow petrol_row(double litres, double hp) {
+  validate::EpaTestRow row;
+  row.fuel = validate::EpaFuel::petrol;
+  row.transmission = validate::EpaTransmission::automatic;
+  row.gears = 8;
+  row.test_mass_kg = 1600.0;
+  row.road_a_n = 150.0;
+  row.road_b_n_s_per_m = 2.0;
+  row.road_c_n_s2_per_m2 = 0.4;
+  row.displacement_m3 = litres * 1e-3;
+  row.rated_power_w = hp * 745.69987158;
+  row.engine_radps_per_mps = 25.0 * 0.2341889;  // 25 rpm/mph
+  return row;
+}
+
+double indicated_efficiency_of(const validate::EpaTestRow& row) {
+  const auto m = validate::car_from_row(row, validate::EpaDefaults{});
+  return dynamic_cast<const ConventionalPowertrain&>(*m.powertrain).params().engine.indicated_efficiency;
+}
+
+// A boosted engine (high output per litre) runs a lower compression ratio: 13 up to 85 hp/l, 9 from 200 hp/l.
+// The ideal Otto efficiency 1 - r^(1 - 1.3) gives 0.537 at 13 and 0.483 at 9: 0.900 of the reference.
+TEST(EpaCar, BoostedEnginesLoseIndicatedEfficiencyWithTheirCompressionRatio) {
+  const double reference = validate::EpaDefaults{}.petrol_indicated_efficiency;
+  EXPECT_DOUBLE_EQ(indicated_efficiency_of(petrol_row(2.5, 200.0)), reference);  // 80 hp/l
+  EXPECT_NEAR(indicated_efficiency_of(petrol_row(2.0, 420.0)) / reference, 0.900, 0.001);  // 210 hp/l
+  const double mid = indicated_efficiency_of(petrol_row(2.0, 230.0)) / reference;  // 115 hp/l: ratio 10.5
+  EXPECT_NEAR(mid, (1.0 - std::pow(10.5, -0.3)) / (1.0 - std::pow(13.0, -0.3)), 1e-9);
+}
+
+// The transient additions read the trace alone: rises of the segment fuel rate, and entries into cut-off.
+TEST(TransientFuel, RisesAndCutOffsComeFromTheTrace) {
+  SimulationResult s;
+  s.fuel = FuelFigures{1e-3, 0.0};
+  for (double rate : {1e-6, 3e-6, 0.0, 0.0, 2e-6, 0.0, 1e-6}) {
+    TracePoint p{};
+    p.segment_fuel_rate_m3_per_s = rate;
+    s.trace.push_back(p);
+  }
+  const auto e = validate::fuel_events(s);
+  EXPECT_NEAR(e.rises_m3_per_s, 2e-6 + 2e-6 + 1e-6, 1e-18);
+  EXPECT_EQ(e.cut_offs, 2);
+  const double idle = 0.3e-6, density = 743.0;
+  EXPECT_NEAR(validate::fuel_with_transients_m3(s, idle, density), 1e-3 + 0.15 * 5e-6 + 2 * (1.5 * idle + 0.3e-3 / density), 1e-15);
 }
 
 ConventionalPowertrainParams car(TransmissionKind kind) {
@@ -237,6 +300,9 @@ TEST(EpaList, WholeListSkipsByNameAndAgreesAsReportedOnTheHeldOutHalf) {
       ++absurd;
     }
     if (o.row->cycle == validate::EpaCycle::sc03) EXPECT_EQ(o.skip, validate::SkipReason::air_conditioning_test);
+    // Lexus's hybrids say so only by an h after the number.
+    if ((m == "LC 500h" || m == "ES 300h") && o.row->cycle != validate::EpaCycle::sc03 && o.row->cycle != validate::EpaCycle::cold)
+      EXPECT_EQ(o.skip, validate::SkipReason::hybrid) << m;
     if (o.skip == validate::SkipReason::none) {
       EXPECT_TRUE(std::isfinite(o.predicted) && o.predicted > 0.0) << o.row->test_number;
     }
@@ -246,19 +312,78 @@ TEST(EpaList, WholeListSkipsByNameAndAgreesAsReportedOnTheHeldOutHalf) {
   // The split keeps every test of a model on one side.
   for (const auto& o : v.rows) EXPECT_EQ(o.fitting_half, validate::in_fitting_half(*o.row));
 
-  // Judged on the half the constants were not fitted on (README, "Validation"): what the model does today, as a
-  // floor that catches a regression, not the issue's targets (which it does not all meet; see README).
+  // Judged on the half the constants were not fitted on (README, "Validation"). The issue's targets where they
+  // are met (petrol HWFET: median |error| <= 5 %, 90th percentile <= 12 %; electric highway <= 6 %); elsewhere
+  // what the model does today, as a floor that catches a regression (README says what is not met).
   const auto c = validate::coverage(v, false);
   EXPECT_GE(c.simulated, 0.8 * c.eligible);
   for (const auto& s : validate::summarise(v)) {
     if (s.half != "held-out" || s.count < 30) continue;
-    if (s.powertrain == "petrol") EXPECT_LT(s.median_abs_error_pct, 10.0) << s.cycle;
+    if (s.powertrain == "petrol" && s.cycle == "HWFET") {
+      EXPECT_LE(s.median_abs_error_pct, 5.0);
+      EXPECT_LE(s.p90_abs_error_pct, 12.0);
+    }
+    if (s.powertrain == "petrol") EXPECT_LT(s.median_abs_error_pct, 7.0) << s.cycle;
+    if (s.powertrain == "electric" && s.cycle == "CD HWFET") EXPECT_LE(s.median_abs_error_pct, 6.0);
     if (s.powertrain == "electric") EXPECT_LT(s.median_abs_error_pct, 13.0) << s.cycle;
   }
   // The fitted constants stay physical: gross indicated efficiency 0.3-0.5, charge efficiency below 1.
   EXPECT_GT(v.fitted.defaults.petrol_indicated_efficiency, 0.3);
   EXPECT_LT(v.fitted.defaults.petrol_indicated_efficiency, 0.5);
   EXPECT_LT(v.fitted.defaults.charge_efficiency, 1.0);
+}
+
+// Issue 13, item 5: the Camry built from its own EPA row (2022 XLE, 203 hp, 3625 lb: the Argonne car's generation)
+// with the same maps, on the Argonne D3 traces and their measured fuel flow. The model enters fuel cut-off about
+// as often as the car's fuel flow drops to zero; the errors after one calibrated scale are printed for the
+// README (they do not meet the issue's 3 %; see there).
+TEST(CamryArgonne, CutOffEntriesMatchTheMeasuredFuelFlow) {
+  const auto rows = validate::read_epa_test_car_list(std::string(ROLLSIM_SOURCE_DIR) + "/../shared/data/vehicles/epa_2022_toyota_camry.csv");
+  const validate::EpaTestRow* row = nullptr;
+  for (const auto& r : rows) {
+    if (r.model == "CAMRY XLE/XSE" && r.cycle == validate::EpaCycle::ftp75 && std::abs(*r.test_mass_kg - 3625 * 0.45359237) < 1.0) row = &r;
+  }
+  ASSERT_NE(row, nullptr);
+  const VehicleModel car = validate::car_from_row(*row, validate::EpaDefaults{});
+  const double idle_m3_per_s = car.powertrain->deliver(0.0, 0.0, 0, car.wheel_radius_m).fuel_rate_m3_per_s;
+  SimulationOptions traced;
+  traced.record_trace = true;
+  const std::string dir = std::string(ROLLSIM_SOURCE_DIR) + "/../shared/data/recordings/anl_d3_2018_toyota_camry/";
+  double measured_sum = 0.0, predicted_sum = 0.0;
+  std::vector<std::pair<double, double>> fuel;  // measured, predicted [m3]
+  for (const char* file : {"61811012_test_data.csv", "61811013_test_data.csv", "61811014_test_data.csv"}) {
+    std::ifstream in(dir + file);
+    std::string line;
+    std::getline(in, line);  // Time[s],Eng_FuelFlow_Direct_DI[ccps],Dyno_Spd[mph]
+    DriveCycle c;
+    c.name = file;
+    double measured_m3 = 0.0, last_cm3_per_s = 0.0;
+    int measured_cut_offs = 0;
+    while (std::getline(in, line)) {
+      double t = 0.0, cm3_per_s = 0.0, mph = 0.0;
+      if (std::sscanf(line.c_str(), "%lf,%lf,%lf", &t, &cm3_per_s, &mph) != 3 || (!c.time_s.empty() && t <= c.time_s.back())) continue;
+      c.time_s.push_back(t);
+      c.speed_mps.push_back(mph * 0.44704);
+      c.grade.push_back(0.0);
+      measured_m3 += cm3_per_s * 1e-6;  // 1 Hz samples
+      if (mph > 1.0 && cm3_per_s <= 0.02 && last_cm3_per_s > 0.02) ++measured_cut_offs;
+      last_cm3_per_s = cm3_per_s;
+    }
+    const SimulationResult s = simulate_replay(car, c, traced);
+    const int model_cut_offs = validate::fuel_events(s).cut_offs;
+    const double predicted_m3 = validate::fuel_with_transients_m3(s, idle_m3_per_s, car.powertrain->fuel()->density_kg_per_m3);
+    std::cout << file << ": cut-off entries " << model_cut_offs << " (measured " << measured_cut_offs << ")\n";
+    // Hot UDDS 68 against 63 measured, two HWFETs 34 against 28, two US06s 43 against 39: within a quarter.
+    EXPECT_NEAR(model_cut_offs, measured_cut_offs, 0.25 * measured_cut_offs) << file;
+    fuel.emplace_back(measured_m3, predicted_m3);
+    measured_sum += measured_m3;
+    predicted_sum += predicted_m3;
+  }
+  const double scale = measured_sum / predicted_sum;  // the Camry's own calibration: one scale on its fuel
+  for (const auto& [measured, predicted] : fuel) {
+    std::cout << "fuel " << measured * 1e6 << " cm3 measured, " << predicted * 1e6 << " predicted (" << 100.0 * (predicted / measured - 1.0)
+              << " %), calibrated x" << scale << ": " << 100.0 * (scale * predicted / measured - 1.0) << " %\n";
+  }
 }
 
 TEST(CliValidate, JsonRowsAndANamedErrorForAFileWithoutTheColumns) {

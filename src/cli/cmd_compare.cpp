@@ -22,15 +22,16 @@ struct CompareOptionsText {
   std::string catalogue;
   bool use_catalogue = false;
   std::string diameter_tolerance_pct = "3";
-  bool json = false, csv = false;
+  bool json = false, csv = false, replay = false;
+  std::string threads;
 };
 
 std::string signed_fixed(double v, int d) { return (v > 0 ? "+" : "") + fixed(v, d); }
 
-void print_table(const selection::Comparison& c) {
+void print_table(const selection::Comparison& c, bool replay) {
   const std::string unit = selection::energy_unit_label(c.unit);
   std::cout << c.vehicle << " on " << c.cycle << ": tyres ranked by " << (c.shows_range ? "battery energy" : "fuel")
-            << " (forward simulation, tyre on all four wheels; RRC and RR power at 80 km/h and "
+            << " (" << selection::run_mode_label(replay) << ", tyre on all four wheels; RRC and RR power at 80 km/h and "
             << fixed(c.ranked.empty() ? 0.0 : c.ranked.front().fit.wheel_load_n, 0) << " N per wheel)\n";
   std::vector<std::string> h{"#", "tyre", "size", "p [bar]", "RRC x1000", "P_RR [W]", unit, "vs own [%]"};
   if (c.shows_range) h.push_back("range chg [km]");
@@ -88,11 +89,14 @@ void print_csv(const selection::Comparison& c, bool header) {
   for (const auto& r : c.unfit) emit(r, 0);
 }
 
-void run_compare(const CompareOptionsText& o) {
+void run_compare(const CompareOptionsText& o, const ProcessGroup& group) {
   if (o.vehicles.empty()) throw InputError("--vehicle", "missing: give the car, e.g. --vehicle ev");
   if (o.json && o.csv) throw InputError("--csv", "not allowed together with --json");
   selection::CompareOptions copt;
   copt.diameter_tolerance_pct = selection::parse_diameter_tolerance_pct(o.diameter_tolerance_pct);
+  copt.replay = o.replay;
+  if (!o.threads.empty()) copt.threads = static_cast<unsigned>(parse_option_number(o.threads, "--threads", Range::closed(1, 1024)));
+  copt.map_cases = group.mapper();
 
   // Candidates: --tyre files, then every *.yaml of the catalogue; a broken file is named and skipped.
   const selection::CandidateList list = selection::load_candidates(o.tyres, o.use_catalogue, o.catalogue);
@@ -108,7 +112,7 @@ void run_compare(const CompareOptionsText& o) {
       const auto cmp = selection::compare_tyres(v, candidates, cycle, copt);
       if (o.json) print_json(cmp);
       else if (o.csv) print_csv(cmp, csv_header);
-      else print_table(cmp);
+      else print_table(cmp, o.replay);
       csv_header = false;
     }
   }
@@ -117,7 +121,7 @@ void run_compare(const CompareOptionsText& o) {
 
 }  // namespace
 
-void register_compare_command(CLI::App& app) {
+void register_compare_command(CLI::App& app, const ProcessGroup& group) {
   auto o = std::make_shared<CompareOptionsText>();
   CLI::App* sub = app.add_subcommand("compare", "Tyre selection: rank tyres for a car by cycle energy or fuel, with fit checks");
   sub->add_option("--vehicle", o->vehicles, "Vehicle file or shipped name (repeatable)")->type_name("FILE");
@@ -130,11 +134,14 @@ void register_compare_command(CLI::App& app) {
   sub->add_option("--diameter-tolerance-pct", o->diameter_tolerance_pct,
                   "Allowed outer-diameter change from the car's own tyre [%] (default 3)")
       ->type_name("PCT");
+  sub->add_flag("--replay", o->replay, "Kinematic replay of the cycle instead of the forward simulation (driver + CVODE)");
+  sub->add_option("--threads", o->threads, "Worker threads (default: every core; under mpirun, the node's cores over its ranks)")
+      ->type_name("N");
   sub->add_flag("--json", o->json, "One JSON object per tyre per line");
   sub->add_flag("--csv", o->csv, "CSV with a header line");
-  sub->callback([o, cat] {
+  sub->callback([o, cat, &group] {
     o->use_catalogue = cat->count() > 0;
-    run_compare(*o);
+    run_compare(*o, group);
   });
 }
 

@@ -24,7 +24,7 @@ struct CliOptions {
 
 }  // namespace
 
-void register_diagnose_bench_command(CLI::App& app) {
+void register_diagnose_bench_command(CLI::App& app, const ProcessGroup& group) {
   auto o = std::make_shared<CliOptions>();
   CLI::App* sub = app.add_subcommand("diagnose-bench", "Scorecard of rollsim diagnose on synthetic recordings with concealed effects, beside two baselines");
   sub->add_option("--vehicle", o->vehicle, "Vehicle YAML (electric; default ev)")->type_name("FILE");
@@ -40,12 +40,13 @@ void register_diagnose_bench_command(CLI::App& app) {
                 "Diagnose with the road_profile stage on (default) or off, on every row");
   sub->add_option("--real-trace-preset", o->real_trace_preset, "Column preset of the --real-trace files (default rsk_twizy)")
       ->type_name("NAME");
-  sub->callback([o] {
+  sub->callback([o, &group] {
     const Vehicle v = load_vehicle_file(resolve_data_file(o->vehicle, "vehicles", ".yaml", "--vehicle"));
     BenchOptions b = o->bench;
     const ColumnMapping mapping = preset_mapping(o->real_trace_preset);
     for (const auto& path : o->real_traces) b.real_traces.push_back(cycle_of_recording(load_recording(path, mapping)));
-    b.progress = isatty(STDERR_FILENO) != 0;
+    b.progress = group.is_root() && isatty(STDERR_FILENO) != 0;
+    b.map_cases = group.mapper();
     std::cout << bench_text(run_discovery_bench(v, b));
   });
 }

@@ -30,7 +30,7 @@ struct SweepOptionsText {
   std::string tyre, vehicle, cycle = "nedc";
   selection::SweepRequest request;
   std::string output, plot;
-  bool base100 = false, json = false;
+  bool base100 = false, json = false, replay = false;
 };
 
 
@@ -122,9 +122,12 @@ std::string render_plot(const selection::SweepResult& r, const std::string& tyre
   return bytes.str();
 }
 
-void run_sweep(const SweepOptionsText& o) {
+void run_sweep(const SweepOptionsText& o, const ProcessGroup& group) {
   if (o.tyre.empty()) throw InputError("--tyre", "missing: give the tyre to sweep, e.g. --tyre 175-70R14");
+  if (o.replay && o.vehicle.empty()) throw InputError("--replay", "needs --vehicle: a tyre alone is not simulated");
   selection::SweepOptions so = selection::sweep_options_from_request(o.request);
+  so.replay = o.replay;
+  so.map_cases = group.mapper();
   // Every destination is checked before the sweep, and all are written after it (nothing is left behind).
   if (!o.output.empty()) check_output_file(o.output, "--output");
   if (!o.plot.empty()) {
@@ -156,8 +159,9 @@ void run_sweep(const SweepOptionsText& o) {
   }
   std::vector<OutputFile> files;
   if (!o.output.empty()) files.push_back({o.output, "--output", table});
-  if (!o.plot.empty()) files.push_back({o.plot, "--plot", render_plot(r, tyre.name, o.plot, o.base100)});
-  write_files_atomically(files);
+  if (!o.plot.empty() && group.is_root()) files.push_back({o.plot, "--plot", render_plot(r, tyre.name, o.plot, o.base100)});
+  // Under MPI every rank holds the whole result; only rank 0 writes it.
+  if (group.is_root()) write_files_atomically(files);
   if (o.output.empty()) std::cout << table;
   if (r.stopped) {
     throw InputError("--param", *r.stopped + " (the " + std::to_string(r.points.size()) + " valid points of " +
@@ -167,7 +171,7 @@ void run_sweep(const SweepOptionsText& o) {
 
 }  // namespace
 
-void register_sweep_command(CLI::App& app) {
+void register_sweep_command(CLI::App& app, const ProcessGroup& group) {
   auto o = std::make_shared<SweepOptionsText>();
   CLI::App* sub = app.add_subcommand(
       "sweep", "Sweep one or two tyre parameters: RRC, force and power, or a car's energy/fuel on a cycle (CSV)");
@@ -182,12 +186,15 @@ void register_sweep_command(CLI::App& app) {
   sub->add_option("--speed-kmh", o->request.speed_kmh, "Fixed speed [km/h] (default 80)")->type_name("KMH");
   sub->add_option("--vehicle", o->vehicle, "Run this car with the swept tyre on all four wheels")->type_name("FILE");
   sub->add_option("--cycle", o->cycle, "Drive cycle for --vehicle (default nedc)")->type_name("CYCLE");
-  sub->add_option("--threads", o->request.threads, "Worker threads for vehicle sweeps (default: every core)")->type_name("N");
+  sub->add_option("--threads", o->request.threads, "Worker threads for vehicle sweeps (default: every core; under "
+                  "mpirun, the node's cores over its ranks)")->type_name("N");
+  sub->add_flag("--replay", o->replay, "With --vehicle: kinematic replay of the cycle instead of the forward simulation "
+                "(driver + CVODE); about 10x faster, within 0.05 % of it on the shipped cycles");
   sub->add_option("--output", o->output, "Write the CSV here (atomically) instead of stdout")->type_name("FILE.csv");
   sub->add_option("--plot", o->plot, "Draw RRC against the swept parameter with gnuplot")->type_name("FILE.svg|.png");
   sub->add_flag("--base100", o->base100, "Plot RRC as base 100 at the first point of each line");
   sub->add_flag("--json", o->json, "JSON lines instead of CSV (no progress display)");
-  sub->callback([o] { run_sweep(*o); });
+  sub->callback([o, &group] { run_sweep(*o, group); });
 }
 
 }  // namespace rollsim::cli

@@ -117,13 +117,13 @@ void plot(const validate::Validation& v, const std::string& file) {
   if (ec) throw InputError("--plot " + file, "cannot replace the file: " + ec.message());
 }
 
-void run_validate(const ValidateOptionsText& o) {
+void run_validate(const ValidateOptionsText& o, const ProcessGroup& group) {
   if (o.list.empty()) throw InputError("--epa-test-car-list", "missing: give the EPA Test Car List CSV");
   unsigned threads = 0;
   if (!o.threads.empty()) threads = static_cast<unsigned>(parse_option_number(o.threads, "--threads", Range::closed(1, 1024)));
   const auto rows = validate::read_epa_test_car_list(o.list);
-  const auto v = validate::validate_epa_list(rows, threads);
-  if (!o.plot.empty()) plot(v, o.plot);
+  const auto v = validate::validate_epa_list(rows, threads, group.mapper());
+  if (!o.plot.empty() && group.is_root()) plot(v, o.plot);
   if (o.json) {
     for (const auto& r : v.rows) std::cout << row_json(r).str() << "\n";
     return;
@@ -133,14 +133,14 @@ void run_validate(const ValidateOptionsText& o) {
 
 }  // namespace
 
-void register_validate_command(CLI::App& app) {
+void register_validate_command(CLI::App& app, const ProcessGroup& group) {
   auto o = std::make_shared<ValidateOptionsText>();
   auto* sub = app.add_subcommand("validate", "Simulate every car of the EPA Test Car List from its certification data and compare with its measured result");
   sub->add_option("--epa-test-car-list", o->list, "EPA Test Car List CSV (e.g. ../shared/data/vehicles/epa_test_car_list_2022_part.csv)")->type_name("FILE");
   sub->add_flag("--json", o->json, "One JSON object per row instead of the summary");
   sub->add_option("--plot", o->plot, "Draw predicted against measured (gnuplot, .svg)")->type_name("FILE");
   sub->add_option("--threads", o->threads, "Worker threads (default: every core)")->type_name("N");
-  sub->callback([o] { run_validate(*o); });
+  sub->callback([o, &group] { run_validate(*o, group); });
 }
 
 }  // namespace rollsim::cli

@@ -2,16 +2,16 @@
 
 namespace rollsim::cli {
 
-void register_commands(CLI::App& app) {
+void register_commands(CLI::App& app, const ProcessGroup& group) {
   register_tyre_command(app);
-  register_diagnose_command(app);
-  register_diagnose_bench_command(app);
-  register_compare_command(app);
-  register_sweep_command(app);
+  register_diagnose_command(app, group);
+  register_diagnose_bench_command(app, group);
+  register_compare_command(app, group);
+  register_sweep_command(app, group);
   register_sensitivity_command(app);
   register_regress_command(app);
   register_simulate_command(app);
-  register_validate_command(app);
+  register_validate_command(app, group);
 }
 
 }  // namespace rollsim::cli

@@ -3,18 +3,21 @@
 
 #include <CLI/CLI.hpp>
 
+#include "rollsim/common/distribute.hpp"
+
 namespace rollsim::cli {
 
-void register_commands(CLI::App& app);
+/// `group`: the processes the distributed commands (sweep, compare, validate, diagnose-bench, diagnose --fleet) use.
+void register_commands(CLI::App& app, const ProcessGroup& group);
 void register_simulate_command(CLI::App& app);
 void register_tyre_command(CLI::App& app);
 void register_tyre_fit_command(CLI::App& tyre);
-void register_diagnose_command(CLI::App& app);
-void register_diagnose_bench_command(CLI::App& app);
-void register_compare_command(CLI::App& app);
-void register_sweep_command(CLI::App& app);
+void register_diagnose_command(CLI::App& app, const ProcessGroup& group);
+void register_diagnose_bench_command(CLI::App& app, const ProcessGroup& group);
+void register_compare_command(CLI::App& app, const ProcessGroup& group);
+void register_sweep_command(CLI::App& app, const ProcessGroup& group);
 void register_sensitivity_command(CLI::App& app);
 void register_regress_command(CLI::App& app);
-void register_validate_command(CLI::App& app);
+void register_validate_command(CLI::App& app, const ProcessGroup& group);
 
 }  // namespace rollsim::cli

@@ -1,17 +1,45 @@
 // rollsim command-line entry point: parses the subcommand and hands over to the library.
 #include <CLI/CLI.hpp>
 
+#include <cstdio>
 #include <iostream>
+#include <optional>
 #include <string>
 
 #include "commands.hpp"
+#include "rollsim/common/distribute.hpp"
 #include "rollsim/common/error.hpp"
 
+namespace {
+
+// Under mpirun every rank runs the same command on the same input; only rank 0 prints. Errors that every rank
+// meets alike (bad input, a failed case: agreed collectively) are printed once, by rank 0; any other error may be
+// one rank's alone, so that rank names itself.
+int report(const rollsim::ProcessGroup& group, const std::exception& e, bool same_on_every_rank, int code) {
+  if (group.is_root()) std::cerr << "error: " << e.what() << "\n";
+  else if (!same_on_every_rank) std::fprintf(stderr, "error (rank %d): %s\n", group.rank(), e.what());
+  return code;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
+  std::optional<rollsim::ProcessGroup> started;
+  try {
+    started.emplace(argc, argv);
+  } catch (const rollsim::InputError& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 2;
+  }
+  const rollsim::ProcessGroup& group = *started;
+  if (!group.is_root()) {
+    std::cout.rdbuf(nullptr);
+    std::cerr.rdbuf(nullptr);
+  }
   CLI::App app{"rollsim: tyre rolling resistance and vehicle energy simulation"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "rollsim 0.1.0");
-  rollsim::cli::register_commands(app);
+  rollsim::cli::register_commands(app, group);
   // CLI11 answers an unknown first word with "A subcommand is required"; name it and the known ones instead.
   if (argc > 1 && argv[1][0] != '-') {
     std::string known;
@@ -30,14 +58,13 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   } catch (const rollsim::InputError& e) {
-    std::cerr << "error: " << e.what() << "\n";
-    return 2;
+    return report(group, e, true, 2);
   } catch (const rollsim::ModelDomainError& e) {
-    std::cerr << "error: " << e.what() << "\n";
-    return 2;
+    return report(group, e, true, 2);
+  } catch (const rollsim::CaseFailure& e) {
+    return report(group, e, true, 1);
   } catch (const std::exception& e) {
-    std::cerr << "error: " << e.what() << "\n";
-    return 1;
+    return report(group, e, group.size() == 1, 1);
   }
   return 0;
 }

@@ -1,5 +1,5 @@
 // Discovery benchmark: concealed-effect cases, blind diagnosis, parameter-only and sparse-regression baselines.
-#include "rollsim/common/parallel.hpp"
+#include "rollsim/common/distribute.hpp"
 #include "rollsim/discovery/scorecard.hpp"
 
 #include <algorithm>
@@ -295,11 +295,10 @@ BenchResult run_discovery_bench(const Vehicle& vehicle, const BenchOptions& opt)
   std::vector<Task> tasks;
   for (std::size_t c = 0; c < cases.size(); ++c)
     for (int s = 0; s < cases[c].seeds; ++s) tasks.push_back({c, s});
-  std::vector<Outcome> out(tasks.size());
-  std::atomic<std::size_t> done{0};
-  std::mutex io;
   const unsigned threads = opt.threads > 0 ? opt.threads : std::max(1u, std::thread::hardware_concurrency());
+  // Each recording's outcome travels as bytes: it may be diagnosed on another MPI rank.
   auto worker = [&](std::size_t k) {
+    Outcome o;
     {
       const Case& c = cases[tasks[k].c];
       SyntheticCase s = c.synth;
@@ -317,7 +316,6 @@ BenchResult run_discovery_bench(const Vehicle& vehicle, const BenchOptions& opt)
       DiagnoseOptions dopt;
       dopt.infer_road_profile = opt.infer_road_profile;
       const Diagnosis d = diagnose(car, recs, dopt);
-      Outcome& o = out[k];
       for (const auto& f : d.findings) {
         const auto from = f.fitted.find("wind_from_deg");
         o.findings.push_back({f.effect, f.confounded_with, f.parameters.empty() ? 0.0 : f.parameters.front().value,
@@ -330,15 +328,42 @@ BenchResult run_discovery_bench(const Vehicle& vehicle, const BenchOptions& opt)
         for (std::size_t t = 0; t < sw.by_threshold.size(); ++t) merge_ids(o.sparse[t], sw.by_threshold[t]);
         merge_ids(o.sparse.back(), sw.bic);
       }
-      const std::size_t n = done.fetch_add(1) + 1;
-      if (opt.progress) {
-        std::lock_guard<std::mutex> lock(io);
-        std::fprintf(stderr, "\rdiagnose-bench: %zu/%zu recordings", n, tasks.size());
-        if (n == tasks.size()) std::fprintf(stderr, "\n");
-      }
     }
+    std::string bytes;
+    put(bytes, o.findings.size());
+    for (const auto& f : o.findings) {
+      put(bytes, f.effect);
+      put(bytes, f.confounded_with);
+      put(bytes, f.size);
+      put(bytes, f.wind_from_deg);
+    }
+    put(bytes, o.sparse);
+    return bytes;
   };
-  parallel_for(tasks.size(), threads, worker);
+  std::mutex io;
+  CaseProgress progress;
+  if (opt.progress) {
+    progress = [&io](std::size_t n, std::size_t total) {
+      std::lock_guard<std::mutex> lock(io);
+      std::fprintf(stderr, "\rdiagnose-bench: %zu/%zu recordings", n, total);
+      if (n == total) std::fprintf(stderr, "\n");
+    };
+  }
+  const auto gathered = map_cases(opt.map_cases, tasks.size(), opt.threads, worker, progress);
+  std::vector<Outcome> out(tasks.size());
+  for (std::size_t k = 0; k < tasks.size(); ++k) {
+    std::string_view in = gathered[k];
+    std::size_t n = 0;
+    take(in, n);
+    out[k].findings.resize(n);
+    for (auto& f : out[k].findings) {
+      take(in, f.effect);
+      take(in, f.confounded_with);
+      take(in, f.size);
+      take(in, f.wind_from_deg);
+    }
+    take(in, out[k].sparse);
+  }
 
   BenchResult res;
   res.threads = threads;

@@ -41,12 +41,14 @@ double EngineMap::fuel_power_w(double speed_radps, double brake_torque_nm) const
   const double pc = p_.pumping_mep_closed_pa, a = p_.unthrottled_imep_pa;
   if (pc > 0.0 && imep_pa < a) imep_pa = (bmep_pa + fmep_pa + pc) / (1.0 + pc / a);
   double fuel_w = imep_pa * p_.displacement_m3 * w / kFourStroke / p_.indicated_efficiency;
-  if (p_.enrichment_max > 0.0 && p_.enrichment_start_fraction < 1.0) {
-    const double full_nm = max_torque_nm(w);
-    const double load = full_nm > 0.0 ? torque_nm / full_nm : 1.0;
-    const double s = std::clamp((load - p_.enrichment_start_fraction) / (1.0 - p_.enrichment_start_fraction), 0.0, 1.0);
-    fuel_w *= 1.0 + p_.enrichment_max * s;
-  }
+  const double full_nm = max_torque_nm(w);
+  const double load = full_nm > 0.0 ? torque_nm / full_nm : 1.0;
+  // Share of the way from a threshold load to full load: 0 below it, 1 at full load.
+  auto above = [load](double start_fraction) {
+    return start_fraction < 1.0 ? std::clamp((load - start_fraction) / (1.0 - start_fraction), 0.0, 1.0) : 0.0;
+  };
+  fuel_w *= 1.0 + p_.enrichment_max * above(p_.enrichment_start_fraction);
+  fuel_w /= 1.0 - p_.knock_efficiency_loss_max * above(p_.knock_start_fraction);
   return fuel_w;
 }
 

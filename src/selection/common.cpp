@@ -29,4 +29,10 @@ EnergyFigure run_forward(const Vehicle& vehicle, const DriveCycle& cycle) {
   return energy_figure(simulate_forward(model, cycle));
 }
 
+EnergyFigure run_model(const VehicleModel& model, const DriveCycle& cycle, bool replay) {
+  return energy_figure(replay ? simulate_replay(model, cycle) : simulate_forward(model, cycle));
+}
+
+std::string run_mode_label(bool replay) { return replay ? "kinematic replay" : "forward simulation"; }
+
 }  // namespace rollsim::selection

@@ -55,18 +55,17 @@ FitCheck check_fit(const Vehicle& vehicle, const TyreSpec& own, const TyreSpec& 
 
 namespace {
 
-CandidateResult evaluate(const Vehicle& vehicle, const TyreSpec& own, const TyreSpec& tyre, const DriveCycle& cycle,
-                         const CompareOptions& o) {
+// One candidate's simulated figures, as bytes: it may be run on another MPI rank.
+std::string simulate_candidate(const Vehicle& vehicle, const VehicleModel& base, const TyreSpec& tyre,
+                               const DriveCycle& cycle, double wheel_load_n, const CompareOptions& o) {
   CandidateResult c;
-  c.tyre = tyre;
-  c.fit = check_fit(vehicle, own, tyre, o.diameter_tolerance_pct);
   try {
-    const RollingResistance rr = evaluate_rolling_resistance(tyre.state, c.fit.wheel_load_n, o.reference_speed_mps);
+    const RollingResistance rr = evaluate_rolling_resistance(tyre.state, wheel_load_n, o.reference_speed_mps);
     c.rrc_80 = rr.rrc;
     c.rr_power_80_w = rr.rr_power_w;
     Vehicle v = vehicle;
     fit_tyres(v, tyre);
-    const EnergyFigure e = run_forward(v, cycle);
+    const EnergyFigure e = run_model(VehicleModel::with_tyres_of(base, v), cycle, o.replay);
     c.value = e.value;
     c.range_km = e.range_km;
     c.simulated = true;
@@ -76,6 +75,21 @@ CandidateResult evaluate(const Vehicle& vehicle, const TyreSpec& own, const Tyre
     c.rrc_80 = c.rr_power_80_w = NAN;
     c.value = c.range_km = NAN;
   }
+  std::string bytes;
+  for (double x : {c.rrc_80, c.rr_power_80_w, c.value, c.range_km}) put(bytes, x);
+  put(bytes, c.simulated);
+  put(bytes, c.error);
+  return bytes;
+}
+
+CandidateResult evaluated(const Vehicle& vehicle, const TyreSpec& own, const TyreSpec& tyre, std::string_view in,
+                          const CompareOptions& o) {
+  CandidateResult c;
+  c.tyre = tyre;
+  c.fit = check_fit(vehicle, own, tyre, o.diameter_tolerance_pct);
+  for (double* x : {&c.rrc_80, &c.rr_power_80_w, &c.value, &c.range_km}) take(in, *x);
+  take(in, c.simulated);
+  take(in, c.error);
   return c;
 }
 
@@ -93,14 +107,22 @@ Comparison compare_tyres(const Vehicle& vehicle, const std::vector<TyreSpec>& ca
   cmp.unit = energy_unit(vehicle);
   cmp.shows_range = cmp.unit == "kwh_per_10km";
 
-  CandidateResult own_result = evaluate(vehicle, own, own, cycle, o);
+  // Case 0 is the car's own tyre, case k the k-th candidate.
+  const VehicleModel base = VehicleModel::assemble(vehicle);
+  const double wheel_load_n = check_fit(vehicle, own, own, o.diameter_tolerance_pct).wheel_load_n;
+  auto tyre_of = [&](std::size_t k) -> const TyreSpec& { return k == 0 ? own : candidates[k - 1]; };
+  const auto results = map_cases(
+      o.map_cases, candidates.size() + 1, o.threads,
+      [&](std::size_t k) { return simulate_candidate(vehicle, base, tyre_of(k), cycle, wheel_load_n, o); }, {});
+
+  CandidateResult own_result = evaluated(vehicle, own, own, results[0], o);
   if (!own_result.simulated) throw InputError(vehicle.source, "cannot run the car on its own tyre: " + own_result.error);
   own_result.is_own = true;
   cmp.own_value = own_result.value;
   cmp.own_range_km = own_result.range_km;
 
   std::vector<CandidateResult> all{own_result};
-  for (const auto& t : candidates) all.push_back(evaluate(vehicle, own, t, cycle, o));
+  for (std::size_t k = 1; k <= candidates.size(); ++k) all.push_back(evaluated(vehicle, own, tyre_of(k), results[k], o));
   for (auto& c : all) {
     c.diff_pct = (c.value / cmp.own_value - 1.0) * 100.0;
     c.range_change_km = c.range_km - cmp.own_range_km;

@@ -2,7 +2,6 @@
 #include "rollsim/selection/sweep.hpp"
 
 
-#include <atomic>
 #include <cmath>
 #include <exception>
 #include <sstream>
@@ -224,39 +223,42 @@ SweepResult sweep_vehicle(const Vehicle& vehicle, const TyreSpec& tyre, const Dr
   const auto pts = grid(o.axes, kMaxVehicleSweepPoints, "a sweep with a car (one simulation per point)");
   r.planned_points = pts.size();
 
-  struct Slot {
-    SweepPoint point;
-    std::string error;
-    bool done = false;
-  };
-  std::vector<Slot> slots(pts.size());
-  std::atomic<std::size_t> finished{0};
-  // Each point keeps its slot, so the output is in grid order whatever order the threads finish in.
-  parallel_for(pts.size(), o.threads, [&](std::size_t i) {
-    Slot& s = slots[i];
+  // The car is assembled once; each point makes only its tyre-dependent parts (VehicleModel::with_tyres_of).
+  const VehicleModel base = VehicleModel::assemble(vehicle);
+  // Each point's result travels as bytes (it may be computed on another MPI rank) and keeps its index, so the
+  // output is in grid order whatever order the points finish in.
+  const auto body = [&](std::size_t i) {
     const PointSetup ps = setup(tyre, o, pts[i]);
+    SweepPoint p;
+    std::string error;
     try {
-      s.point.values = pts[i];
-      s.point.load_n = ps.load_n;
-      s.point.speed_kmh = ps.speed_kmh;
-      s.point.rr = evaluate_rolling_resistance(ps.tyre.state, ps.load_n, units::kmh_to_mps(ps.speed_kmh));
+      p.rr = evaluate_rolling_resistance(ps.tyre.state, ps.load_n, units::kmh_to_mps(ps.speed_kmh));
       Vehicle v = vehicle;
       fit_tyres(v, ps.tyre);
-      s.point.energy = run_forward(v, cycle).value;  // own VehicleModel per point, so per thread
+      p.energy = run_model(VehicleModel::with_tyres_of(base, v), cycle, o.replay).value;
     } catch (const std::exception& e) {
-      s.error = e.what();
+      error = e.what();
     }
-    s.done = true;
-    const std::size_t n = ++finished;
-    if (o.progress) o.progress(n, pts.size());
-  });
-
+    std::string bytes;
+    put(bytes, p.rr);
+    put(bytes, p.energy);
+    put(bytes, error);
+    return bytes;
+  };
+  const auto results = map_cases(o.map_cases, pts.size(), o.threads, body, o.progress);
   for (std::size_t i = 0; i < pts.size(); ++i) {
-    if (!slots[i].error.empty()) {
-      r.stopped = stop_message(o.axes, pts[i], slots[i].error, r.points);
+    const PointSetup ps = setup(tyre, o, pts[i]);
+    SweepPoint p{pts[i], ps.load_n, ps.speed_kmh, {}, 0.0};
+    std::string error;
+    std::string_view in = results[i];
+    take(in, p.rr);
+    take(in, p.energy);
+    take(in, error);
+    if (!error.empty()) {
+      r.stopped = stop_message(o.axes, pts[i], error, r.points);
       break;
     }
-    r.points.push_back(slots[i].point);
+    r.points.push_back(std::move(p));
   }
   return r;
 }

@@ -26,6 +26,15 @@ VehicleModel VehicleModel::assemble(const Vehicle& vehicle) {
   return m;
 }
 
+VehicleModel VehicleModel::with_tyres_of(const VehicleModel& base, const Vehicle& vehicle) {
+  VehicleModel m = base;
+  m.wheel_radius_m = driven_wheel_radius_m(vehicle);
+  m.road_load = make_road_load(vehicle);
+  m.road_load_description = m.road_load->describe();
+  m.flat_road_load = m.road_load->at_grade(0.0);
+  return m;
+}
+
 double EnergyBreakdown::wheel_residual_j() const {
   return traction_j + unmet_demand_j - (rolling_j + aero_j + grade_j + other_resistance_j + friction_brake_j + regen_wheel_j +
                        wheel_loss_j + kinetic_change_j);

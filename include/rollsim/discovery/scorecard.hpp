@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "rollsim/common/distribute.hpp"
 #include "rollsim/discovery/baselines.hpp"
 #include "rollsim/discovery/generate.hpp"
 #include "rollsim/vehicle/vehicle.hpp"
@@ -24,6 +25,8 @@ struct BenchOptions {
   /// Only the rows whose label contains one of these (empty: every row), e.g. {"real logger"}.
   std::vector<std::string> only;
   bool infer_road_profile = true;  ///< diagnose with the road_profile stage (DiagnoseOptions), on every row
+  /// How the recordings are spread (over MPI ranks by the CLI); empty = this process's threads.
+  CaseMap map_cases;
 };
 
 /// How one method fared on one case, over its seeds.

@@ -25,6 +25,11 @@ struct EngineMapParams {
   /// full-load torque to 1 at full load (component protection; catalysts of 2022 cars allow little of it).
   double enrichment_start_fraction = 1.0;
   double enrichment_max = 0.0;
+  /// Knock-limited spark retard: above this fraction of the full-load torque the spark is retarded from its
+  /// best-efficiency timing, and the gross indicated efficiency falls linearly to (1 - knock_efficiency_loss_max)
+  /// at full load. Zero loss for a compression-ignition engine, which does not knock.
+  double knock_start_fraction = 1.0;
+  double knock_efficiency_loss_max = 0.0;
   double idle_speed_radps = 0.0;
   double rated_speed_radps = 0.0;  ///< speed of rated power
   double max_speed_radps = 0.0;    ///< rev limit

@@ -27,4 +27,10 @@ EnergyFigure energy_figure(const SimulationResult& result);
 /// Assembles `vehicle` and runs it forward (driver + CVODE) over `cycle`.
 EnergyFigure run_forward(const Vehicle& vehicle, const DriveCycle& cycle);
 
+/// Runs an assembled car over `cycle`: forward (driver + CVODE), or as a kinematic replay when `replay`.
+EnergyFigure run_model(const VehicleModel& model, const DriveCycle& cycle, bool replay);
+
+/// "forward simulation" or "kinematic replay", for the tables' titles.
+std::string run_mode_label(bool replay);
+
 }  // namespace rollsim::selection

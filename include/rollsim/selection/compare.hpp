@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "rollsim/common/distribute.hpp"
 #include "rollsim/cycle/drive_cycle.hpp"
 #include "rollsim/tyre/tyre_spec.hpp"
 #include "rollsim/vehicle/vehicle.hpp"
@@ -59,9 +60,14 @@ struct Comparison {
 struct CompareOptions {
   double diameter_tolerance_pct = 3.0;
   double reference_speed_mps = units::kmh_to_mps(80.0);
+  bool replay = false;   ///< kinematic replay instead of the forward simulation
+  unsigned threads = 0;  ///< 0: every core
+  /// How the candidates are spread (over MPI ranks by the CLI); empty = this process's threads.
+  CaseMap map_cases;
 };
 
-/// Runs the car (forward simulation) with its own tyre and with each candidate on all four wheels.
+/// Runs the car (forward simulation, or replay) with its own tyre and with each candidate on all four wheels,
+/// the car assembled once and only its tyres made per candidate.
 /// Throws InputError if the car cannot be run on its own tyre.
 Comparison compare_tyres(const Vehicle& vehicle, const std::vector<TyreSpec>& candidates, const DriveCycle& cycle,
                          const CompareOptions& options = {});

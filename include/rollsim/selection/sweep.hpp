@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "rollsim/common/distribute.hpp"
 #include "rollsim/cycle/drive_cycle.hpp"
 #include "rollsim/tyre/tyre_model.hpp"
 #include "rollsim/tyre/tyre_spec.hpp"
@@ -43,6 +44,9 @@ struct SweepOptions {
   std::optional<double> load_n;        ///< fixed load; default 80 % of the tyre's maximum load
   double speed_kmh = 80.0;             ///< fixed speed
   unsigned threads = 0;                ///< vehicle sweeps: 0 = every core
+  bool replay = false;                 ///< vehicle sweeps: kinematic replay instead of the forward simulation
+  /// Vehicle sweeps: how the points are spread (over MPI ranks by the CLI); empty = this process's threads.
+  CaseMap map_cases;
   /// Called as points finish (done, total), possibly from worker threads; must be thread-safe.
   std::function<void(std::size_t, std::size_t)> progress;
 };
@@ -73,7 +77,8 @@ TyreSpec with_parameter(const TyreSpec& tyre, SweepParam p, double value);
 SweepResult sweep_tyre(const TyreSpec& tyre, const SweepOptions& options);
 
 /// The car on `cycle` with the swept tyre on all four wheels (pressure, diameter, width only): forward
-/// simulation per point, on every core, each thread with its own VehicleModel. Stops like sweep_tyre.
+/// simulation (or replay) per point, on every core, the car assembled once and only its tyres made per point.
+/// Stops like sweep_tyre.
 SweepResult sweep_vehicle(const Vehicle& vehicle, const TyreSpec& tyre, const DriveCycle& cycle,
                           const SweepOptions& options);
 

@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "rollsim/common/distribute.hpp"
 #include "rollsim/validate/epa_car.hpp"
 #include "rollsim/validate/epa_test_car.hpp"
 
@@ -40,8 +41,22 @@ struct Validation {
 
 /// Classifies every row (skips with reasons, hybrids by rule), simulates the rest by kinematic replay with the
 /// nominal constants, fits the four constants of EpaDefaults on the fitting half, and predicts every row with
-/// them. `threads`: 0 for the hardware's concurrency.
-Validation validate_epa_list(const std::vector<EpaTestRow>& rows, unsigned threads);
+/// them. `threads`: 0 for the hardware's concurrency; `map`: how the rows are spread (over MPI ranks by the CLI;
+/// empty: this process's threads).
+Validation validate_epa_list(const std::vector<EpaTestRow>& rows, unsigned threads, const CaseMap& map = {});
+
+/// What a replay's trace (recorded) shows of the engine's transients: the sum of every rise of the segment fuel
+/// rate, and how many times the fuel is cut off (a fuelled segment followed by one without fuel).
+struct FuelEvents {
+  double rises_m3_per_s = 0.0;
+  int cut_offs = 0;
+};
+FuelEvents fuel_events(const SimulationResult& s);
+
+/// The run's fuel [m3] with what a steady-state map leaves out (validate.cpp, after SAE 2017-01-0533): transient
+/// fuelling (0.15 s of each rise of the fuel rate) and, per cut-off, 1.5 s at the idle rate before it and a
+/// 0.3 g catalyst purge after it. Needs the run's trace.
+double fuel_with_transients_m3(const SimulationResult& s, double idle_fuel_m3_per_s, double fuel_density_kg_per_m3);
 
 /// FTP-75 fuel economy [mpg] from its bags (40 CFR 600.113): 0.43 x the cold UDDS (bags 1 + 2) and 0.57 x the hot
 /// UDDS (bags 3 + 2), weighted in gallons per mile. Bag 3 drives the same trace as bag 1.

@@ -1,0 +1,93 @@
+// Fleet diagnosis: the manifest's groups diagnosed as single diagnoses are, the summary, and the manifest's bad input.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "rollsim/common/error.hpp"
+#include "rollsim/common/yaml_reader.hpp"
+#include "rollsim/diagnose/fleet.hpp"
+#include "test_support.hpp"
+
+using namespace rollsim;
+
+namespace {
+
+const std::string kManifest = std::string(ROLLSIM_SOURCE_DIR) + "/examples/fleet/fleet.csv";
+const std::string kRecordings = std::string(ROLLSIM_SHARED_DIR) + "/data/recordings/";
+
+std::string write_manifest(const std::string& name, const std::string& text) {
+  const auto path = test::temp_dir() / name;
+  std::ofstream(path) << text;
+  return path.string();
+}
+
+}  // namespace
+
+TEST(Fleet, GroupsFollowTheManifestAndEachEqualsItsOwnDiagnosis) {
+  const FleetManifest m = read_fleet_manifest(kManifest);
+  ASSERT_EQ(m.groups.size(), 4u);
+  EXPECT_EQ(m.groups[0].name, "twizy T1");
+  EXPECT_EQ(m.groups[0].recordings.size(), 2u);
+  EXPECT_EQ(m.groups[3].recordings.size(), 1u);
+  EXPECT_EQ(m.groups[3].recordings[0].line, 7u);
+  FleetManifest camry{m.file, {m.groups[2], m.groups[3]}};
+  FleetOptions o;
+  o.threads = 2;
+  const FleetResult r = diagnose_fleet(camry, o);
+  ASSERT_EQ(r.entries.size(), 2u);
+  for (std::size_t k = 0; k < 2; ++k) {
+    // The independent path: the diagnose library on the same car and recording, as `rollsim diagnose` runs it.
+    const Vehicle v = load_vehicle_file(resolve_data_file("camry_2018", "vehicles", ".yaml", "test"));
+    const Diagnosis d = diagnose(v, {load_recording(camry.groups[k].recordings[0].path, camry.groups[k].recordings[0].mapping)}, {});
+    EXPECT_EQ(r.entries[k].verdict, d.verdict);
+    ASSERT_EQ(r.entries[k].findings.size(), d.findings.size());
+    for (std::size_t i = 0; i < d.findings.size(); ++i) {
+      EXPECT_EQ(r.entries[k].findings[i].effect, d.findings[i].effect);
+      if (!d.findings[i].parameters.empty()) EXPECT_EQ(r.entries[k].findings[i].value, d.findings[i].parameters[0].value);
+    }
+  }
+  // The summary counts each effect once per diagnosis: its share is that count over the diagnoses.
+  for (const auto& e : r.effects) {
+    std::size_t n = 0;
+    for (const auto& entry : r.entries) {
+      bool found = false;
+      for (const auto& f : entry.findings) found = found || f.effect == e.effect;
+      n += found ? 1 : 0;
+    }
+    EXPECT_EQ(e.groups, n);
+    EXPECT_DOUBLE_EQ(e.share_pct, 100.0 * static_cast<double>(n) / 2.0);
+  }
+}
+
+TEST(Fleet, AMissingRecordingNamesTheManifestLineAndColumn) {
+  const std::string path = write_manifest("missing.csv", "group,vehicle,recording\na,ev,nowhere.csv\n");
+  const auto r = test::run_rollsim("diagnose --fleet '" + path + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("missing.csv: line 2, column 'recording'"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("nowhere.csv' not found"), std::string::npos) << r.err;
+  EXPECT_TRUE(r.out.empty()) << r.out;
+}
+
+TEST(Fleet, ABadColumnMappingNamesTheManifestAndTheGroupsLine) {
+  const std::string camry = kRecordings + "anl_d3_2018_toyota_camry/61811012_test_data.csv";
+  const std::string path = write_manifest(
+      "badcol.csv", "group,vehicle,recording,columns\nok,camry_2018," + camry + ",\nbad,camry_2018," + camry +
+                        ",speed_kmh=No Such Column\n");
+  const auto r = test::run_rollsim("diagnose --fleet '" + path + "'");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("badcol.csv: group 'bad' (line 3)"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("No Such Column"), std::string::npos) << r.err;
+  EXPECT_TRUE(r.out.empty()) << r.out;
+}
+
+TEST(Fleet, AManifestWithoutTheRecordingColumnIsRefusedAtItsHeader) {
+  const std::string path = write_manifest("nocol.csv", "vehicle,trip\nev,a.csv\n");
+  try {
+    read_fleet_manifest(path);
+    FAIL() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("nocol.csv: line 1: missing column 'recording'"), std::string::npos) << e.what();
+  }
+}
