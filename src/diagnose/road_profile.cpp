@@ -1,7 +1,8 @@
 // Diagnosis stage 5b: the road profile when elevation is withheld. The residual of short windows is inverted into an
 // elevation along distance (piecewise linear between knots, a roughness penalty chosen by generalised
 // cross-validation); it is named only where it explains decisively more than any single catalogue or unexplained
-// shape (BIC with its effective degrees of freedom), predicts held-out windows, and the residual is quiet standing.
+// shape (BIC with its effective degrees of freedom), predicts held-out windows, the residual is quiet standing, and
+// some descent is steeper than the car's whole rolling resistance (which no loss drifting over the trip can mimic).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -169,11 +170,6 @@ double rolling_grade(const Signatures& sig, const BasisShape& unit, const Eigen:
   return (1.0 + 0.1 * k[1] / k[0]) * rrc_w / (per_newton_w * m_g);
 }
 
-// A road is the one explanation in the catalogue whose force can fall below zero loss: a descent steeper than the
-// car's whole rolling resistance. Losses that vary along the trip (an RRC rising with rain or warm-up run
-// backwards, an auxiliary load, a payload, wind gusts about a headwind) move the force by a fraction of it, and a
-// one-pass profile absorbs them as well as it absorbs hills. So a profile is a road only where some knot's grade is
-// below minus the rolling grade by more than the knots' family-wise 95 % bound (Bonferroni over the knots).
 // z with P(Z > z) = p for a standard normal, by bisection on erfc (a handful of calls per diagnosis).
 double normal_upper_quantile(double p) {
   double lo = 0.0, hi = 40.0;
@@ -184,6 +180,11 @@ double normal_upper_quantile(double p) {
   return 0.5 * (lo + hi);
 }
 
+// A road is the one explanation in the catalogue whose force can fall below zero loss: a descent steeper than the
+// car's whole rolling resistance. Losses that vary along the trip (an RRC rising with rain or warm-up run
+// backwards, an auxiliary load, a payload, wind gusts about a headwind) move the force by a fraction of it, and a
+// one-pass profile absorbs them as well as it absorbs hills. So a profile is a road only where some knot's grade is
+// below minus the rolling grade by more than the knots' family-wise 95 % bound (Bonferroni over the knots).
 struct Descent {
   double grade = 0.0, rolling_grade = 0.0, z = 0.0, z_needed = 0.0;
   bool road_only = false;
