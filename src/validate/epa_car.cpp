@@ -63,7 +63,7 @@ SkipReason absurd(std::string& detail, const std::string& field, double value, c
 // BMW B58 (127, 11.0), AMG M139 (200, 9.0). Piecewise linear through them: 13 up to 85 hp/l, 10.5 at 115, 9 from
 // 200. (A high-revving unboosted engine, 125 hp/l at 9000 rpm and 13.3, is the exception the list cannot tell.)
 double petrol_compression_ratio(double power_w, double displacement_m3) {
-  const double hp_per_l = power_w / 745.69987158 / (displacement_m3 * 1e3);
+  const double hp_per_l = power_w / units::kWPerHp / (displacement_m3 / units::kM3PerLitre);
   if (hp_per_l <= 85.0) return 13.0;
   if (hp_per_l <= 115.0) return 13.0 - 2.5 * (hp_per_l - 85.0) / 30.0;
   return std::max(9.0, 10.5 - 1.5 * (hp_per_l - 115.0) / 85.0);

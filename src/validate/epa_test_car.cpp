@@ -15,7 +15,6 @@ namespace {
 
 constexpr double kKgPerLb = 0.45359237;
 using units::kNPerLbf;
-constexpr double kWPerHp = 745.69987158;  // mechanical horsepower
 using units::kMpsPerMph;
 
 std::string lower(std::string s) {
@@ -145,7 +144,7 @@ std::vector<EpaTestRow> read_epa_test_car_list(const std::string& path) {
     r.all_wheel_drive = has(d, "all wheel") || has(d, "4-wheel");
     if (const auto v = number(c_etw)) r.test_mass_kg = *v * kKgPerLb;
     if (const auto v = number(c_disp)) r.displacement_m3 = *v * units::kM3PerLitre;
-    if (const auto v = number(c_hp)) r.rated_power_w = *v * kWPerHp;
+    if (const auto v = number(c_hp)) r.rated_power_w = *v * units::kWPerHp;
     if (const auto v = number(c_gears); v && *v == std::floor(*v) && *v >= 0 && *v < 100) r.gears = static_cast<int>(*v);
     if (const auto v = number(c_nv)) r.engine_radps_per_mps = *v * 2.0 * std::numbers::pi / 60.0 / kMpsPerMph;
     if (const auto v = number(c_a)) r.road_a_n = *v * kNPerLbf;

@@ -11,6 +11,7 @@ inline constexpr double kMPerInch = 0.0254;
 inline constexpr double kJPerKwh = 3.6e6;
 inline constexpr double kMPerKm = 1000.0;
 inline constexpr double kM3PerLitre = 1.0e-3;
+inline constexpr double kWPerHp = 745.69987158;  ///< mechanical horsepower (550 ft lbf/s)
 inline constexpr double kKelvinOffset = 273.15;
 inline constexpr double kMPerMile = 1609.344;
 inline constexpr double kSPerHour = 3600.0;
