@@ -16,6 +16,7 @@
 #include "rollsim/common/csv.hpp"
 #include "rollsim/common/error.hpp"
 #include "rollsim/common/format.hpp"
+#include "rollsim/common/statistics.hpp"
 #include "rollsim/common/units.hpp"
 #include "rollsim/common/yaml_reader.hpp"
 #include "rollsim/report/table.hpp"
@@ -172,10 +173,6 @@ void run_evaluate(const std::string& path, const std::string& drum_text) {
     const double v[6] = {e.one_point_rms, e.one_point_max, e.full_fit_rms, e.thesis_rms, e.constant_rms, e.median_shape_rms};
     for (int k = 0; k < 6; ++k) cols[k].push_back(v[k]);
   }
-  auto median = [](std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
-  };
   auto worst = [](const std::vector<double>& v) { return *std::max_element(v.begin(), v.end()); };
   std::vector<std::string> med{"median"}, wst{"worst"};
   for (int k = 0; k < 6; ++k) {

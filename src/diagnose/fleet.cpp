@@ -11,6 +11,7 @@
 #include "rollsim/common/csv.hpp"
 #include "rollsim/common/error.hpp"
 #include "rollsim/common/format.hpp"
+#include "rollsim/common/statistics.hpp"
 #include "rollsim/common/yaml_reader.hpp"
 #include "rollsim/report/table.hpp"
 
@@ -132,12 +133,6 @@ FleetEntry from_bytes(std::string_view in) {
   FleetEntry e;
   each_field(e, [&](auto& x) { take(in, x); });
   return e;
-}
-
-double median(std::vector<double> x) {
-  std::sort(x.begin(), x.end());
-  const std::size_t n = x.size();
-  return n == 0 ? std::nan("") : n % 2 ? x[n / 2] : 0.5 * (x[n / 2 - 1] + x[n / 2]);
 }
 
 std::vector<FleetEffect> summarise(const std::vector<FleetEntry>& entries) {

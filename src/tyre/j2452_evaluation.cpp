@@ -4,6 +4,7 @@
 #include <cmath>
 #include <functional>
 
+#include "rollsim/common/statistics.hpp"
 #include "rollsim/common/units.hpp"
 #include "rollsim/tyre/hysteresis_model.hpp"
 #include "rollsim/tyre/least_squares.hpp"
@@ -76,12 +77,6 @@ TyreState one_point_tyre(const J2452Set& set, const HysteresisConstants& shared,
   const double measured = j2452_flat_rrc(set, kRefPressure_pa, kRefLoad_n, kRefSpeed_mps, drum_radius_m);
   t.hysteresis.rrc_ref = (measured - rest) / unit;
   return t;
-}
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 Surface median_shape_of(const std::vector<J2452Set>& others) {

@@ -9,6 +9,7 @@
 
 #include "rollsim/common/error.hpp"
 #include "rollsim/common/distribute.hpp"
+#include "rollsim/common/statistics.hpp"
 #include "rollsim/common/units.hpp"
 #include "rollsim/cycle/drive_cycle.hpp"
 
@@ -231,15 +232,6 @@ Raw simulate_row(const EpaTestRow& r, const Cycles& c, const EpaDefaults& d) {
   const SimulationResult s = simulate_replay(car, r.cycle == EpaCycle::hwfet ? c.hwfet : c.us06, traced);
   w.mpg_or_mpge = miles(s.distance_m) / gallons(fuel_m3(s));
   return w;
-}
-
-double median(std::vector<double> x) {
-  if (x.empty()) return std::nan("");
-  const std::size_t n = x.size() / 2;
-  std::nth_element(x.begin(), x.begin() + static_cast<std::ptrdiff_t>(n), x.end());
-  const double hi = x[n];
-  if (x.size() % 2) return hi;
-  return 0.5 * (hi + *std::max_element(x.begin(), x.begin() + static_cast<std::ptrdiff_t>(n)));
 }
 
 // Nearest-rank percentile.
