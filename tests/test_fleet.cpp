@@ -82,6 +82,17 @@ TEST(Fleet, ABadColumnMappingNamesTheManifestAndTheGroupsLine) {
   EXPECT_TRUE(r.out.empty()) << r.out;
 }
 
+TEST(Fleet, PerRecordingOptionsAreRefusedNotIgnored) {
+  // The manifest names each group's files; an option meant for one diagnosis must not be dropped silently.
+  const std::string path = write_manifest("options.csv", "group,vehicle,recording\na,ev,nowhere.csv\n");
+  for (const std::string option : {"--engine-start hot", "--vehicle ev", "--preset anl_d3"}) {
+    const auto r = test::run_rollsim("diagnose --fleet '" + path + "' " + option);
+    EXPECT_EQ(r.exit_code, 2) << option;
+    EXPECT_NE(r.err.find(option.substr(0, option.find(' ')) + ": not allowed with --fleet"), std::string::npos) << r.err;
+    EXPECT_TRUE(r.out.empty()) << r.out;
+  }
+}
+
 TEST(Fleet, AManifestWithoutTheRecordingColumnIsRefusedAtItsHeader) {
   const std::string path = write_manifest("nocol.csv", "vehicle,trip\nev,a.csv\n");
   try {

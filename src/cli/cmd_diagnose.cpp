@@ -75,7 +75,8 @@ void run_fleet(const DiagnoseCliOptions& o, const ProcessGroup& group) {
   for (const auto& [given, option] : {std::pair{!o.vehicle.empty(), "--vehicle"}, {!o.recordings.empty(), "--recording"},
                                       {!o.tyre.empty(), "--tyre"}, {!o.preset.empty(), "--preset"},
                                       {!o.columns.empty() || !o.scales.empty(), "--column/--scale"},
-                                      {!o.report.empty() || !o.write_vehicle.empty(), "--report/--write-vehicle"}}) {
+                                      {!o.report.empty() || !o.write_vehicle.empty(), "--report/--write-vehicle"},
+                                      {!o.engine_start.empty(), "--engine-start"}}) {
     if (given) throw InputError(option, "not allowed with --fleet: the manifest names each group's files and mapping");
   }
   FleetOptions fo;
