@@ -124,12 +124,11 @@ std::vector<bool> engine_off_samples(const Recording& r, double min_s) {
 
 std::vector<double> heading_from_gps(const std::vector<double>& latitude_deg, const std::vector<double>& longitude_deg,
                                      double baseline_m) {
-  constexpr double kEarthRadius_m = 6371000.0;
   const std::size_t n = std::min(latitude_deg.size(), longitude_deg.size());
   std::vector<double> heading(n, 0.0);
   if (n == 0) return heading;
-  const double east_m_per_deg = kEarthRadius_m * std::cos(units::deg_to_rad(latitude_deg.front())) * units::deg_to_rad(1.0);
-  const double north_m_per_deg = kEarthRadius_m * units::deg_to_rad(1.0);
+  const double east_m_per_deg = units::kEarthRadius_m * std::cos(units::deg_to_rad(latitude_deg.front())) * units::deg_to_rad(1.0);
+  const double north_m_per_deg = units::kEarthRadius_m * units::deg_to_rad(1.0);
   auto east = [&](std::size_t i) { return (longitude_deg[i] - longitude_deg.front()) * east_m_per_deg; };
   auto north = [&](std::size_t i) { return (latitude_deg[i] - latitude_deg.front()) * north_m_per_deg; };
   std::size_t j = 0;

@@ -107,10 +107,10 @@ Eigen::MatrixXd roughness(Eigen::Index k) {
 // elevation sum is held at zero by a stiff penalty. Otherwise the net climb is free.
 bool is_loop(const Recording& r) {
   if (!r.latitude_deg || !r.longitude_deg || r.latitude_deg->empty()) return false;
-  constexpr double kEarthRadiusM = 6371000.0, kDeg = 3.141592653589793 / 180.0;
-  const double dlat = (r.latitude_deg->back() - r.latitude_deg->front()) * kDeg;
-  const double dlon = (r.longitude_deg->back() - r.longitude_deg->front()) * kDeg * std::cos(r.latitude_deg->front() * kDeg);
-  return kEarthRadiusM * std::hypot(dlat, dlon) < kLoopClosureM;
+  const double dlat = units::deg_to_rad(r.latitude_deg->back() - r.latitude_deg->front());
+  const double dlon = units::deg_to_rad(r.longitude_deg->back() - r.longitude_deg->front()) *
+                      std::cos(units::deg_to_rad(r.latitude_deg->front()));
+  return units::kEarthRadius_m * std::hypot(dlat, dlon) < kLoopClosureM;
 }
 
 double bic_single(double rtr, const Eigen::VectorXd& col, const Eigen::VectorXd& r, double n_eff) {

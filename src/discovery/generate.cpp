@@ -524,7 +524,7 @@ Recording generate_case(const Vehicle& vehicle, const SyntheticCase& o) {
     route_gps(*route, dist, 48.1, 11.6, lat, lon);
     std::mt19937 gps_rng(o.seed * 40503u + 5u);
     std::normal_distribution<double> jitter_m(0.0, 2.0);
-    const double m_per_deg = 6371000.0 * kTwoPi / 360.0;
+    const double m_per_deg = units::kEarthRadius_m * kTwoPi / 360.0;
     for (std::size_t i = 0; i < n; ++i) {
       lat[i] += jitter_m(gps_rng) / m_per_deg;
       lon[i] += jitter_m(gps_rng) / (m_per_deg * std::cos(48.1 * kTwoPi / 360.0));

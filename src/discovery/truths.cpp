@@ -5,6 +5,8 @@
 #include <cmath>
 #include <string>
 
+#include "rollsim/common/units.hpp"
+
 namespace rollsim {
 namespace {
 
@@ -93,8 +95,7 @@ std::shared_ptr<const Effect> steady_wind_truth(double speed_mps, double from_de
 
 void route_gps(const WindingRoute& route, const std::vector<double>& distance_m, double lat0_deg, double lon0_deg,
                std::vector<double>& latitude_deg, std::vector<double>& longitude_deg) {
-  constexpr double kEarthRadius_m = 6371000.0;
-  const double north_m_per_deg = kEarthRadius_m * kTwoPi / 360.0;
+  const double north_m_per_deg = units::kEarthRadius_m * kTwoPi / 360.0;
   const double east_m_per_deg = north_m_per_deg * std::cos(lat0_deg * kTwoPi / 360.0);
   latitude_deg.assign(distance_m.size(), lat0_deg);
   longitude_deg.assign(distance_m.size(), lon0_deg);
