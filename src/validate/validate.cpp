@@ -182,8 +182,6 @@ double fuel_with_transients_m3(const SimulationResult& s, double idle_fuel_m3_pe
 
 namespace {
 
-
-
 // ---- simulation with the nominal constants; everything the fit needs is linear in what it scales ----
 struct Raw {
   double mpg_or_mpge = 0.0;        // non-FTP rows: the prediction with the nominal constants
