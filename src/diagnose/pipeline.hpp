@@ -221,6 +221,7 @@ struct ProfileResult {
   std::string parameter;
   Eigen::VectorXd signature;
   Scored score;
+  std::vector<ParameterEstimate> nuisance;  // shape parameters fitted at the profile's best (aux_load's share)
 };
 ProfileResult profile_time_constant(const Model& m, const TimeProfile& tp, const Eigen::VectorXd& selected_signature,
                                     const Scored& selected_score, double amp_min, double amp_max);
@@ -243,6 +244,13 @@ struct SelectionContext {
 };
 
 /// Forward selection of catalogue effects; the model grows by each finding.
+/// A found constant aux_load (electric channels): whether a share of it decays from the trip's start, P0 + P1
+/// exp(-t / tau), with tau profiled over [decay_low_s, decay_high_s] and the share fitted at each grid point; kept
+/// (the candidate's shape, signature and `score` changed) only past the BIC threshold for its two extra parameters
+/// and with a better held-out fit.
+std::optional<ProfileResult> refine_aux_decay(const SelectionContext& sc, Candidate& c, const Model& m, Scored& score,
+                                              double decay_low_s, double decay_high_s);
+
 std::vector<Finding> select_effects(const SelectionContext& sc, const std::vector<Candidate>& cands, Model& m,
                                     std::vector<EffectId>& chosen);
 std::vector<DetectionLimit> detection_limits(const std::vector<Candidate>& cands, const std::vector<EffectId>& chosen,

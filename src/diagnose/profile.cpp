@@ -66,7 +66,7 @@ ProfileResult profile_time_constant(const Model& m, const TimeProfile& tp, const
     const bool inert = !(sigs.back().norm() > 0.0);
     rss.push_back(inert ? m.fit.rss : least_squares(hcat(m.x, sigs.back()), *m.y, m.prior).rss);
   }
-  ProfileResult r{profile_likelihood_interval(tp.grid, rss, m.n_eff), tp.parameter, selected_signature, selected_score};
+  ProfileResult r{profile_likelihood_interval(tp.grid, rss, m.n_eff), tp.parameter, selected_signature, selected_score, {}};
   double kept = tp.selected;
   if (tp.grid[r.interval.best] != tp.selected) {
     Scored s = score_column(m, sigs[r.interval.best]);

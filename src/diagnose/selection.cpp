@@ -153,7 +153,11 @@ std::vector<Passing> passing_candidates(const SelectionContext& sc, const std::v
   return out;
 }
 
+// aux_load's decay from the trip's start: a winter heater's cabin warms in minutes, a long trip's in up to two hours.
+constexpr double kAuxDecayLow_s = 120.0, kAuxDecayHigh_s = 7680.0;
+
 std::optional<ProfileResult> refine(const SelectionContext& sc, Candidate& c, const Model& m, Passing& best) {
+  if (c.id == EffectId::aux_load) return refine_aux_decay(sc, c, m, best.score, kAuxDecayLow_s, kAuxDecayHigh_s);
   for (const auto& tp : kShapeParameters) {
     if (c.id != tp.effect || !c.shape.count(tp.parameter)) continue;
     TimeProfile prof;
@@ -208,12 +212,23 @@ Finding catalogue_finding(const SelectionContext& sc, const Candidate& c, const 
                     fixed(sc.standing.mean_w + 1.96 * sc.standing.se_w, 0) +
                     "], is an auxiliary load's signature (nothing else draws power at standstill); constant or duty-cycled, "
                     "the windows see its mean";
+  if (prof && prof->parameter == "decay_s") {
+    const double share = c.shape.at("decaying_share");
+    f.description += std::string(f.description.empty() ? "" : "; ") + "decaying from the start of the trip (a heater "
+                     "bringing a cold cabin to temperature): " + fixed(value, 0) + " W at the start, " +
+                     fixed(value * (1.0 - share), 0) + " W once settled, time constant " + fixed(prof->interval.value / 60.0, 1) +
+                     " min [" + fixed(prof->interval.low / 60.0, 1) + ", " + fixed(prof->interval.high / 60.0, 1) + "]";
+  }
   for (const auto& [k, v] : c.shape) {
     for (const auto& pi : info.parameters) {
       if (pi.name != k) continue;
+      const auto nuisance = prof ? std::find_if(prof->nuisance.begin(), prof->nuisance.end(), [&k = k](const auto& e) { return e.name == k; })
+                                 : std::vector<ParameterEstimate>::const_iterator{};
       if (prof && k == prof->parameter)
         f.parameters.push_back({k, pi.unit, v, prof->interval.low, prof->interval.high, true, prof->interval.low_open,
                                 prof->interval.high_open});
+      else if (prof && nuisance != prof->nuisance.end())
+        f.parameters.push_back(*nuisance);
       else
         f.parameters.push_back({k, pi.unit, v, v, v});  // fixed, not fitted
     }

@@ -341,6 +341,12 @@ const std::vector<ConcealedTruthInfo>& concealed_truths() {
        {1000, 2000, 3000}, SyntheticChannel::battery_power, false, +1, true},
       {"rising_rrc", "", "1 (RRC rise by the end)", "RRC x (1 + r (t / T)^p), p 0.7-1.5: a null for tyre warm-up",
        {0.1, 0.2, 0.3}, SyntheticChannel::battery_power, false, 0, true, "tyre_warmup"},
+      // Issue 10's cabin conditioning: a heater that starts at its maximum and settles (after rising_rrc, so that the
+      // rows before keep their seed blocks).
+      {"winter_heater", "aux_load", "W (heater's maximum)",
+       "EV winter heater: cabin air and interior nodes warmed from -10..+5 degC to 21 degC by a saturated "
+       "proportional thermostat, full power then falling over 10-30 min to 25-50 % of it, blower 100-200 W",
+       {1000, 2000, 3000}, SyntheticChannel::battery_power, false, +1, true},
   };
   return kTruths;
 }
@@ -470,6 +476,8 @@ Recording generate_case(const Vehicle& vehicle, const SyntheticCase& o) {
       const bool decaying = u01(truth_rng) < 0.5;
       const double decay_s = 300.0 + 600.0 * u01(truth_rng), floor = 0.3 + 0.2 * u01(truth_rng);
       truths.push_back(cabin_load_truth(e.size, decaying ? decay_s : 0.0, floor));
+    } else if (t == "winter_heater") {
+      truths.push_back(winter_heater_truth(winter_cabin(e.size, truth_rng)));
     } else if (t == "rising_rrc") {
       const double power = 0.7 + 0.8 * std::uniform_real_distribution<double>(0.0, 1.0)(truth_rng);
       truths.push_back(rising_rrc_truth(e.size, c.duration_s(), power));

@@ -318,8 +318,9 @@ BenchResult run_discovery_bench(const Vehicle& vehicle, const BenchOptions& opt)
       const Diagnosis d = diagnose(car, recs, dopt);
       for (const auto& f : d.findings) {
         const auto from = f.fitted.find("wind_from_deg");
+        const auto decay = f.fitted.find("decay_s");
         o.findings.push_back({f.effect, f.confounded_with, f.parameters.empty() ? 0.0 : f.parameters.front().value,
-                              from == f.fitted.end() ? -1.0 : from->second});
+                              from == f.fitted.end() ? -1.0 : from->second, decay == f.fitted.end() ? -1.0 : decay->second});
       }
       // The sparse regression sees one trip at a time (its library has no trip-level term): every trip's terms.
       o.sparse.assign(sparse_thresholds().size() + 1, {});
@@ -336,6 +337,7 @@ BenchResult run_discovery_bench(const Vehicle& vehicle, const BenchOptions& opt)
       put(bytes, f.confounded_with);
       put(bytes, f.size);
       put(bytes, f.wind_from_deg);
+      put(bytes, f.decay_s);
     }
     put(bytes, o.sparse);
     return bytes;
@@ -361,6 +363,7 @@ BenchResult run_discovery_bench(const Vehicle& vehicle, const BenchOptions& opt)
       take(in, f.confounded_with);
       take(in, f.size);
       take(in, f.wind_from_deg);
+      take(in, f.decay_s);
     }
     take(in, out[k].sparse);
   }
@@ -391,6 +394,15 @@ BenchResult run_discovery_bench(const Vehicle& vehicle, const BenchOptions& opt)
       if (!f.empty() && f.front().effect == "wind_heading" && f.front().confounded_with.empty() &&
           bearing_error_deg(f.front().wind_from_deg, truth_bearing_deg(c.seed0 + static_cast<unsigned>(tasks[k].s))) <= 45.0)
         ++row.rollsim_direction_right;
+    }
+    // Whether an auxiliary load was found decaying: the winter heater's shape, and how often the duty-cycled and
+    // steady loads (a decay only on half the cabin_load seeds) are given one.
+    static const std::vector<std::string> kLoadTruths{"winter_heater", "cabin_load", "ac_duty_cycle", "aux_compressor"};
+    if (c.synth.effects.size() == 1 && has(kLoadTruths, c.synth.effects.front().truth)) {
+      row.scores_decay = true;
+      const auto& f = r.findings;
+      if (!f.empty() && f.front().effect == "aux_load" && f.front().confounded_with.empty() && f.front().decay_s > 0.0)
+        ++row.rollsim_decay_found;
     }
     if (!r.findings.empty() && r.findings.front().effect == "unexplained") ++row.rollsim_unexplained;
     // Parameter-only calibration fits scale, RRC level and CdA and can say nothing else: "nothing missing".
@@ -489,6 +501,12 @@ std::string bench_text(const BenchResult& r) {
       const auto [dlo, dhi] = wilson_interval(row.rollsim_direction_right, row.rollsim.n());
       os << "    named with the wind's bearing within 45 deg: " << row.rollsim_direction_right << "/" << row.rollsim.n()
          << std::fixed << std::setprecision(0) << " (" << 100.0 * row.rollsim_direction_right / std::max(1, row.rollsim.n())
+         << " %, Wilson 95 % " << 100 * dlo << "-" << 100 * dhi << " %)\n" << std::defaultfloat;
+    }
+    if (row.scores_decay) {
+      const auto [dlo, dhi] = wilson_interval(row.rollsim_decay_found, row.rollsim.n());
+      os << "    named with a decay from the trip's start (decay_s fitted): " << row.rollsim_decay_found << "/" << row.rollsim.n()
+         << std::fixed << std::setprecision(0) << " (" << 100.0 * row.rollsim_decay_found / std::max(1, row.rollsim.n())
          << " %, Wilson 95 % " << 100 * dlo << "-" << 100 * dhi << " %)\n" << std::defaultfloat;
     }
   }

@@ -35,6 +35,30 @@ class CabinLoadTruth final : public Effect {
   double p0_, tau_, floor_;
 };
 
+// Hidden states: the cabin air's and the interior's (seats, trim, glass) temperatures above ambient [K]. The heater
+// holds the air at its set point by a proportional thermostat with feed-forward of the settled holding power,
+// saturated at its maximum: flat at the maximum while the air is cold, then falling as the interior soaks up less.
+class WinterHeaterTruth final : public Effect {
+ public:
+  explicit WinterHeaterTruth(const WinterCabin& c) : c_(c) {}
+  std::string id() const override { return "truth_winter_heater"; }
+  int num_states() const override { return 2; }
+  void initial_states(double* x) const override { x[0] = x[1] = 0.0; }  // the car soaked at ambient
+  void state_derivatives(const EffectInputs&, const double* x, double* xdot) const override {
+    const double to_interior_w = c_.interior_w_per_k * (x[0] - x[1]);
+    xdot[0] = (heater_w(x[0]) - c_.ua_w_per_k * x[0] - to_interior_w) / c_.air_j_per_k;
+    xdot[1] = to_interior_w / c_.interior_j_per_k;
+  }
+  double extra_electric_power_w(const EffectInputs&, const double* x) const override { return heater_w(x[0]) + c_.blower_w; }
+
+ private:
+  double heater_w(double air_k) const {
+    const double gain_w_per_k = c_.max_power_w / c_.band_k;
+    return std::clamp(c_.ua_w_per_k * c_.setpoint_excess_k + gain_w_per_k * (c_.setpoint_excess_k - air_k), 0.0, c_.max_power_w);
+  }
+  WinterCabin c_;
+};
+
 class RisingRrcTruth final : public Effect {
  public:
   RisingRrcTruth(double rise, double duration_s, double power) : rise_(rise), t_(duration_s), p_(power) {}
@@ -177,6 +201,23 @@ std::shared_ptr<const Effect> duty_cycled_ac_truth(DutyCycle schedule) { return 
 std::shared_ptr<const Effect> cabin_load_truth(double initial_w, double decay_s, double floor) {
   return std::make_shared<CabinLoadTruth>(initial_w, decay_s, floor);
 }
+
+WinterCabin winter_cabin(double max_power_w, std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  WinterCabin c;
+  c.max_power_w = max_power_w;
+  c.setpoint_excess_k = 21.0 - (-10.0 + 15.0 * u(rng));  // ambient -10 to +5 degC, set point 21 degC
+  const double hold_share = 0.25 + 0.25 * u(rng);
+  c.ua_w_per_k = hold_share * max_power_w / c.setpoint_excess_k;
+  // With the interior still at ambient the heater would need 60-100 % of the rest of its maximum on top.
+  c.interior_w_per_k = (0.6 + 0.4 * u(rng)) * (1.0 - hold_share) * max_power_w / c.setpoint_excess_k;
+  c.interior_j_per_k = c.interior_w_per_k * (600.0 + 1200.0 * u(rng));
+  c.air_j_per_k = 15000.0 + 15000.0 * u(rng);
+  c.blower_w = 100.0 + 100.0 * u(rng);
+  return c;
+}
+
+std::shared_ptr<const Effect> winter_heater_truth(const WinterCabin& cabin) { return std::make_shared<WinterHeaterTruth>(cabin); }
 
 std::shared_ptr<const Effect> rising_rrc_truth(double rise, double duration_s, double power) {
   return std::make_shared<RisingRrcTruth>(rise, duration_s, power);

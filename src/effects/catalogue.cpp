@@ -22,7 +22,7 @@ struct TyreWarmupParams {
       initial_excess_k;
 };
 struct AuxLoadParams {
-  double power_w, duty_cycle, period_s;
+  double power_w, duty_cycle, period_s, decay_s, decaying_share;
 };
 struct WindParams {
   double headwind_mps;
@@ -85,21 +85,26 @@ class TyreWarmup final : public Effect {
   double excess_, c_, h0_, g_, warm_, initial_;
 };
 
-// Constant electrical consumer (HVAC, electronics) not in the vehicle file's aux power.
+// Electrical consumer (HVAC, electronics) not in the vehicle file's aux power: constant, duty-cycled, or decaying.
 // Duty-cycled (an A/C compressor or heater cycling on and off every few minutes): on for the first duty_cycle x
 // period_s of each period, at power_w / duty_cycle, so power_w is always the mean; period 0 is a constant load.
+// Decaying (a winter heater bringing a cold cabin to temperature, then holding it): a share of power_w falls with
+// time constant decay_s from the start of the trace, P(t) = power_w (1 - share + share exp(-t / decay_s)), so
+// power_w is the power at the start (P0 + P1) and 1 - share its level once the cabin is warm; decay_s 0: no decay.
 class AuxLoad final : public Effect {
  public:
-  AuxLoad(const AuxLoadParams& p, const EffectContext&) : p_(p.power_w), duty_(p.duty_cycle), period_(p.period_s) {}
+  AuxLoad(const AuxLoadParams& p, const EffectContext&)
+      : p_(p.power_w), duty_(p.duty_cycle), period_(p.period_s), decay_s_(p.decay_s), share_(p.decaying_share) {}
   std::string id() const override { return "aux_load"; }
   double extra_electric_power_w(const EffectInputs& in, const double*) const override {
-    if (period_ <= 0.0 || duty_ >= 1.0) return p_;
+    const double level = decay_s_ > 0.0 ? 1.0 - share_ + share_ * std::exp(-std::max(0.0, in.time_s) / decay_s_) : 1.0;
+    if (period_ <= 0.0 || duty_ >= 1.0) return p_ * level;
     const double phase = std::fmod(std::max(0.0, in.time_s), period_) / period_;
-    return phase < duty_ ? p_ / duty_ : 0.0;
+    return phase < duty_ ? p_ * level / duty_ : 0.0;
   }
 
  private:
-  double p_, duty_, period_;
+  double p_, duty_, period_, decay_s_, share_;
 };
 
 // Constant headwind u (negative: tailwind): the aero force is 0.5 rho CdA (v + u)^2 instead of 0.5 rho CdA v^2.
@@ -331,11 +336,14 @@ std::vector<EffectInfo> build_catalogue() {
        {&TyreWarmupParams::initial_excess_k, {"initial_excess_k", "K", 0.0, 0.0, 0.0, 100.0, false}}}));
   c.push_back(row<AuxLoad, AuxLoadParams>(
       I::aux_load, "aux_load",
-      "extra electrical load (HVAC, electronics): constant, or duty-cycled on and off with its mean power_w",
+      "extra electrical load (HVAC, electronics): constant, duty-cycled on and off with its mean power_w, or a share "
+      "decaying from the start of the trip (a winter heater: P0 + P1 exp(-t / decay_s), power_w = P0 + P1)",
       "less constant power drawn than the vehicle file's auxiliaries",
       {{&AuxLoadParams::power_w, {"power_w", "W", 0.0, 400.0, 0.0, 8000.0, true}},
        {&AuxLoadParams::duty_cycle, {"duty_cycle", "1", 1.0, 1.0, 0.05, 1.0, false}},
-       {&AuxLoadParams::period_s, {"period_s", "s", 0.0, 0.0, 0.0, 3600.0, false}}}));
+       {&AuxLoadParams::period_s, {"period_s", "s", 0.0, 0.0, 0.0, 3600.0, false}},
+       {&AuxLoadParams::decay_s, {"decay_s", "s", 0.0, 0.0, 0.0, 36000.0, false}},
+       {&AuxLoadParams::decaying_share, {"decaying_share", "1", 1.0, 1.0, 0.0, 1.0, false}}}));
   c.push_back(row<Wind, WindParams>(I::wind, "wind", "constant headwind (negative: tailwind)", "",
                                     {{&WindParams::headwind_mps, {"headwind_mps", "m/s", 0.0, 3.0, -20.0, 20.0, true}}}));
   c.push_back(row<Mass, MassParams>(I::mass, "mass", "mass or payload missing from the file: inertia, grade and rolling share",

@@ -45,6 +45,7 @@ struct FindingSummary {
   std::vector<std::string> confounded_with;
   double size = 0.0;
   double wind_from_deg = -1.0;  ///< wind_heading's fitted bearing (negative: none)
+  double decay_s = -1.0;        ///< aux_load's fitted decay from the trip's start (negative: none)
 };
 
 /// What a row asks of a diagnosis. `group` as BenchRow's; `sign` +1 where the truth's physics has a sign (the
@@ -80,6 +81,9 @@ struct BenchRow {
   /// Steady-wind rows (GPS): seeds named with the truth's bearing within 45 deg (of rollsim.named), and the cases.
   int rollsim_direction_right = 0;
   bool scores_direction = false;
+  /// Winter-heater rows: seeds named aux_load with a decay from the trip's start (of rollsim.named).
+  int rollsim_decay_found = 0;
+  bool scores_decay = false;
   /// Seeds counted mistaken for a size of the wrong sign (effect rows), or a never_called finding of negative size
   /// ("reversed" rows; the rest of that row's mistakes had a positive size).
   int rollsim_wrong_sign = 0;

@@ -38,6 +38,26 @@ std::shared_ptr<const Effect> duty_cycled_ac_truth(DutyCycle schedule);
 /// Cabin conditioning of an electric car: `initial_w` from the start, constant (decay_s = 0) or falling to
 /// floor x initial_w with time constant decay_s (a cabin reaching its set temperature).
 std::shared_ptr<const Effect> cabin_load_truth(double initial_w, double decay_s, double floor);
+/// A winter heater (an electric car's PTC heater and its blower) warming a car soaked at ambient: two nodes, the
+/// cabin air (C_air, losing UA (T_air - T_amb) through glass and ventilation) and the interior it heats (seats, trim:
+/// C_int, exchanging h (T_air - T_int)). The heater holds the air at its set point, drawing
+/// min(P_max, UA dT_set + (P_max / band) (dT_set - dT_air)): full power while the air is cold, then falling as the
+/// interior warms, to UA dT_set. The catalogue's shape is a plain exponential decay from the start.
+struct WinterCabin {
+  double max_power_w = 3000.0;
+  double setpoint_excess_k = 21.0;  ///< set point above the ambient
+  double ua_w_per_k = 50.0;
+  double air_j_per_k = 20000.0;
+  double interior_w_per_k = 80.0;
+  double interior_j_per_k = 100000.0;
+  double band_k = 2.0;  ///< proportional band
+  double blower_w = 150.0;
+};
+/// Per seed: ambient -10 to +5 degC (set point 21 degC), a settled power of 25-50 % of the maximum, an interior that
+/// with the cabin at ambient would take 60-100 % of the rest, interior time constant C_int / h of 10-30 min, air
+/// 15-30 kJ/K, blower 100-200 W.
+WinterCabin winter_cabin(double max_power_w, std::mt19937& rng);
+std::shared_ptr<const Effect> winter_heater_truth(const WinterCabin& cabin);
 /// RRC rising over the trip (rain, a road surface turning rough, a slow puncture): factor 1 + rise (t / T)^p.
 std::shared_ptr<const Effect> rising_rrc_truth(double rise, double duration_s, double power);
 
