@@ -192,7 +192,7 @@ TEST(EngineSoak, ColdStartWithASoakIsNamedEngineWarmupWithItsHeatCapacityInterva
   EXPECT_TRUE(noted);
 }
 
-TEST(EngineSoak, CliRejectsAStartStateThatIsNeitherColdNorHot) {
+TEST(EngineSoak, CliRejectsAStartStateThatIsNeitherColdHotNorInfer) {
   const auto csv = test::temp_dir() / "short_trip.csv";
   {
     std::ofstream f(csv);
@@ -202,7 +202,7 @@ TEST(EngineSoak, CliRejectsAStartStateThatIsNeitherColdNorHot) {
   const auto r = test::run_rollsim("diagnose --vehicle ice --recording " + csv.string() + " --engine-start warm");
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.err.find("--engine-start"), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find("'warm' is not allowed: cold or hot"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("'warm' is not allowed: cold, hot or infer"), std::string::npos) << r.err;
 }
 
 }  // namespace

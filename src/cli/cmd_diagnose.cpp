@@ -49,8 +49,9 @@ void run_diagnose(const DiagnoseCliOptions& o) {
     throw InputError("--engine-start", std::to_string(o.engine_start.size()) + " start states given for " +
                                            std::to_string(recs.size()) + " recordings: give at most one per --recording");
   for (const auto& s : o.engine_start) {
-    if (s != "cold" && s != "hot") throw InputError("--engine-start", "'" + s + "' is not allowed: cold or hot");
-    dopt.engine_start.push_back(s == "hot" ? EngineStart::hot : EngineStart::cold);
+    if (s != "cold" && s != "hot" && s != "infer")
+      throw InputError("--engine-start", "'" + s + "' is not allowed: cold, hot or infer");
+    dopt.engine_start.push_back(s == "hot" ? EngineStart::hot : s == "cold" ? EngineStart::cold : EngineStart::infer);
   }
   const Diagnosis d = diagnose(v, recs, dopt);
   std::cout << diagnosis_text(d);
@@ -115,7 +116,8 @@ void register_diagnose_command(CLI::App& app, const ProcessGroup& group) {
                 "profile along the route as an explanation (default on; named only with a descent steeper than the rolling "
                 "resistance; README)");
   sub->add_option("--engine-start", o->engine_start,
-                  "cold or hot per --recording, in order (default cold, at ambient): a hot test is not warmed up again")
+                  "cold, hot or infer per --recording, in order (default infer, from a fuel recording's first minutes): a "
+                  "hot test is not warmed up again")
       ->type_name("STATE");
   sub->add_option("--report", o->report, "Write figures (SVG, gnuplot) and report.html into this folder")->type_name("DIR");
   sub->add_option("--write-vehicle", o->write_vehicle, "Write the vehicle with the fitted effects switched on")->type_name("FILE");

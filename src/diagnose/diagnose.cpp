@@ -15,7 +15,7 @@ namespace rollsim {
 namespace {
 
 // What the replay takes from the fuel channel about the engine: its switched-off runs and its start state.
-void note_engine_state(const DriveCycle& c, const Recording& r, std::vector<std::string>& notes) {
+void note_engine_state(const DriveCycle& c, const Recording& r, const EngineStartState& start, std::vector<std::string>& notes) {
   if (!r.fuel_rate_m3ps) return;
   int runs = 0;
   double off_s = 0.0;
@@ -24,7 +24,12 @@ void note_engine_state(const DriveCycle& c, const Recording& r, std::vector<std:
     if (i == 0 || !c.engine_off_at(i - 1)) ++runs;
     off_s += c.time_s[i + 1] - c.time_s[i];
   }
-  notes.push_back(r.source + ": engine " + (c.engine_hot_start ? "hot" : "cold (at ambient)") + " at the start; " +
+  const std::string how =
+      start.inferred ? " (inferred: its first minutes of running burn " + fixed(100.0 * start.early_excess, 1) + " % [" +
+                           fixed(100.0 * start.early_excess_ci_low, 1) + ", " + fixed(100.0 * start.early_excess_ci_high, 1) +
+                           "] more fuel than the warm model, relative to its later running)"
+                     : "";
+  notes.push_back(r.source + ": engine " + (c.engine_hot_start ? "hot" : "cold (at ambient)") + " at the start" + how + "; " +
                   (runs == 0 ? std::string("never switched off")
                              : "switched off " + std::to_string(runs) + " times for " + fixed(off_s, 0) +
                                    " s in all (standing with zero fuel flow): no fuel there, and a cold engine cools"));
@@ -35,9 +40,8 @@ std::vector<DriveCycle> cycles_of(const std::vector<Recording>& recordings, cons
   std::vector<DriveCycle> cycles;
   for (std::size_t k = 0; k < recordings.size(); ++k) {
     const Recording& r = recordings[k];
-    const EngineStart start = k < opt.engine_start.size() ? opt.engine_start[k] : EngineStart::cold;
+    const EngineStart start = k < opt.engine_start.size() ? opt.engine_start[k] : EngineStart::infer;
     cycles.push_back(cycle_of_recording(r, opt.engine_off_min_s, start));
-    note_engine_state(cycles.back(), r, notes);
     if (!r.grade && r.elevation_m)
       notes.push_back(r.source + ": grade from recorded elevation (" +
                       std::to_string(grade_from_elevation(r.time_s, r.speed_mps, *r.elevation_m).rejected_steps) +
@@ -74,6 +78,26 @@ void describe_wind(const std::vector<DriveCycle>& cycles, std::vector<Finding>& 
       f.description += std::string(f.description.empty() ? "" : "; ") + "a steady wind of " +
                        fixed(f.fitted.at("wind_speed_mps"), 1) + " m/s from " + fixed(f.fitted.at("wind_from_deg"), 0) +
                        " deg (clockwise from north, to 30 deg), its headwind turning with the recorded heading";
+  }
+}
+
+// Each fuel-rate recording's start: as set, or inferred from its first minutes against the warm model's replay (which
+// no start state changes), before any engine signature is run.
+void set_engine_starts(std::vector<DriveCycle>& cycles, const std::vector<Recording>& recordings, const diag::Observations& o,
+                       const diag::Variant& base, const DiagnoseOptions& opt, Diagnosis& out) {
+  for (std::size_t k = 0; k < recordings.size(); ++k) {
+    if (!recordings[k].fuel_rate_m3ps) continue;
+    EngineStartState s;
+    const EngineStart set = k < opt.engine_start.size() ? opt.engine_start[k] : EngineStart::infer;
+    if (set == EngineStart::infer && o.channel == ChannelKind::fuel_rate) {
+      s = diag::infer_engine_start(o.measured_w[k], base.power_w[k], o.dt_s[k], cycles[k], opt);
+    } else {
+      s.start = set == EngineStart::hot ? EngineStart::hot : EngineStart::cold;
+    }
+    s.recording = recordings[k].source;
+    cycles[k].engine_hot_start = s.start == EngineStart::hot;
+    note_engine_state(cycles[k], recordings[k], s, out.notes);
+    out.engine_starts.push_back(s);
   }
 }
 
@@ -177,7 +201,7 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
   using namespace diag;
   if (recordings.empty()) throw InputError("--recording", "at least one recording is needed");
   Diagnosis out;
-  const std::vector<DriveCycle> cycles = cycles_of(recordings, opt, out.notes);
+  std::vector<DriveCycle> cycles = cycles_of(recordings, opt, out.notes);
   const Observations obs = build_windows(vehicle, recordings, opt.window_s, opt, out.notes);
   out.channel = to_string(obs.channel);
   out.windows = static_cast<int>(obs.n());
@@ -196,6 +220,7 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
   const LagEstimate lag = estimate_lag(base.power_w, obs);
   base.window_j = window_energies(base.power_w, obs, lag.samples);
   out.raw_trip_energy_error_pct = energy_error_pct(base.window_j, obs.measured_j);
+  set_engine_starts(cycles, recordings, obs, base, opt, out);
   const Signatures sig = compute_signatures(rp, obs, base, lag.samples, amb, ctx, opt);
   const Calibration cal = calibrate(obs, sig.base, sig.rrc, sig.drag, opt.priors, opt.bic_threshold);
   report_calibration(cal, obs, lag, out);

@@ -34,6 +34,14 @@ std::string diagnosis_json(const Diagnosis& d) {
      << num(d.final_residual_to_noise_z) << "},\n";
   os << "  \"lag_samples\": " << d.lag_samples << ",\n";
   os << "  \"lag_s\": {\"value\": " << num(d.lag_s) << ", \"ci_low\": " << num(d.lag_ci_low_s) << ", \"ci_high\": " << num(d.lag_ci_high_s) << "},\n";
+  os << "  \"engine_starts\": [";
+  for (std::size_t i = 0; i < d.engine_starts.size(); ++i) {
+    const auto& e = d.engine_starts[i];
+    os << (i ? ", " : "") << "{\"recording\": " << json_string(e.recording) << ", \"start\": " << json_string(to_string(e.start))
+       << ", \"inferred\": " << (e.inferred ? "true" : "false") << ", \"early_excess\": " << num(e.early_excess)
+       << ", \"early_excess_ci\": [" << num(e.early_excess_ci_low) << ", " << num(e.early_excess_ci_high) << "]}";
+  }
+  os << "],\n";
   os << "  \"window_s\": " << num(d.window_s) << ",\n  \"notes\": [";
   for (std::size_t i = 0; i < d.notes.size(); ++i) os << (i ? ", " : "") << json_string(d.notes[i]);
   os << "],\n";

@@ -74,6 +74,14 @@ struct LagEstimate {
 };
 LagEstimate estimate_lag(const std::vector<std::vector<double>>& sim_w, const Observations& o);
 
+// ---- engine start (engine_start.cpp) ---------------------------------------------------------------------------
+
+/// A fuel-rate recording's engine start from its measured and simulated (warm-model) fuel power per sample: cold
+/// unless the early running's excess over the model, relative to the late running's, is ruled out at
+/// opt.engine_start_min_cold_excess (its 95 % upper bound below it). Not inferred (cold) when too short to tell.
+EngineStartState infer_engine_start(const std::vector<double>& measured_w, const std::vector<double>& sim_w,
+                                    const std::vector<double>& dt_s, const DriveCycle& c, const DiagnoseOptions& opt);
+
 // ---- least squares with priors (fit.cpp) -----------------------------------------------------------------------
 
 /// Priors of the calibration columns: Gaussian penalties (rows pulling a coefficient towards `target`) and hard

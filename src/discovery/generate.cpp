@@ -347,6 +347,12 @@ const std::vector<ConcealedTruthInfo>& concealed_truths() {
        "EV winter heater: cabin air and interior nodes warmed from -10..+5 degC to 21 degC by a saturated "
        "proportional thermostat, full power then falling over 10-30 min to 25-50 % of it, blower 100-200 W",
        {1000, 2000, 3000}, SyntheticChannel::battery_power, false, +1, true},
+      // The same cold-start test's engine started hot (a pooled hot test): a null for engine_warmup, whose start the
+      // diagnosis infers from the first minutes.
+      {"engine_hot_soak", "", "1 (cold fuel excess, engine started hot)",
+       "engine_cold_soak's engine, both nodes at running temperature at the start; UDDS, 10 min soak, UDDS (fuel "
+       "channel)",
+       {0.25}, SyntheticChannel::fuel_rate, false, 0, false, "engine_warmup", "udds", 600.0},
   };
   return kTruths;
 }
@@ -421,9 +427,10 @@ Recording generate_case(const Vehicle& vehicle, const SyntheticCase& o) {
     if (t == "engine_oil_coolant") {
       if (o.channel != SyntheticChannel::fuel_rate) throw InputError("concealed truth 'engine_oil_coolant'", "needs the fuel channel");
       engine_cold_excess = e.size;
-    } else if (t == "engine_cold_soak") {
-      if (o.channel != SyntheticChannel::fuel_rate) throw InputError("concealed truth 'engine_cold_soak'", "needs the fuel channel");
+    } else if (t == "engine_cold_soak" || t == "engine_hot_soak") {
+      if (o.channel != SyntheticChannel::fuel_rate) throw InputError("concealed truth '" + t + "'", "needs the fuel channel");
       engine_soak = cold_start_engine(e.size, truth_rng);
+      engine_soak->hot_start = t == "engine_hot_soak";
     } else if (t == "wind_steady_gps") {
       if (!route) throw InputError("concealed truth 'wind_steady_gps'", "needs a route with GPS (SyntheticCase::gps)");
       const double from = o.wind_from_deg.value_or(360.0 * std::uniform_real_distribution<double>(0.0, 1.0)(truth_rng));

@@ -36,8 +36,10 @@ struct CalibrationPriors {
 CalibrationPriors calibration_priors_from_yaml(YamlMap& file);
 
 /// Fixed in advance (not tuned per recording), so that the null case's false-discovery rate is what it is.
-/// A recording's engine at its start: cold at ambient (a cold-start test, the first trip of the day) or hot.
-enum class EngineStart { cold, hot };
+/// A recording's engine at its start: cold at ambient (a cold-start test, the first trip of the day), hot, or
+/// inferred from the recording's first minutes of fuel flow.
+enum class EngineStart { cold, hot, infer };
+std::string to_string(EngineStart s);
 
 struct DiagnoseOptions {
   double window_s = 60.0;          ///< energy windows
@@ -83,9 +85,16 @@ struct DiagnoseOptions {
   /// flow for at least this long (a soak between two tests, start-stop at a light): the replay burns no fuel there
   /// and a cold engine cools instead of idling warm. Shorter runs of zeros are read as the flow meter's noise.
   double engine_off_min_s = 5.0;
-  /// Each recording's engine at its start, in the recordings' order (missing entries: cold at ambient): a hot
-  /// test pooled with a cold one is not warmed up again.
+  /// Each recording's engine at its start, in the recordings' order (missing entries: inferred): a hot test pooled
+  /// with a cold one is not warmed up again.
   std::vector<EngineStart> engine_start;
+  /// Inferring a fuel-rate recording's start: the fuel its first `engine_start_early_s` of running burn, against
+  /// the model's, relative to the same ratio after `engine_start_late_s` of running (60 s blocks). Hot only when the
+  /// data rule out (95 %, one-sided by the upper bound) an early excess of `engine_start_min_cold_excess`: a cold
+  /// guess costs nothing on a hot engine (the warm-up's fit is then zero), a hot guess hides a real warm-up.
+  double engine_start_early_s = 300.0;
+  double engine_start_late_s = 900.0;
+  double engine_start_min_cold_excess = 0.05;
 };
 
 struct ParameterEstimate {
@@ -161,6 +170,15 @@ struct DetectionLimit {
   bool within_bounds = true;         ///< false: even the largest allowed size would not have been detected
 };
 
+/// A fuel-rate recording's engine start as the diagnosis took it, and the evidence where it was inferred: the early
+/// running's fuel excess over the model, relative to the rest of the recording, with its 95 % interval.
+struct EngineStartState {
+  std::string recording;
+  EngineStart start = EngineStart::cold;  ///< cold or hot
+  bool inferred = false;                  ///< false: set (--engine-start), or too short to infer (then cold)
+  double early_excess = 0.0, early_excess_ci_low = 0.0, early_excess_ci_high = 0.0;
+};
+
 struct Diagnosis {
   std::string verdict;   ///< missing_physics, nothing_missing, confounded
   std::string channel;   ///< which measured channel was compared
@@ -191,6 +209,7 @@ struct Diagnosis {
   std::vector<DetectionLimit> detection_limits;  ///< catalogue effects not found, with what would have been
   double window_s = 0.0;            ///< window length used (SOC: lengthened by the quantum)
   std::vector<std::string> notes;   ///< preparation done on the data (grade from elevation, SOC quantum)
+  std::vector<EngineStartState> engine_starts;  ///< fuel-rate recordings only, in the recordings' order
   std::vector<DiagnosisWindow> series;
 };
 

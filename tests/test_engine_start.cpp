@@ -1,0 +1,77 @@
+// A fuel recording's engine start inferred from its first minutes (issue 10): cold on a cold-start test, hot on the
+// same test started hot (which is then not warmed up again), set by --engine-start where given.
+#include <gtest/gtest.h>
+
+#include "rollsim/diagnose/diagnose.hpp"
+#include "rollsim/discovery/generate.hpp"
+#include "rollsim/vehicle/vehicle_file.hpp"
+
+namespace rollsim {
+namespace {
+
+Vehicle ice() { return load_vehicle_file(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/ice.yaml"); }
+
+Recording soak_test(const std::string& truth, unsigned seed) {
+  SyntheticCase c;
+  c.cycle = "udds";
+  c.soak_s = 600.0;
+  c.channel = SyntheticChannel::fuel_rate;
+  c.effects = {{truth, 0.25}};
+  c.seed = seed;
+  return generate_case(ice(), c);
+}
+
+double warmup_excess(const Diagnosis& d) {
+  for (const auto& f : d.findings)
+    if (f.effect == "engine_warmup") return f.fitted.at("cold_fuel_excess");
+  return 0.0;
+}
+
+TEST(EngineStart, ColdStartIsInferredColdAndAHotStartHot) {
+  const Vehicle v = ice();
+  for (unsigned seed : {3u, 4u, 5u}) {
+    const Diagnosis cold = diagnose(v, {soak_test("engine_cold_soak", seed)});
+    ASSERT_EQ(cold.engine_starts.size(), 1u);
+    EXPECT_TRUE(cold.engine_starts[0].inferred);
+    EXPECT_EQ(cold.engine_starts[0].start, EngineStart::cold) << seed;
+    EXPECT_GT(cold.engine_starts[0].early_excess_ci_low, 0.0) << seed;  // a 25 % cold excess shows in 5 minutes
+    const Diagnosis hot = diagnose(v, {soak_test("engine_hot_soak", seed)});
+    ASSERT_EQ(hot.engine_starts.size(), 1u);
+    EXPECT_TRUE(hot.engine_starts[0].inferred);
+    EXPECT_EQ(hot.engine_starts[0].start, EngineStart::hot) << seed;
+    EXPECT_LT(hot.engine_starts[0].early_excess_ci_high, 0.05) << seed;
+    EXPECT_EQ(warmup_excess(hot), 0.0) << seed;  // not warmed up again
+  }
+}
+
+TEST(EngineStart, PooledTestsEachGetTheirOwnStartAndASetStartOverrides) {
+  const Vehicle v = ice();
+  const std::vector<Recording> recs{soak_test("engine_cold_soak", 7), soak_test("engine_hot_soak", 7)};
+  const Diagnosis inferred = diagnose(v, recs);
+  ASSERT_EQ(inferred.engine_starts.size(), 2u);
+  EXPECT_EQ(inferred.engine_starts[0].start, EngineStart::cold);
+  EXPECT_EQ(inferred.engine_starts[1].start, EngineStart::hot);
+  DiagnoseOptions set;
+  set.engine_start = {EngineStart::hot, EngineStart::infer};
+  const Diagnosis d = diagnose(v, recs, set);
+  EXPECT_FALSE(d.engine_starts[0].inferred);  // --engine-start overrides the data
+  EXPECT_EQ(d.engine_starts[0].start, EngineStart::hot);
+  EXPECT_TRUE(d.engine_starts[1].inferred);
+  EXPECT_EQ(d.engine_starts[1].start, EngineStart::hot);
+  EXPECT_EQ(warmup_excess(d), 0.0);  // both hot: no engine warms up, so none is fitted
+}
+
+TEST(EngineStart, WarmNullIsInferredHot) {
+  // A fuel recording without any warm-up (the fuel null on WLTC x2): nothing early, so hot.
+  const Vehicle v = ice();
+  SyntheticCase c;
+  c.channel = SyntheticChannel::fuel_rate;
+  c.seed = 9;
+  const Diagnosis d = diagnose(v, {generate_case(v, c)});
+  ASSERT_EQ(d.engine_starts.size(), 1u);
+  EXPECT_EQ(d.engine_starts[0].start, EngineStart::hot);
+  EXPECT_TRUE(d.findings.empty());
+}
+
+}  // namespace
+}  // namespace rollsim
