@@ -124,9 +124,39 @@ DriveCycle read_cycle_csv(const std::string& path, const std::string& name) {
   return cycle_from_table(read_csv(path), name);
 }
 
+namespace {
+
+// The direction of travel over the segment starting at this sample, clockwise from north, as a compass gives it.
+double heading_rad(const CsvTable& table, std::size_t row, std::size_t col, double deg) {
+  if (!(deg >= 0.0 && deg <= 360.0))
+    throw InputError(table.where(row, col), format_value(deg) + " deg is not allowed: a heading is in [0, 360] deg, clockwise from north");
+  return units::deg_to_rad(deg);
+}
+
+// 1: the engine runs over the segment starting here; 0: switched off (a soak, start-stop), no fuel, cooling.
+bool engine_off(const CsvTable& table, std::size_t row, std::size_t col, double on) {
+  if (on != 0.0 && on != 1.0) throw InputError(table.where(row, col), format_value(on) + " is not allowed: engine_on is 1 (running) or 0 (off)");
+  return on == 0.0;
+}
+
+// The simulator switches an engine off only on a standing segment (a moving car's engine-off flag would be ignored,
+// a silently wrong number): both ends of an off segment must stand still. All-running is no engine_off at all.
+void check_engine_off_standing(const CsvTable& table, std::size_t col, DriveCycle& c) {
+  for (std::size_t r = 0; r < c.engine_off.size(); ++r) {
+    if (!c.engine_off[r]) continue;
+    const std::size_t next = std::min(r + 1, c.speed_mps.size() - 1);
+    if (c.speed_mps[r] > 0.0 || c.speed_mps[next] > 0.0)
+      throw InputError(table.where(r, col), "0 (off) is not allowed while moving (" + format_value(units::mps_to_kmh(std::max(c.speed_mps[r], c.speed_mps[next]))) +
+                                                " km/h over the segment from here): the engine may be off only standing still");
+  }
+  if (std::none_of(c.engine_off.begin(), c.engine_off.end(), [](bool b) { return b; })) c.engine_off.clear();
+}
+
+}  // namespace
+
 DriveCycle cycle_from_table(const CsvTable& table, const std::string& name) {
   const std::string& path = table.file;
-  const std::string allowed = "time_s, speed_kmh or speed_mps, optional grade_pct or elevation_m";
+  const std::string allowed = "time_s, speed_kmh or speed_mps, optional grade_pct or elevation_m, heading_deg, engine_on";
   const std::string found = "found columns: " + table.columns_list();
   // A header of numbers means the file has none, and its first sample would otherwise be lost or misread.
   bool header_numeric = !table.header.empty();
@@ -137,7 +167,8 @@ DriveCycle cycle_from_table(const CsvTable& table, const std::string& name) {
   }
   for (std::size_t i = 0; i < table.header.size(); ++i) {
     const std::string& h = table.header[i];
-    if (h != "time_s" && h != "speed_kmh" && h != "speed_mps" && h != "grade_pct" && h != "elevation_m") {
+    if (h != "time_s" && h != "speed_kmh" && h != "speed_mps" && h != "grade_pct" && h != "elevation_m" && h != "heading_deg" &&
+        h != "engine_on") {
       throw InputError(path + ": line " + std::to_string(table.header_line) + ", column " + std::to_string(i + 1),
                        "unknown column '" + h + "' (misspelt?); allowed: " + allowed + "; " + found);
     }
@@ -152,6 +183,8 @@ DriveCycle cycle_from_table(const CsvTable& table, const std::string& name) {
   const auto col_mps = table.column("speed_mps");
   const auto col_grade = table.column("grade_pct");
   const auto col_elev = table.column("elevation_m");
+  const auto col_heading = table.column("heading_deg");
+  const auto col_engine = table.column("engine_on");
   if (!col_t) throw InputError(path, "missing column 'time_s'; " + found);
   if (!col_kmh && !col_mps) throw InputError(path, "missing a speed column, 'speed_kmh' or 'speed_mps'; " + found);
   if (col_kmh && col_mps) throw InputError(path, "has both 'speed_kmh' and 'speed_mps'; give exactly one");
@@ -212,7 +245,10 @@ DriveCycle cycle_from_table(const CsvTable& table, const std::string& name) {
       c.grade[r] = g / 100.0;
     }
     if (col_elev) elevation.push_back(number(r, *col_elev));
+    if (col_heading) c.heading_rad.push_back(heading_rad(table, r, *col_heading, number(r, *col_heading)));
+    if (col_engine) c.engine_off.push_back(engine_off(table, r, *col_engine, number(r, *col_engine)));
   }
+  if (col_engine) check_engine_off_standing(table, *col_engine, c);
 
   if (col_elev) {
     // Grade at each sample: elevation difference over the distance travelled across a window that grows

@@ -19,13 +19,14 @@ struct DriveCycle {
   std::vector<double> speed_mps;
   std::vector<double> grade;
   /// Per sample: the engine is switched off over the segment starting here (a soak between two tests, start-stop
-  /// at a light), so it burns no fuel; empty when the engine runs throughout (every shipped cycle and CSV file).
+  /// at a light), so it burns no fuel; empty when the engine runs throughout (every shipped cycle; a CSV file
+  /// without an engine_on column or with the engine on throughout).
   std::vector<bool> engine_off;
   /// The engine is warm when the trace starts (a hot start, e.g. the second half of a test after a short soak);
   /// otherwise it starts cold, at ambient.
   bool engine_hot_start = false;
   /// Per sample: the direction of travel over the segment starting here, clockwise from north [rad] (from a
-  /// recording's latitude and longitude); empty where the route's heading is unknown.
+  /// recording's latitude and longitude, or a cycle CSV's heading_deg); empty where the route's heading is unknown.
   std::vector<double> heading_rad;
 
   bool engine_off_at(std::size_t segment) const { return segment < engine_off.size() && engine_off[segment]; }
@@ -57,8 +58,10 @@ std::vector<std::string> shipped_cycle_names();
 /// Loads a shipped cycle by name (case-insensitive, see shipped_cycle_names) or a CSV file by path.
 /// CSV: a header line, then one sample per line. Columns: `time_s` (increasing by 1 ms to one day per sample),
 /// exactly one of `speed_kmh` or `speed_mps` (0 to 500 km/h; at most 2 g between samples), and at most one of
-/// `grade_pct` (percent, within +-30) or `elevation_m` (converted to grade over travelled distance). Any bad
-/// value throws InputError naming file, line, column, the value and the allowed range.
+/// `grade_pct` (percent, within +-30) or `elevation_m` (converted to grade over travelled distance); optionally
+/// `heading_deg` (direction of travel, clockwise from north, [0, 360]: wind_heading reads it) and `engine_on` (1, or
+/// 0 where the engine is switched off over the segment from that sample, standing only: no fuel, a cold engine
+/// cools). Any bad value throws InputError naming file, line, column, the value and the allowed range.
 /// `option` names where the name came from in error messages (e.g. "--cycle").
 DriveCycle load_cycle(const std::string& name_or_path, const std::string& option = "--cycle");
 

@@ -1,0 +1,107 @@
+// A cycle CSV's heading_deg and engine_on columns (issue 10): what makes a vehicle file's wind_heading and engine
+// soaks do something in `simulate`, and the named errors for their bad values.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+
+#include "rollsim/common/error.hpp"
+#include "rollsim/cycle/drive_cycle.hpp"
+#include "rollsim/effects/catalogue.hpp"
+#include "rollsim/sim/simulation.hpp"
+#include "rollsim/vehicle/vehicle_file.hpp"
+#include "test_support.hpp"
+
+namespace rollsim {
+namespace {
+
+std::string write(const std::string& name, const std::string& text) {
+  const auto path = test::temp_dir() / name;
+  std::ofstream(path) << text;
+  return path.string();
+}
+
+// A 10 min cruise at 72 km/h along one heading, accelerating from and braking to a stop.
+std::string cruise(double heading_deg) {
+  std::string s = "time_s,speed_kmh,heading_deg\n";
+  for (int t = 0; t <= 620; ++t) {
+    const double v = t < 10 ? 7.2 * t : t > 610 ? 7.2 * (620 - t) : 72.0;
+    s += std::to_string(t) + "," + std::to_string(v) + "," + std::to_string(heading_deg) + "\n";
+  }
+  return s;
+}
+
+double terminal_j(const Vehicle& v, const DriveCycle& c, const std::shared_ptr<const Effect>& e) {
+  VehicleModel m = VehicleModel::assemble(v);
+  if (e) m.effects.push_back(e);
+  return simulate_forward(m, c).energy.battery_terminal_j;
+}
+
+TEST(CycleColumns, HeadingMakesASteadyWindAHeadwindOrATailwind) {
+  const Vehicle v = load_vehicle_file(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/ev.yaml");
+  const auto wind = make_effect("wind_heading", {{"wind_speed_mps", 5.0}, {"wind_from_deg", 90.0}}, effect_context(v));
+  const DriveCycle east = read_cycle_csv(write("east.csv", cruise(90.0)), "east");
+  const DriveCycle west = read_cycle_csv(write("west.csv", cruise(270.0)), "west");
+  const DriveCycle north = read_cycle_csv(write("north.csv", cruise(0.0)), "north");
+  ASSERT_EQ(east.heading_rad.size(), east.time_s.size());
+  EXPECT_NEAR(east.heading_rad[5], units::deg_to_rad(90.0), 1e-12);
+  const double base = terminal_j(v, east, nullptr);
+  // Driving into the wind (east, wind from 90 deg) costs the aero work of 5 m/s more air speed; across it nothing.
+  const double into = terminal_j(v, east, wind) - base, with = terminal_j(v, west, wind) - base;
+  EXPECT_GT(into, 0.0);
+  EXPECT_LT(with, 0.0);
+  EXPECT_NEAR(terminal_j(v, north, wind), base, 1e-4 * base);  // the integrator's tolerance (an effect changes its steps)
+  EXPECT_LT(std::abs(terminal_j(v, north, wind) - base), 0.01 * into);
+  // At 20 m/s the extra drag force is 0.5 rho CdA ((20 + 5)^2 - 20^2) into the wind, (15^2 - 20^2) with it.
+  EXPECT_NEAR(into / -with, (25.0 * 25.0 - 400.0) / (400.0 - 15.0 * 15.0), 0.05);
+}
+
+TEST(CycleColumns, EngineOffSegmentsBurnNoFuel) {
+  const Vehicle v = load_vehicle_file(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/ice.yaml");
+  std::string on = "time_s,speed_kmh,engine_on\n", off = on;
+  for (int t = 0; t <= 300; ++t) {
+    const double speed = t < 100 ? 0.0 : t < 110 ? 5.0 * (t - 100) : t < 190 ? 50.0 : t < 200 ? 5.0 * (200 - t) : 0.0;
+    const bool standing_soak = t < 99;  // off over the first 99 segments, restarted at t = 99
+    on += std::to_string(t) + "," + std::to_string(speed) + ",1\n";
+    off += std::to_string(t) + "," + std::to_string(speed) + "," + (standing_soak ? "0" : "1") + "\n";
+  }
+  const DriveCycle c_on = read_cycle_csv(write("on.csv", on), "on"), c_off = read_cycle_csv(write("off.csv", off), "off");
+  EXPECT_TRUE(c_on.engine_off.empty());  // running throughout: no engine_off at all
+  ASSERT_EQ(c_off.engine_off.size(), c_off.time_s.size());
+  const VehicleModel m = VehicleModel::assemble(v);
+  const double idle_j = simulate_forward(m, c_on).energy.fuel_j - simulate_forward(m, c_off).energy.fuel_j;
+  // 99 s of idling saved: positive and of an idle flow's size (under 5 kW of fuel power for a passenger car).
+  EXPECT_GT(idle_j, 0.0);
+  EXPECT_LT(idle_j / 99.0, 5000.0);
+}
+
+TEST(CycleColumns, BadHeadingOrEngineValuesAreNamedErrors) {
+  auto error_of = [](const std::string& name, const std::string& text) {
+    try {
+      read_cycle_csv(write(name, text), name);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const std::string h = error_of("h.csv", "time_s,speed_kmh,heading_deg\n0,0,10\n1,3.6,400\n");
+  EXPECT_NE(h.find("h.csv"), std::string::npos) << h;
+  EXPECT_NE(h.find("line 3"), std::string::npos) << h;
+  EXPECT_NE(h.find("heading_deg"), std::string::npos) << h;
+  EXPECT_NE(h.find("400 deg is not allowed: a heading is in [0, 360] deg"), std::string::npos) << h;
+  const std::string e = error_of("e.csv", "time_s,speed_kmh,engine_on\n0,0,1\n1,0,2\n");
+  EXPECT_NE(e.find("line 3"), std::string::npos) << e;
+  EXPECT_NE(e.find("2 is not allowed: engine_on is 1 (running) or 0 (off)"), std::string::npos) << e;
+  const std::string m = error_of("m.csv", "time_s,speed_kmh,engine_on\n0,0,0\n1,3.6,1\n2,3.6,1\n");
+  EXPECT_NE(m.find("line 2"), std::string::npos) << m;
+  EXPECT_NE(m.find("not allowed while moving"), std::string::npos) << m;
+  const std::string empty = error_of("x.csv", "time_s,speed_kmh,heading_deg\n0,0,\n1,0,5\n");
+  EXPECT_NE(empty.find("is empty"), std::string::npos) << empty;
+  // Through the CLI: exit non-zero, the same message.
+  const auto r = test::run_rollsim("simulate --vehicle ev --cycle " + write("cli.csv", "time_s,speed_kmh,heading_deg\n0,0,-5\n1,0,5\n"));
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("-5 deg is not allowed"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace rollsim
