@@ -187,6 +187,22 @@ TEST(EngineSoak, ColdStartWithASoakIsNamedEngineWarmupWithItsHeatCapacityInterva
       EXPECT_GT(p.ci_high, p.ci_low);
     }
   EXPECT_TRUE(profiled);
+  // The soak's cooling time constant, profiled since the recording switches the engine off: an interval holding its
+  // value (open at an end the 10-minute soak cannot bound). The truth's engine cools as oil and block together,
+  // (C_oil + C_block) / (6 + 12 W/K): 1400-4700 s.
+  bool soak_profiled = false;
+  for (const auto& p : f.parameters)
+    if (p.name == "soak_cooling_s") {
+      soak_profiled = p.profiled;
+      EXPECT_LE(p.ci_low, p.value);
+      EXPECT_GE(p.ci_high, p.value);
+      std::mt19937 truth_rng(3u * 7919u + 13u);
+      const EngineThermalTruth e = cold_start_engine(0.25, truth_rng);
+      const double truth_s = (e.oil_j_per_k + e.block_j_per_k) / 18.0;
+      EXPECT_LE(p.ci_low, truth_s) << p.value << " [" << p.ci_low << ", " << p.ci_high << "] against " << truth_s;
+      EXPECT_GE(p.ci_high, truth_s) << p.value << " [" << p.ci_low << ", " << p.ci_high << "] against " << truth_s;
+    }
+  EXPECT_TRUE(soak_profiled);
   bool noted = false;
   for (const auto& n : d.notes) noted = noted || n.find("switched off 1 times") != std::string::npos;
   EXPECT_TRUE(noted);

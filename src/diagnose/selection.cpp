@@ -46,10 +46,13 @@ struct ShapeParameter {
   EffectId effect;
   const char* parameter;
   double low, high;
+  bool soaks_only = false;  // profiled only where a recording switches the engine off (the data carry it nowhere else)
 };
 constexpr ShapeParameter kShapeParameters[] = {
     {EffectId::tyre_warmup, "heat_capacity_j_per_k", 10000.0, 320000.0},   // tau ~ C / h: ~3-60 min at 20-50 W/K
     {EffectId::engine_warmup, "heat_capacity_j_per_k", 25000.0, 800000.0},  // oil, block and coolant of small to large engines
+    // A switched-off engine's cooling, bonnet closed: from a small engine's oil in a wind to a big block in still air.
+    {EffectId::engine_warmup, "soak_cooling_s", 300.0, 76800.0, true},
     {EffectId::regen_limit, "regen_limit_w", 1500.0, 48000.0},               // braking power at the wheels, small to large motors
 };
 
@@ -156,10 +159,23 @@ std::vector<Passing> passing_candidates(const SelectionContext& sc, const std::v
 // aux_load's decay from the trip's start: a winter heater's cabin warms in minutes, a long trip's in up to two hours.
 constexpr double kAuxDecayLow_s = 120.0, kAuxDecayHigh_s = 7680.0;
 
+bool switches_engine_off(const SelectionContext& sc) {
+  return std::any_of(sc.replayer.cycles.begin(), sc.replayer.cycles.end(),
+                     [](const DriveCycle& c) { return std::find(c.engine_off.begin(), c.engine_off.end(), true) != c.engine_off.end(); });
+}
+
+// Each of the effect's shape parameters in turn, the later ones at the earlier ones' values; the first is the
+// finding's profile, the later ones travel as its profiled nuisance parameters.
 std::optional<ProfileResult> refine(const SelectionContext& sc, Candidate& c, const Model& m, Passing& best) {
   if (c.id == EffectId::aux_load) return refine_aux_decay(sc, c, m, best.score, kAuxDecayLow_s, kAuxDecayHigh_s);
+  std::optional<ProfileResult> out;
   for (const auto& tp : kShapeParameters) {
-    if (c.id != tp.effect || !c.shape.count(tp.parameter)) continue;
+    if (c.id != tp.effect) continue;
+    if (tp.soaks_only ? !switches_engine_off(sc) : !c.shape.count(tp.parameter)) continue;
+    const EffectParameterInfo* info = nullptr;
+    for (const auto& pi : effect_info(c.id).parameters)
+      if (pi.name == tp.parameter) info = &pi;
+    if (!c.shape.count(tp.parameter)) c.shape[tp.parameter] = info->neutral;
     TimeProfile prof;
     prof.parameter = tp.parameter;
     prof.selected = c.shape.at(tp.parameter);
@@ -182,9 +198,16 @@ std::optional<ProfileResult> refine(const SelectionContext& sc, Candidate& c, co
     c.signature = r.signature;
     c.shape[tp.parameter] = r.interval.value;
     best.score = r.score;
-    return r;
+    if (!out) {
+      out = std::move(r);
+    } else {
+      out->signature = r.signature;
+      out->score = r.score;
+      out->nuisance.push_back({tp.parameter, info->unit, r.interval.value, r.interval.low, r.interval.high, true,
+                               r.interval.low_open, r.interval.high_open});
+    }
   }
-  return std::nullopt;
+  return out;
 }
 
 Finding catalogue_finding(const SelectionContext& sc, const Candidate& c, const Passing& best,
