@@ -300,6 +300,9 @@ const std::vector<ConcealedTruthInfo>& concealed_truths() {
       {"aux_compressor", "aux_load", "W (mean)", "A/C compressor cycling 40 % duty (period 240-360 s) plus blower", {150, 300, 600},
        SyntheticChannel::battery_power, false, +1},
       {"wind_gusty", "wind", "m/s (mean headwind)", "mean headwind + OU gusts (sd 1.5 m/s, 15 s) on a slowly turning road", {1.5, 3, 5}},
+      {"wind_tail", "wind", "m/s (mean tailwind)",
+       "mean tailwind + OU gusts (sd 1.5 m/s, 15 s) on a slowly turning road: pushes the road load below the tyres' "
+       "loss like a descent does, so road_profile must not take it", {3, 5}},
       {"payload_drop", "mass", "kg (before the drop)", "payload, 60 % leaves at the mid-trip stop; rolling share ~ load^0.9", {75, 150, 300},
        SyntheticChannel::battery_power, false, +1},
       {"rotating_parts", "rotational_inertia", "kg (equivalent)", "wheels 60 %, rotor 40 % through the reduction (gear loss both ways)",
@@ -437,6 +440,8 @@ Recording generate_case(const Vehicle& vehicle, const SyntheticCase& o) {
       truths.push_back(std::make_shared<CompressorTruth>(e.size, period, period * 0.5 * (1.0 + unit(truth_rng))));
     } else if (t == "wind_gusty") {
       truths.push_back(std::make_shared<GustyWindTruth>(e.size, rho_cda, c.duration_s(), truth_rng));
+    } else if (t == "wind_tail") {
+      truths.push_back(std::make_shared<GustyWindTruth>(-e.size, rho_cda, c.duration_s(), truth_rng));
     } else if (t == "payload_drop") {
       truths.push_back(std::make_shared<PayloadTruth>(e.size, vehicle.body.test_mass_kg, middle_stop_s(c)));
     } else if (t == "rotating_parts") {
