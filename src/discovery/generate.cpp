@@ -323,6 +323,10 @@ const std::vector<ConcealedTruthInfo>& concealed_truths() {
        "steady wind w cos(theta - psi(s)) on a winding route (three 1-4 km bends, +-70-100 deg), latitude and "
        "longitude recorded (2 m GPS noise)",
        {4.0}, SyntheticChannel::battery_power, false, 0, false, "", "", 0.0, true},
+      {"wind_gusty_gps", "wind_heading", "m/s (mean wind, from a bearing drawn per seed)",
+       "the steady GPS wind with along-wind Ornstein-Uhlenbeck gusts (sd 1.5 m/s, 15 s) about its mean, on the same "
+       "winding routes",
+       {2.0, 4.0, 6.0}, SyntheticChannel::battery_power, false, 0, false, "", "", 0.0, true},
       {"battery_r_of_soc", "battery_resistance", "ohm (extra at full charge)",
        "extra cell resistance rising as SOC falls, OCV(SOC), loss I^2 R (SOC channel, 0.1 % quantum)",
        {0.05, 0.1, 0.2}, SyntheticChannel::soc, false, +1},
@@ -425,6 +429,10 @@ Recording generate_case(const Vehicle& vehicle, const SyntheticCase& o) {
       if (!route) throw InputError("concealed truth 'wind_steady_gps'", "needs a route with GPS (SyntheticCase::gps)");
       const double from = o.wind_from_deg.value_or(360.0 * std::uniform_real_distribution<double>(0.0, 1.0)(truth_rng));
       truths.push_back(steady_wind_truth(e.size, from, *route, rho_cda));
+    } else if (t == "wind_gusty_gps") {
+      if (!route) throw InputError("concealed truth 'wind_gusty_gps'", "needs a route with GPS (SyntheticCase::gps)");
+      const double from = o.wind_from_deg.value_or(360.0 * std::uniform_real_distribution<double>(0.0, 1.0)(truth_rng));
+      truths.push_back(gusty_wind_truth(e.size, from, *route, rho_cda, c.duration_s(), truth_rng));
     } else if (t == "battery_r_of_soc") {
       if (o.channel != SyntheticChannel::soc) throw InputError("concealed truth 'battery_r_of_soc'", "needs the SOC channel");
       battery_extra_ohm = e.size;
