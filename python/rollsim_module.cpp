@@ -54,8 +54,8 @@ std::optional<TyreSpec> tyre_from(py::handle t) {
 }
 
 // A shipped name or CSV path; a dict of arrays named like the CSV columns (time_s, speed_kmh or speed_mps,
-// optional grade_pct or elevation_m); or a pair (time_s, speed_kmh). Arrays pass the CSV file's checks,
-// their errors naming the sample index as the "line".
+// optional grade_pct or elevation_m, heading_deg, engine_on); or a pair (time_s, speed_kmh). Arrays pass the CSV
+// file's checks, their errors naming the sample index as the "line".
 DriveCycle cycle_from(py::handle c) {
   if (py::isinstance<py::str>(c)) return load_cycle(c.cast<std::string>(), "--cycle");
   CsvTable table;
@@ -254,7 +254,8 @@ rrc_coulomb, rrc_viscous, rrc_rotational_drag, and the tyre's geometry, pressure
 vehicle: file or shipped name ('ev', 'ice') or a dict with the vehicle file's keys. tyre: None (the car's own),
 a file or shipped name ('nominal', 'low-rrc'), or a dict with the tyre file's keys, on all four wheels.
 cycle: a shipped name ('nedc', 'wltc', 'udds', ...), a CSV path, a pair (time_s [s], speed_kmh [km/h]) of arrays,
-or a dict of arrays named like the CSV columns (time_s, speed_kmh or speed_mps, optional grade_pct or elevation_m).
+or a dict of arrays named like the CSV columns (time_s, speed_kmh or speed_mps, optional grade_pct or elevation_m,
+heading_deg [deg clockwise from north], engine_on [1 or 0, standing only]).
 replay: kinematic replay instead of driver + CVODE. Returns {'summary': dict (the --json keys: distance_km,
 aec_kwh_per_10km or fuel_l_per_100km, energy_breakdown_kwh, ...), 'trace': dict of numpy arrays (the --trace
 columns: time_s, speed_kmh, rolling_force_n, battery_power_kw, ...; empty with trace=False)}.)");
