@@ -15,7 +15,8 @@ namespace rollsim {
 namespace {
 
 // What the replay takes from the fuel channel about the engine: its switched-off runs and its start state.
-void note_engine_state(const DriveCycle& c, const Recording& r, const EngineStartState& start, std::vector<std::string>& notes) {
+void note_engine_state(const DriveCycle& c, const Recording& r, const EngineStartState& start, double min_cold_excess,
+                       std::vector<std::string>& notes) {
   if (!r.fuel_rate_m3ps) return;
   int runs = 0;
   double off_s = 0.0;
@@ -27,7 +28,8 @@ void note_engine_state(const DriveCycle& c, const Recording& r, const EngineStar
   const std::string how =
       start.inferred ? " (inferred: its first minutes of running burn " + fixed(100.0 * start.early_excess, 1) + " % [" +
                            fixed(100.0 * start.early_excess_ci_low, 1) + ", " + fixed(100.0 * start.early_excess_ci_high, 1) +
-                           "] more fuel than the warm model, relative to its later running)"
+                           "] more fuel than the warm model, relative to its later running; hot only where that interval "
+                           "ends under " + fixed(100.0 * min_cold_excess, 0) + " %)"
                      : "";
   notes.push_back(r.source + ": engine " + (c.engine_hot_start ? "hot" : "cold (at ambient)") + " at the start" + how + "; " +
                   (runs == 0 ? std::string("never switched off")
@@ -96,7 +98,7 @@ void set_engine_starts(std::vector<DriveCycle>& cycles, const std::vector<Record
     }
     s.recording = recordings[k].source;
     cycles[k].engine_hot_start = s.start == EngineStart::hot;
-    note_engine_state(cycles[k], recordings[k], s, out.notes);
+    note_engine_state(cycles[k], recordings[k], s, opt.engine_start_min_cold_excess, out.notes);
     out.engine_starts.push_back(s);
   }
 }
