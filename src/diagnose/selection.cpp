@@ -233,8 +233,8 @@ Finding catalogue_finding(const SelectionContext& sc, const Candidate& c, const 
     f.description = "the calibrated model's residual when standing, " + fixed(sc.standing.mean_w, 0) + " W [" +
                     fixed(sc.standing.mean_w - 1.96 * sc.standing.se_w, 0) + ", " +
                     fixed(sc.standing.mean_w + 1.96 * sc.standing.se_w, 0) +
-                    "], is an auxiliary load's signature (nothing else draws power at standstill); constant or duty-cycled, "
-                    "the windows see its mean";
+                    "], is an auxiliary load's signature (nothing else draws power at standstill); a duty-cycled one is seen "
+                    "by its mean";
   if (prof && prof->parameter == "decay_s") {
     const double share = c.shape.at("decaying_share");
     f.description += std::string(f.description.empty() ? "" : "; ") + "decaying from the start of the trip (a heater "
