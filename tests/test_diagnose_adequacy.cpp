@@ -200,11 +200,11 @@ TEST(DiagnoseAdequacy, SubSampleLagIsEstimatedWithItsInterval) {
 TEST(DiagnoseAdequacy, AnInstantaneousLoggerIsReadAsOne) {
   // The replay's power is each interval's mean; a 1 Hz logger that reads the power at the interval's start differs
   // from it by half a second of speed change in every ramp, which no lag removes: read as interval means, this
-  // null was missing_physics with two unexplained findings.
+  // null was missing_physics with two unexplained findings. (At 10 Hz the two readings differ too little to choose.)
   const Vehicle v = ev();
   const Diagnosis d = run(v, recording(v, nullptr, 1.0, 0.0, 1.0, 8, true), 60.0);
   EXPECT_EQ(d.channel_sampling, "instantaneous") << diagnosis_text(d);
-  EXPECT_GT(d.channel_sampling_sse_ratio, 1.0);
+  EXPECT_GT(d.channel_sampling_sse_ratio, 1.05);
   EXPECT_NEAR(d.lag_s, 0.0, 0.1) << diagnosis_text(d);
   EXPECT_EQ(d.verdict, "nothing_missing") << diagnosis_text(d);
   // And an integrating logger is read as the interval means it holds.
