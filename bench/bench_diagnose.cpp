@@ -29,8 +29,9 @@ rollsim::Recording one_hour_10hz(const rollsim::Vehicle& v, bool hilly, bool war
     }
   c.grade.assign(c.time_s.size(), 0.0);
   // Hilly: an elevation channel (20 m sine over 1.5 km of road) that the diagnosis turns into a grade; the truth
-  // runs on the exact grade of that profile. The label says what was found: here the 200 m elevation filter
-  // flattens these short steep hills' grade by ~6 % and the diagnosis reports it as rotational_inertia (see README).
+  // runs on the exact grade of that profile. The label says what was found: an unexplained force-squared residual,
+  // because the power is the replay's instantaneous value at each sample, which at 10 Hz the diagnosis cannot tell
+  // from an interval mean decisively and reads as one (README, channel sampling).
   std::vector<double> elevation(c.time_s.size(), 0.0);
   if (hilly) {
     double s = 0.0;

@@ -42,6 +42,8 @@ std::string diagnosis_json(const Diagnosis& d) {
        << ", \"early_excess_ci\": [" << num(e.early_excess_ci_low) << ", " << num(e.early_excess_ci_high) << "]}";
   }
   os << "],\n";
+  os << "  \"channel_sampling\": {\"chosen\": \"" << d.channel_sampling << "\", \"interval_over_instant_sse\": "
+     << num(d.channel_sampling_sse_ratio) << "},\n";
   os << "  \"window_s\": " << num(d.window_s) << ",\n  \"notes\": [";
   for (std::size_t i = 0; i < d.notes.size(); ++i) os << (i ? ", " : "") << json_string(d.notes[i]);
   os << "],\n";
@@ -119,6 +121,10 @@ std::string diagnosis_text(const Diagnosis& d) {
      << ", lag-1 autocorrelation " << d.lag1_autocorrelation << ")\n";
   for (const auto& note : d.notes) os << note << "\n";
   os << "channel lag: " << d.lag_s << " s [" << d.lag_ci_low_s << ", " << d.lag_ci_high_s << "] (interpolated channel)\n";
+  if (d.channel != "soc")
+    os << "channel sampling: " << (d.channel_sampling == "instantaneous" ? "read at each sample's instant" : "mean over each sample's interval")
+       << " (squared residual as interval means over as instants: " << d.channel_sampling_sse_ratio
+       << "; the instant is chosen above 1.05)\n";
   os << "uncalibrated trip energy error: " << d.raw_trip_energy_error_pct << " %\n";
   os << "calibration: channel scale " << d.channel_scale << " (prior [" << d.channel_scale_prior_low << ", "
      << d.channel_scale_prior_high << "]), RRC level " << 100 * d.rrc_level_change << " %, aero C " << 100 * d.drag_change << " %\n";
