@@ -73,5 +73,30 @@ TEST(EngineStart, WarmNullIsInferredHot) {
   EXPECT_TRUE(d.findings.empty());
 }
 
+TEST(EngineStart, ATripTooShortToTellIsTakenColdAndSaysSo) {
+  // Ten minutes of a WLTC fuel recording: no running after 15 minutes to compare the first five with.
+  const Vehicle v = ice();
+  SyntheticCase c;
+  c.channel = SyntheticChannel::fuel_rate;
+  c.seed = 9;
+  Recording r = generate_case(v, c);
+  r.time_s.resize(600);
+  r.speed_mps.resize(600);
+  r.fuel_rate_m3ps->resize(600);
+  const Diagnosis d = diagnose(v, {r});
+  ASSERT_EQ(d.engine_starts.size(), 1u);
+  EXPECT_FALSE(d.engine_starts[0].inferred);
+  EXPECT_EQ(d.engine_starts[0].start, EngineStart::cold);
+  bool said = false;
+  for (const auto& n : d.notes) said = said || n.find("too little running to infer it") != std::string::npos;
+  EXPECT_TRUE(said);
+  DiagnoseOptions set;
+  set.engine_start = {EngineStart::hot};
+  const Diagnosis h = diagnose(v, {r}, set);
+  bool noted = false;
+  for (const auto& n : h.notes) noted = noted || n.find("engine hot at the start (set)") != std::string::npos;
+  EXPECT_TRUE(noted);
+}
+
 }  // namespace
 }  // namespace rollsim

@@ -15,8 +15,8 @@ namespace rollsim {
 namespace {
 
 // What the replay takes from the fuel channel about the engine: its switched-off runs and its start state.
-void note_engine_state(const DriveCycle& c, const Recording& r, const EngineStartState& start, double min_cold_excess,
-                       std::vector<std::string>& notes) {
+void note_engine_state(const DriveCycle& c, const Recording& r, const EngineStartState& start, bool to_infer,
+                       const DiagnoseOptions& opt, std::vector<std::string>& notes) {
   if (!r.fuel_rate_m3ps) return;
   int runs = 0;
   double off_s = 0.0;
@@ -29,8 +29,10 @@ void note_engine_state(const DriveCycle& c, const Recording& r, const EngineStar
       start.inferred ? " (inferred: its first minutes of running burn " + fixed(100.0 * start.early_excess, 1) + " % [" +
                            fixed(100.0 * start.early_excess_ci_low, 1) + ", " + fixed(100.0 * start.early_excess_ci_high, 1) +
                            "] more fuel than the warm model, relative to its later running; hot only where that interval "
-                           "ends under " + fixed(100.0 * min_cold_excess, 0) + " %)"
-                     : "";
+                           "ends under " + fixed(100.0 * opt.engine_start_min_cold_excess, 0) + " %)"
+      : to_infer ? " (too little running to infer it from its first " + fixed(opt.engine_start_early_s, 0) +
+                       " s against its running after " + fixed(opt.engine_start_late_s, 0) + " s: taken cold)"
+                 : " (set)";
   notes.push_back(r.source + ": engine " + (c.engine_hot_start ? "hot" : "cold (at ambient)") + " at the start" + how + "; " +
                   (runs == 0 ? std::string("never switched off")
                              : "switched off " + std::to_string(runs) + " times for " + fixed(off_s, 0) +
@@ -98,7 +100,7 @@ void set_engine_starts(std::vector<DriveCycle>& cycles, const std::vector<Record
     }
     s.recording = recordings[k].source;
     cycles[k].engine_hot_start = s.start == EngineStart::hot;
-    note_engine_state(cycles[k], recordings[k], s, opt.engine_start_min_cold_excess, out.notes);
+    note_engine_state(cycles[k], recordings[k], s, set == EngineStart::infer, opt, out.notes);
     out.engine_starts.push_back(s);
   }
 }
