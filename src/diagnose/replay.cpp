@@ -46,8 +46,7 @@ std::vector<std::vector<double>> Replayer::power(const EffectList& extra) const 
   for (const auto& e : extra) model.effects.push_back(e);
   const bool electric = vehicle.is_electric();
   double fuel_j_per_m3 = 0.0;
-  if (const auto* cp = std::get_if<CombustionPowertrainParams>(&vehicle.powertrain))
-    fuel_j_per_m3 = cp->fuel.density_kg_per_m3 * cp->fuel.lower_heating_value_j_per_kg;
+  if (const FuelParams* f = vehicle.fuel()) fuel_j_per_m3 = f->density_kg_per_m3 * f->lower_heating_value_j_per_kg;
   SimulationOptions so;
   so.record_trace = true;
   std::vector<std::vector<double>> out;

@@ -166,7 +166,7 @@ PowerFlow ConventionalPowertrain::deliver(double wheel_force_n, double speed_mps
         out.machine_speed_radps = op.engine_speed_radps;
         return out;
       }
-    } else if (p_.transmission.kind != TransmissionKind::clutch) {
+    } else if (p_.transmission.kind != TransmissionKind::clutch && !p_.transmission.converter.neutral_at_standstill) {
       // Standing in Drive: the converter's pump turns at idle against a stalled turbine and absorbs its capacity
       // (ω_idle / K)^2, all of it heat, while the brakes hold the car.
       const double q = e.idle_speed_radps / p_.transmission.converter.k_factor_radps_per_sqrt_nm;

@@ -24,6 +24,9 @@ struct TorqueConverterParams {
   double coupling_speed_ratio = 0.85;
   int lockup_min_gear = 2;                  ///< lock-up clutch closes from this gear up (CVT: always when above speed)
   double lockup_min_speed_radps = 0.0;      ///< ... and above this turbine speed
+  /// Neutral idle control: standing in Drive with the brake on, the controller opens a clutch so the stalled
+  /// converter does not load the idling engine (Mazda's 2018 Skyactiv-Drive, GM's and Ford's "neutral idle").
+  bool neutral_at_standstill = false;
 };
 
 struct TransmissionParams {
