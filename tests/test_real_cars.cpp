@@ -3,12 +3,15 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 
 #include "rollsim/common/error.hpp"
 #include "rollsim/common/statistics.hpp"
+#include "rollsim/common/units.hpp"
 #include "rollsim/diagnose/diagnose.hpp"
 #include "rollsim/recording/recording.hpp"
 #include "rollsim/sim/simulation.hpp"
@@ -138,6 +141,65 @@ TEST(CamryFuelMap, ArgonneHotUddsHwfetUs06WithinThreePercentAfterItsOwnCalibrati
     // load had it 40 % above).
     EXPECT_NEAR(idle_m3_per_s / t.measured_idle_m3_per_s, 1.0, 0.15) << t.file;
   }
+}
+
+// Issue 13, item 5, the Twizy: where its trips' energy goes in the model, and what of the measured (state-of-
+// charge) energy is left when the 58 V drive's losses come from published figures (vehicles/twizy_58v.yaml).
+// Prints per trip; returns the median of the model's energy error [%] over the seven trips.
+double twizy_budget(const std::string& vehicle_file) {
+  namespace fs = std::filesystem;
+  const Vehicle v = load_vehicle_file(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/" + vehicle_file);
+  const VehicleModel car = VehicleModel::assemble(v);
+  const double capacity_j = v.battery()->usable_capacity_j;
+  std::vector<fs::path> files;
+  for (const auto& e : fs::directory_iterator(std::string(ROLLSIM_SOURCE_DIR) + "/../shared/data/recordings/rsk_renault_twizy/")) files.push_back(e.path());
+  std::sort(files.begin(), files.end());
+  EXPECT_EQ(files.size(), 7u);
+  SimulationOptions traced;
+  traced.record_trace = true;
+  std::vector<double> errors_pct;
+  std::cout << vehicle_file << "\n";
+  for (const auto& f : files) {
+    const Recording rec = load_recording(f.string(), preset_mapping("rsk_twizy"));
+    const SimulationResult s = simulate_replay(car, cycle_of_recording(rec), traced);
+    const auto& soc = *rec.soc_fraction;
+    const double measured_j = (soc.front() - soc.back()) * capacity_j;
+    const double model_j = s.energy.battery_terminal_j + s.energy.battery_loss_j;
+    // The integral of I^2 over the trip: each extra milliohm in the current's path costs 1e-3 x this.
+    double i2_a2s = 0.0, moving_s = 0.0;
+    for (std::size_t i = 0; i + 1 < s.trace.size(); ++i) {
+      const double dt = s.trace[i + 1].time_s - s.trace[i].time_s;
+      i2_a2s += s.trace[i].battery_current_a * s.trace[i].battery_current_a * dt;
+      if (s.trace[i].speed_mps > 0.0) moving_s += dt;
+    }
+    const double gap_j = measured_j - model_j, km = s.distance_m / 1e3;
+    errors_pct.push_back(100.0 * (model_j / measured_j - 1.0));
+    std::cout << "  " << f.filename().string() << ": " << km << " km, measured " << units::j_to_kwh(measured_j) * 1e3 / km << " Wh/km, model "
+              << units::j_to_kwh(model_j) * 1e3 / km << " Wh/km (" << errors_pct.back() << " %); of the model's energy: motor and inverter "
+              << 100.0 * s.energy.motor_loss_j / model_j << " %, battery I^2R " << 100.0 * s.energy.battery_loss_j / model_j << " %, reduction "
+              << 100.0 * s.energy.gearbox_loss_j / model_j << " %, auxiliaries " << 100.0 * s.energy.aux_j / model_j
+              << " %; the gap is the I^2R of " << 1e3 * gap_j / i2_a2s << " mOhm more, or a capacity of "
+              << units::j_to_kwh(capacity_j * model_j / measured_j) << " kWh, or " << gap_j / moving_s << " W more while moving\n";
+    EXPECT_NEAR(s.energy.powertrain_residual_j(), 0.0, 1e-6 * std::abs(model_j));
+  }
+  return median(errors_pct);
+}
+
+TEST(TwizyGap, PublishedDriveLossesAndCapacityAgainstTheSevenTrips) {
+  // The sourced file's drive takes the SEVCON's 18 kW of electrical input at the motor's 13 kW peak (57 N m).
+  const Vehicle v = load_vehicle_file(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/twizy_58v.yaml");
+  const auto& p = std::get<ElectricPowertrainParams>(v.powertrain);
+  const double base_radps = p.motor.max_power_w / p.motor.max_torque_nm;
+  const double wheel_radius_m = driven_wheel_radius_m(v);
+  const ElectricPowertrain drive(p);
+  const PowerFlow peak = drive.deliver(p.motor.max_torque_nm * p.reduction.ratio * p.reduction.efficiency / wheel_radius_m,
+                                       base_radps / p.reduction.ratio * wheel_radius_m, 0, wheel_radius_m);
+  EXPECT_NEAR((peak.battery_terminal_power_w - peak.aux_power_w) / 18e3, 1.0, 0.02);
+  const double assumed = twizy_budget("twizy.yaml"), sourced = twizy_budget("twizy_58v.yaml");
+  std::cout << "median error over the seven trips: twizy.yaml " << assumed << " %, twizy_58v.yaml " << sourced << " %\n";
+  // What is left is still an under-prediction (README: the induction machine's light-load loss and the SOC of an aged
+  // pack are the candidates; neither is absorbed).
+  EXPECT_LT(sourced, 0.0);
 }
 
 }  // namespace
