@@ -41,6 +41,10 @@ struct TransmissionParams {
   /// `max_torque_fraction` of the full-load torque, but not below this speed.
   double min_engine_speed_radps = 0.0;
   double max_torque_fraction = 0.8;
+  /// A friction clutch's launch: while the gearbox input turns slower than this and the wheels are driven, the
+  /// engine runs at this speed and the clutch slips (a driver or a dual-clutch controller raises the engine above
+  /// idle to pull away). Zero: the clutch slips with the engine at idle.
+  double launch_engine_speed_radps = 0.0;
   TorqueConverterParams converter;   ///< automatic and CVT
 };
 
