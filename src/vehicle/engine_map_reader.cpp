@@ -85,7 +85,10 @@ TransmissionParams read_transmission(YamlMap m, double max_torque_nm) {
   t.max_torque_fraction = m.number("max_load_pct", Range::open_low(0.0, 100.0)) / 100.0;
   if (t.kind == TransmissionKind::clutch) {
     if (m.has("converter")) throw InputError(m.where("converter"), "a manual or dual-clutch gearbox has no torque converter");
+    t.launch_engine_speed_radps = m.number_or("launch_engine_speed_rpm", 0.0, Range::closed(0.0, 1e4)) * kRadpsPerRpm;
   } else {
+    if (m.has("launch_engine_speed_rpm"))
+      throw InputError(m.where("launch_engine_speed_rpm"), "only a manual or dual-clutch gearbox launches on a slipping clutch");
     t.converter = read_converter(m.map("converter"), max_torque_nm);
   }
   m.finish();
