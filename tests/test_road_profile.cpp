@@ -191,6 +191,12 @@ TEST(RoadProfile, LossesDriftingAlongTheTripAreNotARoad) {
     c.seed = seed;
     EXPECT_FALSE(names_a_road(v, c)) << "gusty wind, seed " << seed;
   }
+  for (unsigned seed : {62001u, 62002u}) {  // a tailwind takes the force below zero loss, as a descent does
+    SyntheticCase c = SyntheticCase{};
+    c.effects = {{"wind_tail", 5.0}};
+    c.seed = seed;
+    EXPECT_FALSE(names_a_road(v, c)) << "tailwind, seed " << seed;
+  }
 }
 
 TEST(RoadProfile, DISABLED_ProfileCorrelationOver100Seeds) {

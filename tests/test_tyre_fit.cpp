@@ -228,10 +228,12 @@ TEST(J2452, ShippedSharedConstantsAreTheFitToAllNineSets) {
 // --- label and ISO conditions ---
 
 TEST(TyreLabel, ClassBandsOfRegulation2020_740ForC1) {
-  // Annex I Part A: A <= 6.5, B 6.6-7.7, C 7.8-9.4, D 9.5-10.5, E >= 10.6 kg/t (declared to 0.1 kg/t).
+  // Annex I Part A: A <= 6.5, B 6.6-7.7, C 7.8-9.0, D 9.1-10.5, E >= 10.6 kg/t (declared to 0.1 kg/t). A-C are
+  // the bands of Regulation (EC) 1222/2009 (legislation.gov.uk/eur/2009/1222/annex/I), whose E (9.1-10.5) is D now.
   EXPECT_NEAR(eu_label_band_c1("A", "x").rrc_max, 6.55e-3, 1e-12);
   EXPECT_NEAR(eu_label_band_c1("b", "x").rrc_min, 6.55e-3, 1e-12);
-  EXPECT_NEAR(eu_label_band_c1("C", "x").rrc_max, 9.45e-3, 1e-12);
+  EXPECT_NEAR(eu_label_band_c1("C", "x").rrc_max, 9.05e-3, 1e-12);
+  EXPECT_NEAR(eu_label_band_c1("D", "x").rrc_min, 9.05e-3, 1e-12);
   EXPECT_NEAR(eu_label_band_c1("D", "x").rrc_max, 10.55e-3, 1e-12);
   EXPECT_TRUE(eu_label_band_c1("E", "x").open_above);
   EXPECT_THROW(eu_label_band_c1("F", "--label F"), InputError);

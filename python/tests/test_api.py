@@ -213,6 +213,23 @@ class GilRelease(unittest.TestCase):
         self.assertLess(largest_gap, 0.5 * duration, f"the main thread stood still {largest_gap:.3f} of {duration:.3f} s")
 
 
+class ImportCost(unittest.TestCase):
+    def test_import_loads_only_the_cpp_runtime_and_yaml_cpp(self):
+        # What `import rollsim` costs is mostly what the dynamic loader maps and relocates (python/bench_python.py
+        # times it). MPI's six libraries once came in through the library; the module links neither MPI nor
+        # SUNDIALS' shared objects, so a fresh interpreter gains exactly these.
+        import sys
+        code = ("import re\n"
+                "def libs():\n"
+                "    return {re.sub(r'\\.so.*', '', m.split('/')[-1]) for m in open('/proc/self/maps').read().split()"
+                " if '.so' in m and m.startswith('/')}\n"
+                "before = libs(); import rollsim; print(' '.join(sorted(libs() - before)))")
+        out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                             env={**os.environ}).stdout.split()
+        module = Path(rollsim.__file__).name.split(".so")[0]
+        self.assertEqual(set(out) - {module}, {"libstdc++", "libgcc_s", "libyaml-cpp"}, out)
+
+
 class InputErrors(unittest.TestCase):
     def assert_cli_message(self, call, *cli_args):
         _, stderr, code = cli(*cli_args, expect_ok=False)

@@ -54,10 +54,4 @@ bool launched_by_mpi() {
   return false;
 }
 
-CaseMap ProcessGroup::mapper() const {
-  return [this](std::size_t tasks, unsigned threads, const CaseBody& body, const CaseProgress& progress) {
-    return map(tasks, threads, body, progress);
-  };
-}
-
 }  // namespace rollsim

@@ -197,10 +197,10 @@ Signatures compute_signatures(const Replayer& rp, const Observations& o, const V
   decays.insert(decays.end(), opt.unexplained_decay_s.begin(), opt.unexplained_decay_s.end());
   for (double tau : decays) {
     for (ForceShape fs : {ForceShape::constant, ForceShape::speed, ForceShape::speed_squared, ForceShape::positive_accel}) {
-      s.basis.push_back({BasisShape::force, fs, tau, {}});
+      s.basis.push_back({BasisShape::force, fs, tau, {}, {}});
       extras.push_back({signature_force(fs, tau)});
     }
-    s.basis.push_back({BasisShape::power, ForceShape::constant, tau, {}});  // computed directly, no simulation
+    s.basis.push_back({BasisShape::power, ForceShape::constant, tau, {}, {}});  // computed directly, no simulation
   }
   std::vector<Variant> vars = rp.run(extras, o, lag_samples);
   s.rrc = std::move(vars[0]);

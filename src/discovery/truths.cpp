@@ -49,13 +49,18 @@ class RisingRrcTruth final : public Effect {
 
 class SteadyWindTruth final : public Effect {
  public:
-  SteadyWindTruth(double speed_mps, double from_deg, WindingRoute route, double rho_cda)
-      : w_(speed_mps), from_rad_(from_deg * kTwoPi / 360.0), route_(std::move(route)), k_(0.5 * rho_cda) {}
-  std::string id() const override { return "truth_steady_wind"; }
+  /// `gust_mps`: the wind speed's departure from its mean, one value per second from the start (empty: steady).
+  SteadyWindTruth(double speed_mps, double from_deg, WindingRoute route, double rho_cda, std::vector<double> gust_mps = {})
+      : w_(speed_mps), from_rad_(from_deg * kTwoPi / 360.0), route_(std::move(route)), k_(0.5 * rho_cda),
+        gust_mps_(std::move(gust_mps)) {}
+  std::string id() const override { return gust_mps_.empty() ? "truth_steady_wind" : "truth_gusty_wind_on_route"; }
   double extra_resistance_n(const EffectInputs& in, const double*) const override {
     const double v = std::max(in.speed_mps, 0.0);
     if (v <= 0.0) return 0.0;
-    const double rel = v + w_ * std::cos(from_rad_ - route_.heading_rad(in.distance_m));
+    double w = w_;
+    if (!gust_mps_.empty())
+      w += gust_mps_[static_cast<std::size_t>(std::clamp(in.time_s, 0.0, static_cast<double>(gust_mps_.size() - 1)))];
+    const double rel = v + w * std::cos(from_rad_ - route_.heading_rad(in.distance_m));
     return k_ * (rel * std::abs(rel) - v * v);
   }
 
@@ -63,6 +68,7 @@ class SteadyWindTruth final : public Effect {
   double w_, from_rad_;
   WindingRoute route_;
   double k_;
+  std::vector<double> gust_mps_;
 };
 
 }  // namespace
@@ -91,6 +97,17 @@ WindingRoute winding_route(std::mt19937& rng) {
 
 std::shared_ptr<const Effect> steady_wind_truth(double speed_mps, double from_deg, WindingRoute route, double rho_cda_kg_per_m) {
   return std::make_shared<SteadyWindTruth>(speed_mps, from_deg, std::move(route), rho_cda_kg_per_m);
+}
+
+std::shared_ptr<const Effect> gusty_wind_truth(double mean_speed_mps, double from_deg, WindingRoute route,
+                                               double rho_cda_kg_per_m, double duration_s, std::mt19937& rng) {
+  // Along-wind gusts as an Ornstein-Uhlenbeck process sampled each second (sd 1.5 m/s, 15 s), as wind_gusty's.
+  std::normal_distribution<double> n(0.0, 1.0);
+  const double tau_s = 15.0, sd_mps = 1.5, a = std::exp(-1.0 / tau_s);
+  std::vector<double> gust;
+  double g = 0.0;
+  for (int i = 0; i <= static_cast<int>(duration_s) + 2; ++i) gust.push_back(g = a * g + sd_mps * std::sqrt(1.0 - a * a) * n(rng));
+  return std::make_shared<SteadyWindTruth>(mean_speed_mps, from_deg, std::move(route), rho_cda_kg_per_m, std::move(gust));
 }
 
 void route_gps(const WindingRoute& route, const std::vector<double>& distance_m, double lat0_deg, double lon0_deg,

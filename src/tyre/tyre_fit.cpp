@@ -271,13 +271,14 @@ TyreFit fit_hysteresis(const TyreState& start_in, const FitRequest& r) {
 
 LabelBand eu_label_band_c1(const std::string& label_class, const std::string& where) {
   // Regulation (EU) 2020/740, Annex I, Part A, table for C1 tyres (RRC in kg/t = 1e-3):
-  // A: RRC <= 6.5; B: 6.6-7.7; C: 7.8-9.4; D: 9.5-10.5; E: RRC >= 10.6 (https://eur-lex.europa.eu/eli/reg/2020/740/oj).
+  // A: RRC <= 6.5; B: 6.6-7.7; C: 7.8-9.0; D: 9.1-10.5; E: RRC >= 10.6 (https://eur-lex.europa.eu/eli/reg/2020/740/oj).
+  // A-C are 1222/2009's bands unchanged; D, empty there, takes its old E, and E its old F and G.
   // Values are declared to 0.1 kg/t, so a band's edges are half a digit outside its printed limits. A and E are
   // open-ended in the regulation; we close them with the width of the neighbouring band (our assumption).
   static const LabelBand kBands[] = {{'A', 5.45e-3, 6.55e-3, true, false},
                                      {'B', 6.55e-3, 7.75e-3, false, false},
-                                     {'C', 7.75e-3, 9.45e-3, false, false},
-                                     {'D', 9.45e-3, 10.55e-3, false, false},
+                                     {'C', 7.75e-3, 9.05e-3, false, false},
+                                     {'D', 9.05e-3, 10.55e-3, false, false},
                                      {'E', 10.55e-3, 11.65e-3, false, true}};
   if (label_class.size() == 1) {
     const char c = static_cast<char>(std::toupper(static_cast<unsigned char>(label_class[0])));

@@ -75,6 +75,9 @@ WindingRoute winding_route(std::mt19937& rng);
 /// A steady wind of `speed_mps` from the bearing `from_deg` on that route: headwind w cos(theta - psi(s)), the aero
 /// force 0.5 rho CdA ((v + u)|v + u| - v^2) while moving.
 std::shared_ptr<const Effect> steady_wind_truth(double speed_mps, double from_deg, WindingRoute route, double rho_cda_kg_per_m);
+/// The same wind with along-wind Ornstein-Uhlenbeck gusts about its mean (sd 1.5 m/s, 15 s), drawn from `rng`.
+std::shared_ptr<const Effect> gusty_wind_truth(double mean_speed_mps, double from_deg, WindingRoute route,
+                                               double rho_cda_kg_per_m, double duration_s, std::mt19937& rng);
 /// Latitude and longitude [deg] of the points at these distances along the route from (lat0, lon0), integrated on a
 /// local flat earth in 1 m steps.
 void route_gps(const WindingRoute& route, const std::vector<double>& distance_m, double lat0_deg, double lon0_deg,
