@@ -108,6 +108,7 @@ TEST(CamryFuelMap, BadEngineMapKeysAreNamedErrors) {
   expect_has(error_of("kind: automatic", "kind: manual"), {"converter", "no torque converter"});
   expect_has(error_of("stall_speed_rpm: 2400", "stall_sped_rpm: 2400"), {"stall_speed_rpm"});
   expect_has(error_of("type: engine_map", "type: rotary"), {"powertrain.type", "rotary", "engine_map"});
+  expect_has(error_of("lockup_min_gear: 2 ", "lockup_min_gear: 2.5 "), {"lockup_min_gear", "2.5", "gear number"});
   expect_has(error_of("max_load_pct: 60", "max_load_pct: 60\n    launch_engine_speed_rpm: 1400"), {"launch_engine_speed_rpm", "slipping clutch"});
 }
 

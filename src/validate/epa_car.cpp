@@ -13,7 +13,7 @@ namespace rollsim::validate {
 
 namespace {
 
-constexpr double kRadpsPerRpm = 2.0 * std::numbers::pi / 60.0;
+using units::kRadpsPerRpm;
 constexpr double kFourStroke = 4.0 * std::numbers::pi;
 // The wheel radius only converts between wheel force and torque: the N/V ratio fixes engine speed per road
 // speed, so any radius gives the same car.

@@ -1,5 +1,4 @@
 #include <cmath>
-#include <numbers>
 
 #include "powertrain_readers.hpp"
 #include "rollsim/common/error.hpp"
@@ -8,7 +7,7 @@
 namespace rollsim {
 namespace {
 
-constexpr double kRadpsPerRpm = 2.0 * std::numbers::pi / 60.0;
+using units::kRadpsPerRpm;
 
 double rpm(YamlMap& m, const std::string& key) { return m.number(key, Range::open_low(0.0, 3e4)) * kRadpsPerRpm; }
 double pct(YamlMap& m, const std::string& key, double fallback_pct) {
@@ -62,7 +61,9 @@ TorqueConverterParams read_converter(YamlMap m, double max_torque_nm) {
   c.k_factor_radps_per_sqrt_nm = rpm(m, "stall_speed_rpm") / std::sqrt(max_torque_nm);
   c.stall_torque_ratio = m.number_or("stall_torque_ratio", 2.0, Range::closed(1.0, 4.0));
   c.coupling_speed_ratio = m.number_or("coupling_speed_ratio", 0.85, Range::open_low(0.0, 0.99));
-  c.lockup_min_gear = static_cast<int>(m.number_or("lockup_min_gear", 2.0, Range::closed(1.0, 20.0)));
+  const double lockup_gear = m.number_or("lockup_min_gear", 2.0, Range::closed(1.0, 20.0));
+  if (lockup_gear != std::floor(lockup_gear)) throw InputError(m.where("lockup_min_gear"), format_value(lockup_gear) + " is not a gear number (1, 2, ...)");
+  c.lockup_min_gear = static_cast<int>(lockup_gear);
   c.lockup_min_speed_radps = m.number_or("lockup_min_speed_rpm", 1000.0, Range::closed(0.0, 1e4)) * kRadpsPerRpm;
   c.neutral_at_standstill = m.boolean_or("neutral_at_standstill", false);
   m.finish();
