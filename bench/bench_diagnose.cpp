@@ -29,8 +29,8 @@ rollsim::Recording one_hour_10hz(const rollsim::Vehicle& v, bool hilly, bool war
     }
   c.grade.assign(c.time_s.size(), 0.0);
   // Hilly: an elevation channel (20 m sine over 1.5 km of road) that the diagnosis turns into a grade; the truth
-  // runs on the exact grade of that profile. The label says what was found: here the 200 m elevation filter
-  // flattens these short steep hills' grade by ~6 % and the diagnosis reports it as rotational_inertia (see README).
+  // runs on the exact grade of that profile. The label says what was found (a null: nothing). The power is the
+  // replay's instantaneous value at each sample, which the diagnosis must recognise as such (channel sampling).
   std::vector<double> elevation(c.time_s.size(), 0.0);
   if (hilly) {
     double s = 0.0;

@@ -59,7 +59,9 @@ class RisingRrc final : public Effect {
 
 // WLTC twice at 10 Hz; the truth replayed there; the recording at `hz`, its power the truth's `lag_s` earlier (the
 // 10 Hz trace read at a shifted sample: no interpolation shared with the diagnosis), times `scale`, plus white noise.
-Recording recording(const Vehicle& v, std::shared_ptr<const Effect> truth, double hz, double lag_s, double scale, unsigned seed) {
+// `instantaneous`: a logger that reads the power at the sample's instant instead of integrating over its interval.
+Recording recording(const Vehicle& v, std::shared_ptr<const Effect> truth, double hz, double lag_s, double scale, unsigned seed,
+                    bool instantaneous = false) {
   const DriveCycle one = load_cycle("wltc");
   DriveCycle c;
   c.name = "wltc x2 at 10 Hz";
@@ -90,7 +92,7 @@ Recording recording(const Vehicle& v, std::shared_ptr<const Effect> truth, doubl
     rec.speed_mps.push_back(c.speed_mps[i]);
     double mean_w = 0.0;
     for (std::size_t k = 0; k < step; ++k) mean_w += r.trace[i - shift + k].segment_battery_power_w / static_cast<double>(step);
-    p.push_back(scale * mean_w + noise(rng));
+    p.push_back(scale * (instantaneous ? r.trace[i - shift].battery_power_w : mean_w) + noise(rng));
   }
   rec.battery_power_w = p;
   return rec;
@@ -193,6 +195,20 @@ TEST(DiagnoseAdequacy, SubSampleLagIsEstimatedWithItsInterval) {
   EXPECT_GT(d.lag_ci_low_s, 0.0);
   EXPECT_LT(d.lag_ci_high_s, 1.0);
   EXPECT_EQ(d.verdict, "nothing_missing") << diagnosis_text(d);
+}
+
+TEST(DiagnoseAdequacy, AnInstantaneousLoggerIsReadAsOne) {
+  // The replay's power is each interval's mean; a 1 Hz logger that reads the power at the interval's start differs
+  // from it by half a second of speed change in every ramp, which no lag removes: read as interval means, this
+  // null was missing_physics with two unexplained findings.
+  const Vehicle v = ev();
+  const Diagnosis d = run(v, recording(v, nullptr, 1.0, 0.0, 1.0, 8, true), 60.0);
+  EXPECT_EQ(d.channel_sampling, "instantaneous") << diagnosis_text(d);
+  EXPECT_GT(d.channel_sampling_sse_ratio, 1.0);
+  EXPECT_NEAR(d.lag_s, 0.0, 0.1) << diagnosis_text(d);
+  EXPECT_EQ(d.verdict, "nothing_missing") << diagnosis_text(d);
+  // And an integrating logger is read as the interval means it holds.
+  EXPECT_EQ(run(v, recording(v, nullptr, 1.0, 0.0, 1.0, 8), 60.0).channel_sampling, "interval_mean");
 }
 
 TEST(DiagnoseAdequacy, CalibrationPriorsAreReadFromTheVehicleFileStrictly) {

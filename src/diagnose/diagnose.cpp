@@ -77,6 +77,28 @@ void describe_wind(const std::vector<DriveCycle>& cycles, std::vector<Finding>& 
   }
 }
 
+// A logger integrates its channel over each sample's interval (the replay's segment means) or reads it at the
+// sample's instant (the replay's point values). The two differ by about half a sample wherever the power changes:
+// the speed terms shift but the acceleration, constant over a replay segment, does not, so no lag turns one into the
+// other, and reading one as the other leaves a residual in hard traction and braking (a false tyre_slip shape on a
+// hilly one-hour null). The data choose, as for the lag; a state of charge counts what left the cells, a mean.
+void choose_channel_sampling(diag::Replayer& rp, const diag::Observations& o, diag::Variant& base, diag::LagEstimate& lag,
+                             Diagnosis& out) {
+  diag::ChannelPowers both = rp.both_samplings({});
+  lag = diag::estimate_lag(both.interval_mean, o);
+  base.power_w = std::move(both.interval_mean);
+  if (o.channel == ChannelKind::soc) return;
+  const diag::LagEstimate point_lag = diag::estimate_lag(both.instantaneous, o);
+  const bool instantaneous = point_lag.sse_w2 < lag.sse_w2;
+  out.channel_sampling = instantaneous ? "instantaneous" : "interval_mean";
+  out.channel_sampling_sse_ratio =
+      instantaneous ? lag.sse_w2 / std::max(point_lag.sse_w2, 1e-300) : point_lag.sse_w2 / std::max(lag.sse_w2, 1e-300);
+  if (!instantaneous) return;
+  rp.point_values = true;
+  base.power_w = std::move(both.instantaneous);
+  lag = point_lag;
+}
+
 void report_calibration(const diag::Calibration& c, const diag::Observations& o, const diag::LagEstimate& lag, Diagnosis& out) {
   const Eigen::VectorXd& k = c.model.fit.coef;
   out.channel_scale = k[0];
@@ -192,8 +214,8 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
     out.notes.push_back("air density per recording from its recorded ambient (reference 20 degC)");
   }
   Variant base;
-  base.power_w = rp.power({});
-  const LagEstimate lag = estimate_lag(base.power_w, obs);
+  LagEstimate lag;
+  choose_channel_sampling(rp, obs, base, lag, out);
   base.window_j = window_energies(base.power_w, obs, lag.samples);
   out.raw_trip_energy_error_pct = energy_error_pct(base.window_j, obs.measured_j);
   const Signatures sig = compute_signatures(rp, obs, base, lag.samples, amb, ctx, opt);

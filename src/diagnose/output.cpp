@@ -34,6 +34,8 @@ std::string diagnosis_json(const Diagnosis& d) {
      << num(d.final_residual_to_noise_z) << "},\n";
   os << "  \"lag_samples\": " << d.lag_samples << ",\n";
   os << "  \"lag_s\": {\"value\": " << num(d.lag_s) << ", \"ci_low\": " << num(d.lag_ci_low_s) << ", \"ci_high\": " << num(d.lag_ci_high_s) << "},\n";
+  os << "  \"channel_sampling\": {\"chosen\": \"" << d.channel_sampling << "\", \"other_sse_ratio\": "
+     << num(d.channel_sampling_sse_ratio) << "},\n";
   os << "  \"window_s\": " << num(d.window_s) << ",\n  \"notes\": [";
   for (std::size_t i = 0; i < d.notes.size(); ++i) os << (i ? ", " : "") << json_string(d.notes[i]);
   os << "],\n";
@@ -111,6 +113,9 @@ std::string diagnosis_text(const Diagnosis& d) {
      << ", lag-1 autocorrelation " << d.lag1_autocorrelation << ")\n";
   for (const auto& note : d.notes) os << note << "\n";
   os << "channel lag: " << d.lag_s << " s [" << d.lag_ci_low_s << ", " << d.lag_ci_high_s << "] (interpolated channel)\n";
+  if (d.channel != "soc")
+    os << "channel sampling: " << (d.channel_sampling == "instantaneous" ? "read at each sample's instant" : "mean over each sample's interval")
+       << " (the other fits " << d.channel_sampling_sse_ratio << " x worse)\n";
   os << "uncalibrated trip energy error: " << d.raw_trip_energy_error_pct << " %\n";
   os << "calibration: channel scale " << d.channel_scale << " (prior [" << d.channel_scale_prior_low << ", "
      << d.channel_scale_prior_high << "]), RRC level " << 100 * d.rrc_level_change << " %, aero C " << 100 * d.drag_change << " %\n";

@@ -53,13 +53,20 @@ struct Variant {
 };
 
 /// Replays model variants (the base model plus extra effects) on the recordings' traces, in parallel.
+/// The simulated channel per recording and sample, read both ways a logger may sample it.
+struct ChannelPowers {
+  std::vector<std::vector<double>> interval_mean, instantaneous;
+};
+
 struct Replayer {
   const Vehicle& vehicle;
   const std::vector<DriveCycle>& cycles;
   EffectList per_recording;  // known per-recording physics (air density at the recorded ambient), or empty
   bool cells = false;        // SOC: the cells' internal loss counts
   unsigned threads = 0;
-  std::vector<std::vector<double>> power(const EffectList& extra) const;
+  bool point_values = false;  // the channel read at each sample's instant (else its mean over the sample's interval)
+  std::vector<std::vector<double>> power(const EffectList& extra) const;  ///< as `point_values` says
+  ChannelPowers both_samplings(const EffectList& extra) const;           ///< one replay, both readings
   std::vector<Variant> run(const std::vector<EffectList>& extras, const Observations& o, double lag_samples) const;
 };
 
@@ -71,6 +78,7 @@ Eigen::VectorXd window_energies(const std::vector<std::vector<double>>& power_w,
 struct LagEstimate {
   double samples = 0.0, low = 0.0, high = 0.0;
   double seconds = 0.0, low_s = 0.0, high_s = 0.0;
+  double sse_w2 = 0.0;  ///< sum of squared sample residuals at the best lag (comparable across channel samplings)
 };
 LagEstimate estimate_lag(const std::vector<std::vector<double>>& sim_w, const Observations& o);
 

@@ -14,9 +14,11 @@ namespace {
 
 // The simulated counterpart of the measured channel: fuel power, battery terminal power, or, for a state of charge
 // (which counts what leaves the cells), terminal power plus the cells' internal loss. Segment means, as the replay
-// integrates them: summed as mean x dt they are `simulate`'s energy on the same trace.
-double sim_power_w(const TracePoint& t, bool electric, double fuel_j_per_m3, bool cells) {
-  if (!electric) return t.segment_fuel_rate_m3_per_s * fuel_j_per_m3;
+// integrates them (summed as mean x dt they are `simulate`'s energy on the same trace), or, for a logger that reads
+// its channel at the sample's instant, the values at the samples.
+double sim_power_w(const TracePoint& t, bool electric, double fuel_j_per_m3, bool cells, bool point) {
+  if (!electric) return (point ? t.fuel_rate_m3_per_s : t.segment_fuel_rate_m3_per_s) * fuel_j_per_m3;
+  if (point) return cells ? t.battery_power_w + t.battery_loss_w : t.battery_power_w;
   return cells ? t.segment_battery_power_w + t.segment_battery_loss_w : t.segment_battery_power_w;
 }
 
@@ -39,26 +41,53 @@ double lag_sse(const std::vector<std::vector<double>>& sim_w, const Observations
   return sse;
 }
 
+struct ChannelReading {
+  bool electric;
+  double fuel_j_per_m3;
+  bool cells;
+};
+
+// Runs the replay of every recording with the extra effects and hands each trace to `use`.
+template <class Use>
+void for_each_replay(const Replayer& rp, const EffectList& extra, Use use) {
+  VehicleModel model = VehicleModel::assemble(rp.vehicle);
+  for (const auto& e : extra) model.effects.push_back(e);
+  ChannelReading reading{rp.vehicle.is_electric(), 0.0, rp.cells};
+  if (const FuelParams* f = rp.vehicle.fuel()) reading.fuel_j_per_m3 = f->density_kg_per_m3 * f->lower_heating_value_j_per_kg;
+  SimulationOptions so;
+  so.record_trace = true;
+  for (std::size_t ci = 0; ci < rp.cycles.size(); ++ci) {
+    const bool own = ci < rp.per_recording.size() && rp.per_recording[ci];
+    if (own) model.effects.push_back(rp.per_recording[ci]);
+    const SimulationResult r = simulate_replay(model, rp.cycles[ci], so);
+    if (own) model.effects.pop_back();
+    use(r.trace, reading);
+  }
+}
+
 }  // namespace
 
 std::vector<std::vector<double>> Replayer::power(const EffectList& extra) const {
-  VehicleModel model = VehicleModel::assemble(vehicle);
-  for (const auto& e : extra) model.effects.push_back(e);
-  const bool electric = vehicle.is_electric();
-  double fuel_j_per_m3 = 0.0;
-  if (const FuelParams* f = vehicle.fuel()) fuel_j_per_m3 = f->density_kg_per_m3 * f->lower_heating_value_j_per_kg;
-  SimulationOptions so;
-  so.record_trace = true;
   std::vector<std::vector<double>> out;
-  for (std::size_t ci = 0; ci < cycles.size(); ++ci) {
-    const bool own = ci < per_recording.size() && per_recording[ci];
-    if (own) model.effects.push_back(per_recording[ci]);
-    const SimulationResult r = simulate_replay(model, cycles[ci], so);
-    if (own) model.effects.pop_back();
-    std::vector<double> p(r.trace.size());
-    for (std::size_t i = 0; i < p.size(); ++i) p[i] = sim_power_w(r.trace[i], electric, fuel_j_per_m3, cells);
+  for_each_replay(*this, extra, [&](const std::vector<TracePoint>& trace, const ChannelReading& c) {
+    std::vector<double> p(trace.size());
+    for (std::size_t i = 0; i < p.size(); ++i) p[i] = sim_power_w(trace[i], c.electric, c.fuel_j_per_m3, c.cells, point_values);
     out.push_back(std::move(p));
-  }
+  });
+  return out;
+}
+
+ChannelPowers Replayer::both_samplings(const EffectList& extra) const {
+  ChannelPowers out;
+  for_each_replay(*this, extra, [&](const std::vector<TracePoint>& trace, const ChannelReading& c) {
+    std::vector<double> mean(trace.size()), point(trace.size());
+    for (std::size_t i = 0; i < trace.size(); ++i) {
+      mean[i] = sim_power_w(trace[i], c.electric, c.fuel_j_per_m3, c.cells, false);
+      point[i] = sim_power_w(trace[i], c.electric, c.fuel_j_per_m3, c.cells, true);
+    }
+    out.interval_mean.push_back(std::move(mean));
+    out.instantaneous.push_back(std::move(point));
+  });
   return out;
 }
 
@@ -117,6 +146,7 @@ LagEstimate estimate_lag(const std::vector<std::vector<double>>& sim_w, const Ob
   }
   const std::size_t k = static_cast<std::size_t>(std::min_element(sse.begin(), sse.end()) - sse.begin());
   l.samples = grid[k];
+  l.sse_w2 = sse[k];
   // The residual's autocorrelation at the best lag sets how much independent information the samples carry.
   double num = 0.0, den = 0.0, count = 0.0;
   for (std::size_t ri = 0; ri < sim_w.size(); ++ri) {

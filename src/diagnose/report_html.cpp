@@ -102,6 +102,9 @@ void calibration_table(std::ostream& os, const Diagnosis& d) {
   row("measured channel", d.channel);
   row("energy windows (effective)", std::to_string(d.windows) + " (" + fixed(d.effective_windows, 1) + ") of " + fixed(d.window_s, 0) + " s");
   row("channel lag [s], 95 %", fixed(d.lag_s, 2) + " [" + fixed(d.lag_ci_low_s, 2) + ", " + fixed(d.lag_ci_high_s, 2) + "]");
+  if (d.channel != "soc")
+    row("channel sampling (the other's residual)", (d.channel_sampling == "instantaneous" ? "at each sample's instant" : "mean over each interval") +
+                                                      std::string(" (") + fixed(d.channel_sampling_sse_ratio, 3) + " x)");
   row("uncalibrated trip energy error [%]", fixed(d.raw_trip_energy_error_pct, 2));
   row("channel scale (prior box)", fixed(d.channel_scale, 3) + " (" + fixed(d.channel_scale_prior_low, 3) + " to " +
                                        fixed(d.channel_scale_prior_high, 3) + ")");

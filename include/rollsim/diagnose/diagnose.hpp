@@ -169,6 +169,10 @@ struct Diagnosis {
   double lag1_autocorrelation = 0.0;
   int lag_samples = 0;                     ///< calibration: the lag rounded to whole samples
   double lag_s = 0.0, lag_ci_low_s = 0.0, lag_ci_high_s = 0.0;  ///< continuous lag and its 95 % profile interval
+  /// How the logger sampled the channel, as the data chose: "interval_mean" (each sample integrates its interval,
+  /// the replay's segment means) or "instantaneous" (read at the sample's instant, the replay's point values).
+  std::string channel_sampling = "interval_mean";
+  double channel_sampling_sse_ratio = 1.0;  ///< the other sampling's squared residual over the chosen one's (>= 1)
   double raw_trip_energy_error_pct = 0.0;  ///< uncalibrated model against measured, whole data
   double channel_scale = 1.0;              ///< calibration: measured / simulated
   double rrc_level_change = 0.0;           ///< calibration: fractional RRC change
