@@ -188,6 +188,35 @@ TEST(ConventionalPowertrain, ConverterSlipsAtLaunchAndLocksUpAtSpeed) {
   EXPECT_EQ(ConventionalPowertrain(car(TransmissionKind::clutch)).deliver(0.0, 0.0, 0, 0.33).clutch_loss_w, 0.0);
 }
 
+// Neutral idle control: standing in Drive the converter does not load the engine, which idles as a declutched
+// manual does; moving, nothing changes.
+TEST(ConventionalPowertrain, NeutralIdleStandsWithoutTheConvertersLoad) {
+  auto p = car(TransmissionKind::automatic);
+  const ConventionalPowertrain loaded(p);
+  p.transmission.converter.neutral_at_standstill = true;
+  const ConventionalPowertrain neutral(p);
+  const PowerFlow stand = neutral.deliver(0.0, 0.0, 0, 0.33);
+  EXPECT_EQ(stand.clutch_loss_w, 0.0);
+  EXPECT_NEAR(stand.fuel_power_w, ConventionalPowertrain(car(TransmissionKind::clutch)).deliver(0.0, 0.0, 0, 0.33).fuel_power_w, 1e-9);
+  EXPECT_LT(stand.fuel_power_w, loaded.deliver(0.0, 0.0, 0, 0.33).fuel_power_w);
+  EXPECT_EQ(neutral.deliver(800.0, 5.0, 0, 0.33).fuel_power_w, loaded.deliver(800.0, 5.0, 0, 0.33).fuel_power_w);
+}
+
+// A clutch pulls away with the engine at its launch speed, slipping: the slip is (launch - input speed) x torque,
+// and the balance closes. Braking at the same speed it idles (no fuel cut-off at launch speed).
+TEST(ConventionalPowertrain, ClutchLaunchHoldsTheEngineAtItsLaunchSpeed) {
+  auto p = car(TransmissionKind::clutch);
+  p.transmission.launch_engine_speed_radps = 140.0;
+  const ConventionalPowertrain pt(p);
+  const PowerFlow launch = pt.deliver(1500.0, 1.0, 0, 0.33);
+  EXPECT_NEAR(launch.machine_speed_radps, 140.0, 1e-9);
+  const double input_radps = 1.0 / 0.33 * p.transmission.ratios.front();
+  EXPECT_NEAR(launch.clutch_loss_w, launch.machine_torque_nm * (140.0 - input_radps), 1e-6 * launch.clutch_loss_w);
+  EXPECT_GT(launch.fuel_power_w, ConventionalPowertrain(car(TransmissionKind::clutch)).deliver(1500.0, 1.0, 0, 0.33).fuel_power_w);
+  EXPECT_NEAR(pt.deliver(-500.0, 1.0, 0, 0.33).machine_speed_radps, p.engine.idle_speed_radps, 1e-9);
+  EXPECT_GT(pt.deliver(-500.0, 1.0, 0, 0.33).fuel_power_w, 0.0);
+}
+
 // A powertrain with both capabilities (the shape of a hybrid): results carry both figures and one balance holds.
 class BothSources final : public Powertrain {
  public:
@@ -313,13 +342,17 @@ TEST(EpaList, WholeListSkipsByNameAndAgreesAsReportedOnTheHeldOutHalf) {
   for (const auto& o : v.rows) EXPECT_EQ(o.fitting_half, validate::in_fitting_half(*o.row));
 
   // Judged on the half the constants were not fitted on (README, "Validation"). The targets where they
-  // are met (petrol HWFET: median |error| <= 5 %, 90th percentile <= 12 %; electric highway <= 6 %); elsewhere
+  // are met (petrol HWFET and US06: median |error| <= 5 %, 90th percentile <= 12 %; electric highway <= 6 %); elsewhere
   // what the model does today, as a floor that catches a regression (README says what is not met).
   const auto c = validate::coverage(v, false);
   EXPECT_GE(c.simulated, 0.8 * c.eligible);
   for (const auto& s : validate::summarise(v)) {
     if (s.half != "held-out" || s.count < 30) continue;
     if (s.powertrain == "petrol" && s.cycle == "HWFET") {
+      EXPECT_LE(s.median_abs_error_pct, 5.0);
+      EXPECT_LE(s.p90_abs_error_pct, 12.0);
+    }
+    if (s.powertrain == "petrol" && s.cycle == "US06") {
       EXPECT_LE(s.median_abs_error_pct, 5.0);
       EXPECT_LE(s.p90_abs_error_pct, 12.0);
     }

@@ -78,11 +78,11 @@ std::vector<double> measured_power_w(const Vehicle& v, const Recording& r, Chann
     return p;
   }
   if (r.fuel_rate_m3ps) {
-    const auto* cp = std::get_if<CombustionPowertrainParams>(&v.powertrain);
-    if (!cp) throw InputError(r.source, "fuel rate recorded but the vehicle is electric");
+    const FuelParams* fuel = v.fuel();
+    if (!fuel) throw InputError(r.source, "fuel rate recorded but the vehicle is electric");
     kind = ChannelKind::fuel_rate;
     std::vector<double> p(r.time_s.size());
-    const double j_per_m3 = cp->fuel.density_kg_per_m3 * cp->fuel.lower_heating_value_j_per_kg;
+    const double j_per_m3 = fuel->density_kg_per_m3 * fuel->lower_heating_value_j_per_kg;
     for (std::size_t i = 0; i < p.size(); ++i) p[i] = (*r.fuel_rate_m3ps)[i] * j_per_m3;
     return p;
   }
@@ -93,7 +93,7 @@ std::vector<double> measured_power_w(const Vehicle& v, const Recording& r, Chann
 Observations build_windows(const Vehicle& vehicle, const std::vector<Recording>& recordings, double window_s,
                            const DiagnoseOptions& opt, std::vector<std::string>& notes) {
   Observations o;
-  if (const auto* ep = std::get_if<ElectricPowertrainParams>(&vehicle.powertrain)) o.soc_capacity_j = ep->battery.usable_capacity_j;
+  if (const BatteryParams* b = vehicle.battery()) o.soc_capacity_j = b->usable_capacity_j;
   for (std::size_t ri = 0; ri < recordings.size(); ++ri) {
     const Recording& r = recordings[ri];
     ChannelKind kind{};

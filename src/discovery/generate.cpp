@@ -576,9 +576,9 @@ Recording generate_case(const Vehicle& vehicle, const SyntheticCase& o) {
   }
   std::vector<double> truth_w(n);
   if (o.channel == SyntheticChannel::fuel_rate) {
-    const auto* cp = std::get_if<CombustionPowertrainParams>(&truth_vehicle.powertrain);
-    if (!cp) throw InputError("synthetic fuel channel", "needs a combustion vehicle");
-    const double j_per_m3 = cp->fuel.density_kg_per_m3 * cp->fuel.lower_heating_value_j_per_kg;
+    const FuelParams* fuel = truth_vehicle.fuel();
+    if (!fuel) throw InputError("synthetic fuel channel", "needs a combustion vehicle");
+    const double j_per_m3 = fuel->density_kg_per_m3 * fuel->lower_heating_value_j_per_kg;
     if (engine_soak) {
       std::vector<double> fuel_w(n), traction_w(n);
       for (std::size_t i = 0; i < n; ++i) {

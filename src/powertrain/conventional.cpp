@@ -50,8 +50,10 @@ ConventionalPowertrain::Operating ConventionalPowertrain::through(double ratio, 
   const bool converter = t.kind != TransmissionKind::clutch;
   op.locked = !converter || (gear >= t.converter.lockup_min_gear && turbine_radps >= t.converter.lockup_min_speed_radps);
   if (op.locked) {
-    // Below idle a friction clutch slips: the engine holds idle speed while the gearbox input turns slower.
-    op.engine_speed_radps = std::max(turbine_radps, e.idle_speed_radps);
+    // Below idle (or, pulling away, below the launch speed) a friction clutch slips: the engine holds that speed
+    // while the gearbox input turns slower.
+    const double launch_radps = converter || wheel_torque_nm <= 0.0 ? 0.0 : t.launch_engine_speed_radps;
+    op.engine_speed_radps = std::max({turbine_radps, e.idle_speed_radps, launch_radps});
     op.engine_torque_nm = turbine_nm;
     op.slip_loss_w = turbine_nm * (op.engine_speed_radps - turbine_radps);
     return op;
@@ -166,7 +168,7 @@ PowerFlow ConventionalPowertrain::deliver(double wheel_force_n, double speed_mps
         out.machine_speed_radps = op.engine_speed_radps;
         return out;
       }
-    } else if (p_.transmission.kind != TransmissionKind::clutch) {
+    } else if (p_.transmission.kind != TransmissionKind::clutch && !p_.transmission.converter.neutral_at_standstill) {
       // Standing in Drive: the converter's pump turns at idle against a stalled turbine and absorbs its capacity
       // (ω_idle / K)^2, all of it heat, while the brakes hold the car.
       const double q = e.idle_speed_radps / p_.transmission.converter.k_factor_radps_per_sqrt_nm;

@@ -13,7 +13,7 @@ namespace rollsim::validate {
 
 namespace {
 
-constexpr double kRadpsPerRpm = 2.0 * std::numbers::pi / 60.0;
+using units::kRadpsPerRpm;
 constexpr double kFourStroke = 4.0 * std::numbers::pi;
 // The wheel radius only converts between wheel force and torque: the N/V ratio fixes engine speed per road
 // speed, so any radius gives the same car.
@@ -132,8 +132,14 @@ TransmissionParams transmission_of(const EpaTestRow& row, double top_ratio, cons
   // extra transfer case and axle on an all-wheel-drive car. Drag at the input: pump and clutch packs.
   t.efficiency = (t.kind == TransmissionKind::cvt ? 0.93 : 0.96) * (row.all_wheel_drive ? 0.98 : 1.0);
   t.spin_loss_nm = t.kind == TransmissionKind::clutch ? 2.0 : 4.0;
-  t.min_engine_speed_radps = (t.kind == TransmissionKind::clutch ? 1400.0 : 1250.0) * kRadpsPerRpm;
+  // Shift floor: behind a converter with early lock-up, 1100 rpm (a modern automatic holds its gear down to
+  // ~1050-1150 rpm turbine speed: Mazda's 2017 6-speed service data, closed-pedal 5->4 at 1050-1150 rpm; the
+  // Argonne Camry's cruise fuel agrees); a driver with a clutch keeps ~1400 rpm.
+  t.min_engine_speed_radps = (t.kind == TransmissionKind::clutch ? 1400.0 : 1100.0) * kRadpsPerRpm;
   t.max_torque_fraction = 0.6;
+  // A clutch pulls away with the engine at the speed the gearbox is then held at (the driver's or the dual-clutch
+  // controller's launch, not at idle): it closes fully once the input reaches it.
+  if (t.kind == TransmissionKind::clutch) t.launch_engine_speed_radps = t.min_engine_speed_radps;
   // Torque converter: stall at 2400 rpm against full-load torque; stall torque ratio 2.0, coupling at 0.85;
   // lock-up in every gear of a 6-or-more-speed automatic (third up for 4- and 5-speeds) above 1000 rpm turbine
   // speed, as 2015-2022 automatics do for economy (ZF 8HP: lock-up in all gears shortly after launch).

@@ -10,6 +10,7 @@
 #include "rollsim/common/yaml_reader.hpp"
 #include "rollsim/tyre/tyre_model.hpp"
 #include "rollsim/vehicle/vehicle_file.hpp"
+#include "powertrain_readers.hpp"
 
 namespace rollsim {
 namespace {
@@ -144,19 +145,22 @@ CombustionPowertrainParams read_combustion(YamlMap& pt) {
     }
     m.finish();
   }
-  {
-    YamlMap m = pt.map("fuel");
-    p.fuel.density_kg_per_m3 = m.number("density_kg_per_l", Range::open_low(0.0, 2.0)) / units::kM3PerLitre;
-    p.fuel.lower_heating_value_j_per_kg = m.number("lower_heating_value_mj_per_kg", Range::open_low(0.0, 150.0)) * 1e6;
-    p.fuel.co2_kg_per_kg = m.number("co2_kg_per_kg", Range::closed(0.0, 5.0));
-    m.finish();
-  }
+  p.fuel = read_fuel(pt.map("fuel"));
   p.aux_power_w = pt.number_or("aux_power_w", 0.0, Range::closed(0.0, 1e5));
   p.alternator_efficiency = pt.number_or("alternator_efficiency", 1.0, Range::efficiency());
   return p;
 }
 
 }  // namespace
+
+FuelParams read_fuel(YamlMap m) {
+  FuelParams f;
+  f.density_kg_per_m3 = m.number("density_kg_per_l", Range::open_low(0.0, 2.0)) / units::kM3PerLitre;
+  f.lower_heating_value_j_per_kg = m.number("lower_heating_value_mj_per_kg", Range::open_low(0.0, 150.0)) * 1e6;
+  f.co2_kg_per_kg = m.number("co2_kg_per_kg", Range::closed(0.0, 5.0));
+  m.finish();
+  return f;
+}
 
 Vehicle load_vehicle_file(const std::string& path) { return load_vehicle(YamlMap::load_file(path)); }
 
@@ -197,8 +201,10 @@ Vehicle load_vehicle(YamlMap root) {
     v.powertrain = read_electric(pt);
   } else if (type == "combustion") {
     v.powertrain = read_combustion(pt);
+  } else if (type == "engine_map") {
+    v.powertrain = read_engine_map_powertrain(pt);
   } else {
-    throw InputError(pt.where("type"), "'" + type + "' is not allowed: must be electric or combustion");
+    throw InputError(pt.where("type"), "'" + type + "' is not allowed: must be electric, combustion or engine_map");
   }
   pt.finish();
   if (auto eff = root.optional_map("effects")) v.effects = load_effects(*eff);
@@ -318,10 +324,28 @@ double tyre_rolling_force_at_standstill_limit_n(const Vehicle& vehicle) {
   return TyreRoadLoad(tyres_only).at_grade(0.0).rolling_f0_n;
 }
 
+const FuelParams* Vehicle::fuel() const {
+  return std::visit([](const auto& p) -> const FuelParams* {
+    if constexpr (requires { p.fuel; }) return &p.fuel;
+    else return nullptr;
+  }, powertrain);
+}
+
+const BatteryParams* Vehicle::battery() const {
+  return std::visit([](const auto& p) -> const BatteryParams* {
+    if constexpr (requires { p.battery; }) return &p.battery;
+    else return nullptr;
+  }, powertrain);
+}
+
+namespace {
+std::unique_ptr<Powertrain> make_powertrain_of(const ElectricPowertrainParams& p) { return std::make_unique<ElectricPowertrain>(p); }
+std::unique_ptr<Powertrain> make_powertrain_of(const CombustionPowertrainParams& p) { return std::make_unique<CombustionPowertrain>(p); }
+std::unique_ptr<Powertrain> make_powertrain_of(const ConventionalPowertrainParams& p) { return std::make_unique<ConventionalPowertrain>(p); }
+}  // namespace
+
 std::unique_ptr<Powertrain> make_powertrain(const Vehicle& vehicle) {
-  if (const auto* e = std::get_if<ElectricPowertrainParams>(&vehicle.powertrain))
-    return std::make_unique<ElectricPowertrain>(*e);
-  return std::make_unique<CombustionPowertrain>(std::get<CombustionPowertrainParams>(vehicle.powertrain));
+  return std::visit([](const auto& p) -> std::unique_ptr<Powertrain> { return make_powertrain_of(p); }, vehicle.powertrain);
 }
 
 }  // namespace rollsim

@@ -20,6 +20,7 @@ inline constexpr double kMpsPerMph = kMPerMile / kSPerHour;
 inline constexpr double kNPerLbf = 4.4482216152605;
 
 inline constexpr double kPi = 3.14159265358979323846;
+inline constexpr double kRadpsPerRpm = 2.0 * kPi / 60.0;  ///< engine and motor speeds are given in rpm in files
 inline constexpr double kEarthRadius_m = 6371000.0;  ///< mean radius, for local flat-earth projections of GPS
 constexpr double deg_to_rad(double angle_deg) { return angle_deg * kPi / 180.0; }
 constexpr double rad_to_deg(double angle_rad) { return angle_rad * 180.0 / kPi; }

@@ -24,6 +24,9 @@ struct TorqueConverterParams {
   double coupling_speed_ratio = 0.85;
   int lockup_min_gear = 2;                  ///< lock-up clutch closes from this gear up (CVT: always when above speed)
   double lockup_min_speed_radps = 0.0;      ///< ... and above this turbine speed
+  /// Neutral idle control: standing in Drive with the brake on, the controller opens a clutch so the stalled
+  /// converter does not load the idling engine (Mazda's 2018 Skyactiv-Drive, GM's and Ford's "neutral idle").
+  bool neutral_at_standstill = false;
 };
 
 struct TransmissionParams {
@@ -38,6 +41,10 @@ struct TransmissionParams {
   /// `max_torque_fraction` of the full-load torque, but not below this speed.
   double min_engine_speed_radps = 0.0;
   double max_torque_fraction = 0.8;
+  /// A friction clutch's launch: while the gearbox input turns slower than this and the wheels are driven, the
+  /// engine runs at this speed and the clutch slips (a driver or a dual-clutch controller raises the engine above
+  /// idle to pull away). Zero: the clutch slips with the engine at idle.
+  double launch_engine_speed_radps = 0.0;
   TorqueConverterParams converter;   ///< automatic and CVT
 };
 

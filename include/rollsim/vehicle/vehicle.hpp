@@ -8,6 +8,7 @@
 #include <variant>
 
 #include "rollsim/powertrain/combustion.hpp"
+#include "rollsim/powertrain/conventional.hpp"
 #include "rollsim/powertrain/electric.hpp"
 #include "rollsim/effects/catalogue.hpp"
 #include "rollsim/tyre/tyre_spec.hpp"
@@ -35,7 +36,10 @@ struct CoastdownParams {
   double c_n_s2_per_m2 = 0.0;
 };
 
-using PowertrainParams = std::variant<ElectricPowertrainParams, CombustionPowertrainParams>;
+/// One alternative per vehicle-file powertrain type: electric, combustion (Willans line, scheduled gearbox) and
+/// engine_map (fuel map behind a self-shifting transmission). Code that needs the fuel or the battery asks
+/// Vehicle::fuel() / battery(), so a new type is added here, in its reader and in make_powertrain only.
+using PowertrainParams = std::variant<ElectricPowertrainParams, CombustionPowertrainParams, ConventionalPowertrainParams>;
 
 struct Vehicle {
   std::string name;
@@ -48,6 +52,10 @@ struct Vehicle {
   std::vector<EffectSpec> effects;  ///< the file's `effects:` block; models are built by the simulation's assembly
 
   bool is_electric() const { return std::holds_alternative<ElectricPowertrainParams>(powertrain); }
+  /// The fuel the powertrain burns, or nullptr when it burns none.
+  const FuelParams* fuel() const;
+  /// The traction battery, or nullptr when it has none.
+  const BatteryParams* battery() const;
 };
 
 /// Loads a vehicle file; tyre files named in it are found beside it or in the shipped tyres/.

@@ -1,0 +1,111 @@
+#include <cmath>
+
+#include "powertrain_readers.hpp"
+#include "rollsim/common/error.hpp"
+#include "rollsim/common/units.hpp"
+
+namespace rollsim {
+namespace {
+
+using units::kRadpsPerRpm;
+
+double rpm(YamlMap& m, const std::string& key) { return m.number(key, Range::open_low(0.0, 3e4)) * kRadpsPerRpm; }
+double pct(YamlMap& m, const std::string& key, double fallback_pct) {
+  return m.number_or(key, fallback_pct, Range::closed(0.0, 100.0)) / 100.0;
+}
+
+EngineMapParams read_engine(YamlMap m) {
+  EngineMapParams e;
+  e.displacement_m3 = m.number("displacement_l", Range::open_low(0.0, 30.0)) * units::kM3PerLitre;
+  e.indicated_efficiency = m.number("gross_indicated_efficiency", Range::open_low(0.0, 0.6));
+  // Friction mep f0 + f1 N + f2 N^2 with N in 1000 rpm, as Heywood writes eq. 13.19.
+  const double per_krpm = 1000.0 * kRadpsPerRpm;
+  e.friction_mep0_pa = units::bar_to_pa(m.number("friction_mep_bar", Range::closed(0.0, 10.0)));
+  e.friction_mep1_pa_s_per_rad = units::bar_to_pa(m.number_or("friction_mep_bar_per_krpm", 0.0, Range::closed(0.0, 5.0))) / per_krpm;
+  e.friction_mep2_pa_s2_per_rad2 =
+      units::bar_to_pa(m.number_or("friction_mep_bar_per_krpm2", 0.0, Range::closed(0.0, 1.0))) / (per_krpm * per_krpm);
+  e.pumping_mep_closed_pa = units::bar_to_pa(m.number_or("pumping_mep_closed_throttle_bar", 0.0, Range::closed(0.0, 1.0)));
+  e.unthrottled_imep_pa = units::bar_to_pa(m.number_or("unthrottled_imep_bar", 11.0, Range::open_low(0.0, 40.0)));
+  e.enrichment_start_fraction = pct(m, "enrichment_start_load_pct", 100.0);
+  e.enrichment_max = pct(m, "enrichment_at_full_load_pct", 0.0);
+  e.knock_start_fraction = pct(m, "knock_start_load_pct", 100.0);
+  e.knock_efficiency_loss_max = pct(m, "knock_efficiency_loss_at_full_load_pct", 0.0);
+  e.idle_speed_radps = rpm(m, "idle_speed_rpm");
+  e.rated_speed_radps = rpm(m, "rated_speed_rpm");
+  e.max_speed_radps = rpm(m, "max_speed_rpm");
+  e.max_torque_nm = m.number("max_torque_nm", Range::open_low(0.0, 1e5));
+  e.max_power_w = m.number("max_power_kw", Range::open_low(0.0, 5000.0)) * 1e3;
+  e.fuel_cut_min_speed_radps = m.number_or("fuel_cut_min_speed_rpm", 1.2 * e.idle_speed_radps / kRadpsPerRpm,
+                                           Range::closed(0.0, 3e4)) * kRadpsPerRpm;
+  if (e.rated_speed_radps <= e.idle_speed_radps) throw InputError(m.where("rated_speed_rpm"), "must exceed idle_speed_rpm");
+  if (e.max_speed_radps < e.rated_speed_radps) throw InputError(m.where("max_speed_rpm"), "must be at least rated_speed_rpm");
+  if (e.enrichment_start_fraction >= 1.0 && e.enrichment_max > 0.0)
+    throw InputError(m.where("enrichment_start_load_pct"), "must be below 100 when enrichment_at_full_load_pct is given");
+  if (e.knock_start_fraction >= 1.0 && e.knock_efficiency_loss_max > 0.0)
+    throw InputError(m.where("knock_start_load_pct"), "must be below 100 when knock_efficiency_loss_at_full_load_pct is given");
+  m.finish();
+  return e;
+}
+
+TransmissionKind transmission_kind(YamlMap& m) {
+  const std::string kind = m.string("kind");
+  if (kind == "automatic") return TransmissionKind::automatic;
+  if (kind == "cvt") return TransmissionKind::cvt;
+  if (kind == "manual" || kind == "dual_clutch") return TransmissionKind::clutch;
+  throw InputError(m.where("kind"), "'" + kind + "' is not allowed: must be automatic, cvt, manual or dual_clutch");
+}
+
+TorqueConverterParams read_converter(YamlMap m, double max_torque_nm) {
+  TorqueConverterParams c;
+  // K from the stall speed at full-load torque: a stalled pump absorbs (w / K)^2.
+  c.k_factor_radps_per_sqrt_nm = rpm(m, "stall_speed_rpm") / std::sqrt(max_torque_nm);
+  c.stall_torque_ratio = m.number_or("stall_torque_ratio", 2.0, Range::closed(1.0, 4.0));
+  c.coupling_speed_ratio = m.number_or("coupling_speed_ratio", 0.85, Range::open_low(0.0, 0.99));
+  const double lockup_gear = m.number_or("lockup_min_gear", 2.0, Range::closed(1.0, 20.0));
+  if (lockup_gear != std::floor(lockup_gear)) throw InputError(m.where("lockup_min_gear"), format_value(lockup_gear) + " is not a gear number (1, 2, ...)");
+  c.lockup_min_gear = static_cast<int>(lockup_gear);
+  c.lockup_min_speed_radps = m.number_or("lockup_min_speed_rpm", 1000.0, Range::closed(0.0, 1e4)) * kRadpsPerRpm;
+  c.neutral_at_standstill = m.boolean_or("neutral_at_standstill", false);
+  m.finish();
+  return c;
+}
+
+TransmissionParams read_transmission(YamlMap m, double max_torque_nm) {
+  TransmissionParams t;
+  t.kind = transmission_kind(m);
+  const auto gears = m.numbers("ratios", Range::closed(0.1, 30.0));
+  const double final_drive = m.number("final_drive_ratio", Range::closed(0.1, 30.0));
+  if (t.kind == TransmissionKind::cvt && gears.size() != 2)
+    throw InputError(m.where("ratios"), "a CVT gives exactly two ratios, its lowest gear and its overdrive");
+  for (std::size_t i = 1; i < gears.size(); ++i)
+    if (gears[i] >= gears[i - 1]) throw InputError(m.where("ratios"), "must fall from first gear to top gear");
+  for (double g : gears) t.ratios.push_back(g * final_drive);
+  t.efficiency = m.number("efficiency", Range::efficiency());
+  t.spin_loss_nm = m.number_or("spin_loss_nm", 0.0, Range::closed(0.0, 200.0));
+  t.min_engine_speed_radps = rpm(m, "min_engine_speed_rpm");
+  t.max_torque_fraction = m.number("max_load_pct", Range::open_low(0.0, 100.0)) / 100.0;
+  if (t.kind == TransmissionKind::clutch) {
+    if (m.has("converter")) throw InputError(m.where("converter"), "a manual or dual-clutch gearbox has no torque converter");
+    t.launch_engine_speed_radps = m.number_or("launch_engine_speed_rpm", 0.0, Range::closed(0.0, 1e4)) * kRadpsPerRpm;
+  } else {
+    if (m.has("launch_engine_speed_rpm"))
+      throw InputError(m.where("launch_engine_speed_rpm"), "only a manual or dual-clutch gearbox launches on a slipping clutch");
+    t.converter = read_converter(m.map("converter"), max_torque_nm);
+  }
+  m.finish();
+  return t;
+}
+
+}  // namespace
+
+ConventionalPowertrainParams read_engine_map_powertrain(YamlMap& pt) {
+  ConventionalPowertrainParams p;
+  p.engine = read_engine(pt.map("engine"));
+  p.transmission = read_transmission(pt.map("transmission"), p.engine.max_torque_nm);
+  p.fuel = read_fuel(pt.map("fuel"));
+  p.aux_power_w = pt.number_or("aux_power_w", 0.0, Range::closed(0.0, 1e5));
+  p.alternator_efficiency = pt.number_or("alternator_efficiency", 1.0, Range::efficiency());
+  return p;
+}
+
+}  // namespace rollsim

@@ -1,0 +1,16 @@
+// Readers of the vehicle file's powertrain blocks that live beside vehicle.cpp's own (one reader per type).
+#pragma once
+
+#include "rollsim/common/yaml_reader.hpp"
+#include "rollsim/powertrain/conventional.hpp"
+
+namespace rollsim {
+
+/// A `fuel:` block: density, lower heating value and CO2 per kg, in the file's units.
+FuelParams read_fuel(YamlMap m);
+
+/// `powertrain: {type: engine_map, ...}`: an engine with a fuel map (EngineMap) behind a transmission that picks
+/// its own ratio (ConventionalPowertrain). Every key in the file's units, each with its bounds.
+ConventionalPowertrainParams read_engine_map_powertrain(YamlMap& pt);
+
+}  // namespace rollsim
