@@ -300,9 +300,6 @@ const std::vector<ConcealedTruthInfo>& concealed_truths() {
       {"aux_compressor", "aux_load", "W (mean)", "A/C compressor cycling 40 % duty (period 240-360 s) plus blower", {150, 300, 600},
        SyntheticChannel::battery_power, false, +1},
       {"wind_gusty", "wind", "m/s (mean headwind)", "mean headwind + OU gusts (sd 1.5 m/s, 15 s) on a slowly turning road", {1.5, 3, 5}},
-      {"wind_tail", "wind", "m/s (mean tailwind)",
-       "mean tailwind + OU gusts (sd 1.5 m/s, 15 s) on a slowly turning road: pushes the road load below the tyres' "
-       "loss like a descent does, so road_profile must not take it", {3, 5}},
       {"payload_drop", "mass", "kg (before the drop)", "payload, 60 % leaves at the mid-trip stop; rolling share ~ load^0.9", {75, 150, 300},
        SyntheticChannel::battery_power, false, +1},
       {"rotating_parts", "rotational_inertia", "kg (equivalent)", "wheels 60 %, rotor 40 % through the reduction (gear loss both ways)",
@@ -323,10 +320,6 @@ const std::vector<ConcealedTruthInfo>& concealed_truths() {
        "steady wind w cos(theta - psi(s)) on a winding route (three 1-4 km bends, +-70-100 deg), latitude and "
        "longitude recorded (2 m GPS noise)",
        {4.0}, SyntheticChannel::battery_power, false, 0, false, "", "", 0.0, true},
-      {"wind_gusty_gps", "wind_heading", "m/s (mean wind, from a bearing drawn per seed)",
-       "the steady GPS wind with along-wind Ornstein-Uhlenbeck gusts (sd 1.5 m/s, 15 s) about its mean, on the same "
-       "winding routes",
-       {2.0, 4.0, 6.0}, SyntheticChannel::battery_power, false, 0, false, "", "", 0.0, true},
       {"battery_r_of_soc", "battery_resistance", "ohm (extra at full charge)",
        "extra cell resistance rising as SOC falls, OCV(SOC), loss I^2 R (SOC channel, 0.1 % quantum)",
        {0.05, 0.1, 0.2}, SyntheticChannel::soc, false, +1},
@@ -360,6 +353,14 @@ const std::vector<ConcealedTruthInfo>& concealed_truths() {
        "engine_cold_soak's engine, both nodes at running temperature at the start; UDDS, 10 min soak, UDDS (fuel "
        "channel)",
        {0.25}, SyntheticChannel::fuel_rate, false, 0, false, "engine_warmup", "udds", 600.0},
+      // Appended, so that every row above keeps its seed block.
+      {"wind_tail", "wind", "m/s (mean tailwind)",
+       "mean tailwind + OU gusts (sd 1.5 m/s, 15 s) on a slowly turning road: pushes the road load below the tyres' "
+       "loss like a descent does, so road_profile must not take it", {3, 5}},
+      {"wind_gusty_gps", "wind_heading", "m/s (mean wind, from a bearing drawn per seed)",
+       "the steady GPS wind with along-wind Ornstein-Uhlenbeck gusts (sd 1.5 m/s, 15 s) about its mean, on the same "
+       "winding routes",
+       {2.0, 4.0, 6.0}, SyntheticChannel::battery_power, false, 0, false, "", "", 0.0, true},
   };
   return kTruths;
 }
