@@ -53,7 +53,7 @@ void for_each_replay(const Replayer& rp, const EffectList& extra, Use use) {
   VehicleModel model = VehicleModel::assemble(rp.vehicle);
   for (const auto& e : extra) model.effects.push_back(e);
   ChannelReading reading{rp.vehicle.is_electric(), 0.0, rp.cells};
-  if (const FuelParams* f = rp.vehicle.fuel()) reading.fuel_j_per_m3 = f->density_kg_per_m3 * f->lower_heating_value_j_per_kg;
+  if (const FuelParams* f = rp.vehicle.fuel()) reading.fuel_j_per_m3 = f->energy_j_per_m3();
   SimulationOptions so;
   so.record_trace = true;
   for (std::size_t ci = 0; ci < rp.cycles.size(); ++ci) {

@@ -82,7 +82,7 @@ std::vector<double> measured_power_w(const Vehicle& v, const Recording& r, Chann
     if (!fuel) throw InputError(r.source, "fuel rate recorded but the vehicle is electric");
     kind = ChannelKind::fuel_rate;
     std::vector<double> p(r.time_s.size());
-    const double j_per_m3 = fuel->density_kg_per_m3 * fuel->lower_heating_value_j_per_kg;
+    const double j_per_m3 = fuel->energy_j_per_m3();
     for (std::size_t i = 0; i < p.size(); ++i) p[i] = (*r.fuel_rate_m3ps)[i] * j_per_m3;
     return p;
   }

@@ -32,7 +32,7 @@ SparseDesign sparse_design(const Vehicle& vehicle, const Recording& rec, double 
   const SimulationResult sim = simulate_replay(VehicleModel::assemble(vehicle), c, so);
   // The channel in the simulation's energy domain: battery power, fuel chemical power, or SOC x capacity.
   double fuel_j_per_m3 = 0.0, capacity_j = 0.0;
-  if (const FuelParams* f = vehicle.fuel()) fuel_j_per_m3 = f->density_kg_per_m3 * f->lower_heating_value_j_per_kg;
+  if (const FuelParams* f = vehicle.fuel()) fuel_j_per_m3 = f->energy_j_per_m3();
   if (const BatteryParams* b = vehicle.battery()) capacity_j = b->usable_capacity_j;
   const bool soc = !rec.battery_power_w && !rec.fuel_rate_m3ps && rec.soc_fraction;
   std::vector<double> meas(rec.time_s.size(), 0.0);

@@ -579,7 +579,7 @@ Recording generate_case(const Vehicle& vehicle, const SyntheticCase& o) {
   if (o.channel == SyntheticChannel::fuel_rate) {
     const FuelParams* fuel = truth_vehicle.fuel();
     if (!fuel) throw InputError("synthetic fuel channel", "needs a combustion vehicle");
-    const double j_per_m3 = fuel->density_kg_per_m3 * fuel->lower_heating_value_j_per_kg;
+    const double j_per_m3 = fuel->energy_j_per_m3();
     if (engine_soak) {
       std::vector<double> fuel_w(n), traction_w(n);
       for (std::size_t i = 0; i < n; ++i) {

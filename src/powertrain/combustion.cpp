@@ -47,7 +47,7 @@ void add_alternator_load(double power_w, double alternator_efficiency, double in
   flow.aux_power_w += power_w;
   flow.fuel_power_w += fuel_w;
   flow.engine_loss_w += fuel_w - power_w;
-  flow.fuel_rate_m3_per_s += fuel_w / (fuel.lower_heating_value_j_per_kg * fuel.density_kg_per_m3);
+  flow.fuel_rate_m3_per_s += fuel_w / fuel.energy_j_per_m3();
 }
 
 void CombustionPowertrain::add_electric_load(double power_w, PowerFlow& flow) const {

@@ -181,7 +181,7 @@ PowerFlow ConventionalPowertrain::deliver(double wheel_force_n, double speed_mps
   const double brake_w = engine_nm * engine_radps + accessory_w;
   out.fuel_power_w = map_.fuel_power_w(engine_radps, engine_nm + accessory_torque_nm(engine_radps));
   out.engine_loss_w = out.fuel_power_w - brake_w;
-  out.fuel_rate_m3_per_s = out.fuel_power_w / (p_.fuel.lower_heating_value_j_per_kg * p_.fuel.density_kg_per_m3);
+  out.fuel_rate_m3_per_s = out.fuel_power_w / p_.fuel.energy_j_per_m3();
   return out;
 }
 

@@ -18,6 +18,8 @@ struct FuelParams {
   double density_kg_per_m3 = 0.0;
   double lower_heating_value_j_per_kg = 0.0;
   double co2_kg_per_kg = 0.0;   ///< tank-to-wheel CO2 per kg of fuel burned
+  /// Chemical energy per volume [J/m^3]: the power a volumetric fuel flow carries, per m^3/s.
+  double energy_j_per_m3() const { return density_kg_per_m3 * lower_heating_value_j_per_kg; }
 };
 
 struct PowerFlow;
