@@ -176,8 +176,7 @@ Signatures compute_signatures(const Replayer& rp, const Observations& o, const V
       continue;
     }
     if (info.id == EffectId::wind_heading) {
-      if (!rp.cycles.empty() && std::all_of(rp.cycles.begin(), rp.cycles.end(), [](const DriveCycle& c) { return !c.heading_rad.empty(); }))
-        add_bearing_candidates(info, ctx, extras, s.candidates);
+      if (headings_known(rp.cycles)) add_bearing_candidates(info, ctx, extras, s.candidates);
       continue;
     }
     for (const auto& shape : shapes_of(info, o.channel)) {

@@ -57,7 +57,7 @@ std::vector<DriveCycle> cycles_of(const std::vector<Recording>& recordings, cons
 // A steady wind is a head- or tailwind only relative to the heading: with it recorded, the wind's speed and bearing;
 // without it, a headwind along the trace, said so.
 void describe_wind(const std::vector<DriveCycle>& cycles, std::vector<Finding>& findings, std::vector<std::string>& notes) {
-  const bool heading = std::all_of(cycles.begin(), cycles.end(), [](const DriveCycle& c) { return !c.heading_rad.empty(); });
+  const bool heading = diag::headings_known(cycles);
   if (!heading) notes.push_back("wind_heading not tested: the route's heading is unknown (no latitude and longitude recorded)");
   for (Finding& f : findings) {
     if (f.effect == "wind" && !heading)

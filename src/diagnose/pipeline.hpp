@@ -2,6 +2,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -52,12 +53,18 @@ struct Variant {
   Eigen::VectorXd window_j;
 };
 
-/// Replays model variants (the base model plus extra effects) on the recordings' traces, in parallel.
+/// Every recording's trace knows its direction of travel (latitude and longitude recorded): what wind_heading needs,
+/// without which a wind is only a headwind along the trace.
+inline bool headings_known(const std::vector<DriveCycle>& cycles) {
+  return !cycles.empty() && std::all_of(cycles.begin(), cycles.end(), [](const DriveCycle& c) { return !c.heading_rad.empty(); });
+}
+
 /// The simulated channel per recording and sample, read both ways a logger may sample it.
 struct ChannelPowers {
   std::vector<std::vector<double>> interval_mean, instantaneous;
 };
 
+/// Replays model variants (the base model plus extra effects) on the recordings' traces, in parallel.
 struct Replayer {
   const Vehicle& vehicle;
   const std::vector<DriveCycle>& cycles;
