@@ -31,6 +31,13 @@ std::pair<double, double> wilson_interval(int k, int n) {
 
 namespace {
 
+// A row's second figure, as "    what: k/n (p %, Wilson 95 % lo-hi %)".
+void sub_rate_line(std::ostream& os, const std::string& what, int k, int n) {
+  const auto [lo, hi] = wilson_interval(k, n);
+  os << "    " << what << ": " << k << "/" << n << std::fixed << std::setprecision(0) << " (" << 100.0 * k / std::max(1, n)
+     << " %, Wilson 95 % " << 100 * lo << "-" << 100 * hi << " %)\n" << std::defaultfloat;
+}
+
 struct Case {
   std::string group, label;
   SyntheticCase synth;
@@ -497,18 +504,10 @@ std::string bench_text(const BenchResult& r) {
     os << std::left << std::setw(lw) << row.label << std::setw(18) << exp << std::right << std::setw(14) << cell(row.rollsim)
        << std::setw(8) << row.rollsim_unexplained << std::setw(6) << row.rollsim_wrong_sign << std::setw(18) << named.str()
        << std::setw(12) << cell(row.calibration) << std::setw(14) << cell(row.sparse) << "\n";
-    if (row.scores_direction) {
-      const auto [dlo, dhi] = wilson_interval(row.rollsim_direction_right, row.rollsim.n());
-      os << "    named with the wind's bearing within 45 deg: " << row.rollsim_direction_right << "/" << row.rollsim.n()
-         << std::fixed << std::setprecision(0) << " (" << 100.0 * row.rollsim_direction_right / std::max(1, row.rollsim.n())
-         << " %, Wilson 95 % " << 100 * dlo << "-" << 100 * dhi << " %)\n" << std::defaultfloat;
-    }
-    if (row.scores_decay) {
-      const auto [dlo, dhi] = wilson_interval(row.rollsim_decay_found, row.rollsim.n());
-      os << "    named with a decay from the trip's start (decay_s fitted): " << row.rollsim_decay_found << "/" << row.rollsim.n()
-         << std::fixed << std::setprecision(0) << " (" << 100.0 * row.rollsim_decay_found / std::max(1, row.rollsim.n())
-         << " %, Wilson 95 % " << 100 * dlo << "-" << 100 * dhi << " %)\n" << std::defaultfloat;
-    }
+    if (row.scores_direction)
+      sub_rate_line(os, "named with the wind's bearing within 45 deg", row.rollsim_direction_right, row.rollsim.n());
+    if (row.scores_decay)
+      sub_rate_line(os, "named with a decay from the trip's start (decay_s fitted)", row.rollsim_decay_found, row.rollsim.n());
   }
   os << "\n";
   for (const auto& row : r.rows) {
