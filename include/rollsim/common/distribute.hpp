@@ -4,6 +4,7 @@
 #include <cstddef>
 #include <cstring>
 #include <functional>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -45,6 +46,8 @@ std::vector<CaseBytes> map_cases_locally(std::size_t tasks, unsigned threads, co
 std::vector<CaseBytes> map_cases(const CaseMap& map, std::size_t tasks, unsigned threads, const CaseBody& body,
                                  const CaseProgress& progress);
 
+class MpiSession;  // src/common/mpi_session.hpp: loaded only under a launcher
+
 /// The processes of one run: MPI's world when rollsim was built with MPI and launched by mpirun or srun, else this
 /// process alone. Made once in main (it starts and ends MPI); not copyable.
 class ProcessGroup {
@@ -65,7 +68,7 @@ class ProcessGroup {
   int rank_ = 0;
   int size_ = 1;
   int ranks_on_node_ = 1;  ///< threads default to this node's cores over its ranks
-  bool mpi_ = false;
+  std::unique_ptr<MpiSession> mpi_;  ///< set when a launcher started this process
 };
 
 /// True when the environment says an MPI launcher (mpirun, srun) started this process.
