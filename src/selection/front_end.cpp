@@ -41,8 +41,12 @@ double parse_diameter_tolerance_pct(const std::string& text) {
 
 std::string tyre_size_text(const TyreSpec& t) {
   if (t.size) return t.size->designation;
-  return "R" + fixed(t.state.geometry.outer_radius_m * 1e3, 0) + " W" +
-         fixed(t.state.geometry.section_width_m * 1e3, 0);
+  // Appended, not "R" + ...: GCC 12 warns falsely (-Wrestrict, its bug 105651) on a literal plus a temporary.
+  std::string text = "R";
+  text += fixed(t.state.geometry.outer_radius_m * 1e3, 0);
+  text += " W";
+  text += fixed(t.state.geometry.section_width_m * 1e3, 0);
+  return text;
 }
 
 std::vector<JsonObject> comparison_json(const Comparison& c) {
