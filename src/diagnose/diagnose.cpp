@@ -237,7 +237,7 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
   out.windows = static_cast<int>(obs.n());
   out.window_s = obs.window_s;
   const EffectContext ctx = effect_context(vehicle);
-  const AmbientSetting amb = ambient_setting(recordings, opt, out.notes);
+  const AmbientSetting amb = ambient_setting(recordings, obs.channel, opt, out.notes);
   Replayer rp{vehicle, cycles, {}, obs.channel == ChannelKind::soc, opt.threads};
   // Air density follows the recorded ambient (rho ~ 1 / T at one pressure, the vehicle's taken at 20 degC): known
   // physics of the replay where ambient_rrc is tested, not left for it to absorb.
