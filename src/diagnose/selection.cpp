@@ -241,8 +241,22 @@ bool switches_engine_off(const SelectionContext& sc) {
 
 // Each of the effect's shape parameters in turn, the later ones at the earlier ones' values; the first is the
 // finding's profile, the later ones travel as its profiled nuisance parameters.
-std::optional<ProfileResult> refine(const SelectionContext& sc, Candidate& c, const Model& m, Passing& best) {
+std::optional<ProfileResult> refine(const SelectionContext& sc, const std::vector<Candidate>& cands, Candidate& c, const Model& m,
+                                    Passing& best) {
   if (c.id == EffectId::aux_load) return refine_aux_decay(sc, c, m, best.score, kAuxDecayLow_s, kAuxDecayHigh_s);
+  if (c.mixed_bearing) {
+    // The north (0 deg) and east (90 deg) candidates' signatures span every bearing's.
+    const Eigen::VectorXd* axis[2] = {nullptr, nullptr};
+    for (const auto& o : cands)
+      if (o.mixed_bearing && (o.shape.at("wind_from_deg") == 0.0 || o.shape.at("wind_from_deg") == 90.0))
+        axis[o.shape.at("wind_from_deg") == 0.0 ? 0 : 1] = &o.signature;
+    if (!axis[0] || !axis[1]) return std::nullopt;
+    ProfileResult r = profile_bearing(m, c.shape.at("wind_from_deg"), *axis[0], *axis[1], c.signature, best.score, c.min(), c.max());
+    c.shape["wind_from_deg"] = r.interval.value;
+    c.signature = r.signature;
+    best.score = r.score;
+    return r;
+  }
   std::optional<ProfileResult> out;
   for (const auto& tp : kShapeParameters) {
     if (c.id != tp.effect) continue;
@@ -397,7 +411,7 @@ std::vector<Finding> select_effects(const SelectionContext& sc, const std::vecto
     if (best.wrong_sign) {
       f = wrong_sign_finding(c, best, m.inflate);
     } else {
-      const std::optional<ProfileResult> prof = refine(sc, c, m, best);
+      const std::optional<ProfileResult> prof = refine(sc, cands, c, m, best);
       f = catalogue_finding(sc, c, best, prof, m.inflate);
       add_confounders(f, c, cands, passing, m, sc.opt.collinear_corr);
     }
