@@ -43,6 +43,13 @@ double value_at(const DriveCycle& c, const std::vector<double>& y, double t, std
 
 }  // namespace
 
+bool DriveCycle::any_engine_off() const { return std::find(engine_off.begin(), engine_off.end(), true) != engine_off.end(); }
+
+void DriveCycle::set_engine_off(std::vector<bool> off_per_segment) {
+  engine_off = std::move(off_per_segment);
+  if (!any_engine_off()) engine_off.clear();
+}
+
 double DriveCycle::duration_s() const { return time_s.empty() ? 0.0 : time_s.back() - time_s.front(); }
 
 double DriveCycle::distance_m() const {
@@ -149,7 +156,7 @@ void check_engine_off_standing(const CsvTable& table, std::size_t col, DriveCycl
       throw InputError(table.where(r, col), "0 (off) is not allowed while moving (" + format_value(units::mps_to_kmh(std::max(c.speed_mps[r], c.speed_mps[next]))) +
                                                 " km/h over the segment from here): the engine may be off only standing still");
   }
-  if (std::none_of(c.engine_off.begin(), c.engine_off.end(), [](bool b) { return b; })) c.engine_off.clear();
+  c.set_engine_off(std::move(c.engine_off));
 }
 
 }  // namespace

@@ -223,11 +223,11 @@ DriveCycle cycle_of_recording(const Recording& r, double engine_off_min_s, Engin
   if (r.latitude_deg && r.longitude_deg) c.heading_rad = heading_from_gps(*r.latitude_deg, *r.longitude_deg);
   c.engine_hot_start = start == EngineStart::hot;
   if (r.fuel_rate_m3ps && engine_off_min_s > 0.0) {
-    c.engine_off = engine_off_samples(r, engine_off_min_s);
+    std::vector<bool> off = engine_off_samples(r, engine_off_min_s);
     // A segment is off when it starts in a run and the run goes on past it (the run's last sample restarts).
-    for (std::size_t i = 0; i + 1 < c.engine_off.size(); ++i) c.engine_off[i] = c.engine_off[i] && c.engine_off[i + 1];
-    if (!c.engine_off.empty()) c.engine_off.back() = false;
-    if (std::none_of(c.engine_off.begin(), c.engine_off.end(), [](bool b) { return b; })) c.engine_off.clear();
+    for (std::size_t i = 0; i + 1 < off.size(); ++i) off[i] = off[i] && off[i + 1];
+    if (!off.empty()) off.back() = false;
+    c.set_engine_off(std::move(off));
   }
   c.name = r.source;
   c.source = r.source;

@@ -236,7 +236,7 @@ constexpr double kAuxDecayLow_s = 120.0, kAuxDecayHigh_s = 7680.0;
 
 bool switches_engine_off(const SelectionContext& sc) {
   return std::any_of(sc.replayer.cycles.begin(), sc.replayer.cycles.end(),
-                     [](const DriveCycle& c) { return std::find(c.engine_off.begin(), c.engine_off.end(), true) != c.engine_off.end(); });
+                     [](const DriveCycle& c) { return c.any_engine_off(); });
 }
 
 // Each of the effect's shape parameters in turn, the later ones at the earlier ones' values; the first is the

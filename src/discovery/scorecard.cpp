@@ -47,7 +47,7 @@ struct Case {
   bool combustion = false;  ///< run on the combustion car (fuel channel) instead of the bench's electric one
   std::optional<MultiTripCase> trips;  ///< several trips diagnosed together instead of `synth` alone
   int sign = 0;                         ///< RowRule::sign
-  std::string never_called;             ///< RowRule::never_called ("reversed" rows)
+  std::string never_called{};           ///< RowRule::never_called ("reversed" rows); `{}`: rows may leave it out
 };
 
 struct Outcome {

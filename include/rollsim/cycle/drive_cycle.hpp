@@ -30,6 +30,9 @@ struct DriveCycle {
   std::vector<double> heading_rad;
 
   bool engine_off_at(std::size_t segment) const { return segment < engine_off.size() && engine_off[segment]; }
+  bool any_engine_off() const;
+  /// Stores engine_off's documented form: all-running becomes empty, so readers need not search for a true flag.
+  void set_engine_off(std::vector<bool> off_per_segment);
   double duration_s() const;  ///< last time minus first time
   double distance_m() const;  ///< trapezoid integral of speed, exact for the piecewise-linear trace
 

@@ -26,7 +26,8 @@ enum class SyntheticChannel {
   soc,            ///< Recording::soc_fraction, quantised like a BMS display (electric car)
 };
 
-/// What each truth is, which catalogue effect an honest diagnosis should name, and a sweep of sizes.
+/// What each truth is, which catalogue effect an honest diagnosis should name, and a sweep of sizes. Members after
+/// `sweep` carry initialisers (also the strings' `{}`): the truth table's rows leave out what they do not use.
 struct ConcealedTruthInfo {
   std::string truth;            ///< e.g. "aux_compressor"
   std::string catalogue_id;     ///< the effect it should be named as, e.g. "aux_load"
@@ -46,10 +47,10 @@ struct ConcealedTruthInfo {
   bool real_logger = false;
   /// A null for this catalogue id (e.g. an RRC rising over the trip for tyre_warmup): catalogue_id is empty, and
   /// any finding of this id, of either sign, is the mistake the row counts.
-  std::string never_called;
+  std::string never_called{};
   /// The trip the truth is concealed in when it needs its own (empty: the bench's WLTC x2): a shipped cycle, twice,
   /// with an engine-off standstill of soak_s between the two (a cold-start test's soak).
-  std::string cycle;
+  std::string cycle{};
   double soak_s = 0.0;
   /// The trip is driven on a winding route whose latitude and longitude the recording carries.
   bool gps = false;
