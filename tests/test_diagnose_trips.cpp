@@ -26,6 +26,12 @@ const Finding* finding(const Diagnosis& d, const std::string& id) {
   return nullptr;
 }
 
+const ParameterEstimate* parameter(const Finding& f, const std::string& name) {
+  for (const auto& p : f.parameters)
+    if (p.name == name) return &p;
+  return nullptr;
+}
+
 bool has_note(const Diagnosis& d, const std::string& text) {
   return std::any_of(d.notes.begin(), d.notes.end(), [&](const std::string& n) { return n.find(text) != std::string::npos; });
 }
@@ -43,16 +49,15 @@ class AirAt final : public Effect {
   double k_;
 };
 
-// A trip whose measured power is the catalogue's own ambient_rrc module at a known c (an exact linear law, the
-// analytic limit the fit must recover) in the air of that ambient, with white noise; its recorded ambient is
-// `ambient_c`.
-Recording linear_ambient_trip(const Vehicle& v, const std::string& cycle, double ambient_c, double c_per_k, unsigned seed) {
+// A trip whose measured power carries one catalogue module at a known size (an exact law, the analytic limit the fit
+// must recover), optionally in the air of that ambient, with white noise; its recorded ambient is `ambient_c`.
+Recording catalogue_law_trip(const Vehicle& v, const std::string& cycle, double ambient_c, const std::string& effect,
+                             const EffectParameters& params, bool air_at_ambient, unsigned seed) {
   const DriveCycle c = load_cycle(cycle);
   VehicleModel m = VehicleModel::assemble(v);
-  EffectContext ctx;
-  ctx.mass_kg = v.body.test_mass_kg;
-  m.effects.push_back(make_effect("ambient_rrc", {{"rrc_change_per_k", c_per_k}, {"ambient_temp_c", ambient_c}, {"reference_temp_c", 20.0}}, ctx));
-  m.effects.push_back(std::make_shared<AirAt>(v, ambient_c));
+  EffectContext ctx = effect_context(v);
+  m.effects.push_back(make_effect(effect, params, ctx));
+  if (air_at_ambient) m.effects.push_back(std::make_shared<AirAt>(v, ambient_c));
   SimulationOptions so;
   so.record_trace = true;
   const SimulationResult r = simulate_replay(m, c, so);
@@ -69,6 +74,17 @@ Recording linear_ambient_trip(const Vehicle& v, const std::string& cycle, double
   rec.battery_power_w = p;
   rec.ambient_temp_k = std::vector<double>(p.size(), ambient_c + 273.15);
   return rec;
+}
+
+Recording linear_ambient_trip(const Vehicle& v, const std::string& cycle, double ambient_c, double c_per_k, unsigned seed) {
+  return catalogue_law_trip(v, cycle, ambient_c, "ambient_rrc",
+                            {{"rrc_change_per_k", c_per_k}, {"ambient_temp_c", ambient_c}, {"reference_temp_c", 20.0}}, true, seed);
+}
+
+// hvac_ambient's exact law, in the vehicle's air (the diagnosis is then told not to correct the density).
+Recording hvac_law_trip(const Vehicle& v, const std::string& cycle, double ambient_c, double heat, double cool, unsigned seed) {
+  return catalogue_law_trip(v, cycle, ambient_c, "hvac_ambient",
+                            {{"heat_w_per_k", heat}, {"cool_w_per_k", cool}, {"ambient_temp_c", ambient_c}}, false, seed);
 }
 
 TEST(DiagnoseTrips, RecoversALinearAmbientLawAcrossTrips) {
@@ -174,6 +190,42 @@ TEST(DiagnoseTrips, NamesTheConcealedCompoundLawAndNotTheNull) {
     EXPECT_GT(c, 0.7 * 0.008) << diagnosis_text(d);
     EXPECT_LT(c, 2.0 * 0.008) << diagnosis_text(d);
   }
+}
+
+TEST(DiagnoseTrips, HvacDiagnosisRecoversTheLawAcrossTripsWithAnInterval) {
+  // The exact catalogue law, heating 60 W/K and cooling half that, over four trips at -5, 8, 21 and 33 degC.
+  const Vehicle v = ev();
+  DiagnoseOptions opt;
+  opt.air_density_from_ambient = false;  // the trips' air is the vehicle's here
+  const std::vector<Recording> recs{hvac_law_trip(v, "wltc", -5.0, 60.0, 30.0, 1), hvac_law_trip(v, "ftp75", 8.0, 60.0, 30.0, 2),
+                                    hvac_law_trip(v, "artemis_road", 21.0, 60.0, 30.0, 3), hvac_law_trip(v, "wltc", 33.0, 60.0, 30.0, 4)};
+  const Diagnosis d = diagnose(v, recs, opt);
+  ASSERT_FALSE(d.findings.empty()) << diagnosis_text(d);
+  EXPECT_EQ(d.findings.front().effect, "hvac_ambient") << diagnosis_text(d);
+  EXPECT_EQ(finding(d, "ambient_rrc"), nullptr) << diagnosis_text(d);
+  const Finding* f = finding(d, "hvac_ambient");
+  ASSERT_NE(f, nullptr);
+  const ParameterEstimate* heat = parameter(*f, "heat_w_per_k");
+  const ParameterEstimate* cool = parameter(*f, "cool_w_per_k");
+  ASSERT_NE(heat, nullptr);
+  ASSERT_NE(cool, nullptr);
+  EXPECT_EQ(heat->unit, "W/K");
+  EXPECT_LT(heat->ci_low, 60.0) << diagnosis_text(d);
+  EXPECT_GT(heat->ci_high, 60.0) << diagnosis_text(d);
+  EXPECT_GT(heat->ci_low, 0.0);
+  EXPECT_NEAR(cool->value / heat->value, 0.5, 1e-9);  // the grid's ratio that is the truth's
+  EXPECT_TRUE(has_note(d, "hvac_ambient tested across 4 recordings")) << diagnosis_text(d);
+}
+
+TEST(DiagnoseTrips, HvacNotTestedOnOneTripTheSameAmbientOrInTheDeadBand) {
+  const Vehicle v = ev();
+  const Recording cold = hvac_law_trip(v, "wltc", -5.0, 80.0, 0.0, 1);
+  const Diagnosis one = diagnose(v, {cold});
+  EXPECT_EQ(finding(one, "hvac_ambient"), nullptr);
+  EXPECT_TRUE(has_note(one, "hvac_ambient not tested: one recording")) << diagnosis_text(one);
+  const Diagnosis band = diagnose(v, {hvac_law_trip(v, "wltc", 18.5, 80.0, 80.0, 1), hvac_law_trip(v, "ftp75", 23.5, 80.0, 80.0, 2)});
+  EXPECT_EQ(finding(band, "hvac_ambient"), nullptr);
+  EXPECT_TRUE(has_note(band, "within its dead band")) << diagnosis_text(band);
 }
 
 TEST(SparseBaseline, ThresholdSweepIsConsistentAndHasItsLimits) {

@@ -165,16 +165,22 @@ TEST(EffectCatalogue, EnergyBalancesCloseWithEveryEffectOn) {
   }
 }
 
+// ev.yaml's text with its tyre file's path made absolute, so that it can be written anywhere with an effects block.
+std::string ev_yaml_text() {
+  std::ifstream in(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/ev.yaml");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  std::string text = ss.str();
+  const std::string tyres = std::string("all: ") + ROLLSIM_SOURCE_DIR + "/tyres/nominal.yaml";
+  text.replace(text.find("all: nominal.yaml"), std::string("all: nominal.yaml").size(), tyres);
+  return text;
+}
+
 TEST(EffectCatalogue, VehicleFileEffectsBlockIsReadStrictly) {
   const std::string dir = ::testing::TempDir();
   const std::string good = dir + "/ev_effects.yaml";
   {
-    std::ifstream in(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/ev.yaml");
-    std::stringstream ss;
-    ss << in.rdbuf();
-    std::string text = ss.str();
-    const std::string tyres = std::string("all: ") + ROLLSIM_SOURCE_DIR + "/tyres/nominal.yaml";
-    text.replace(text.find("all: nominal.yaml"), std::string("all: nominal.yaml").size(), tyres);
+    const std::string text = ev_yaml_text();
     std::ofstream(good) << text << "effects:\n  aux_load:\n    power_w: 500\n";
     std::ofstream(dir + "/ev_bad.yaml") << text << "effects:\n  aux_load:\n    powr_w: 500\n";
     std::ofstream(dir + "/ev_range.yaml") << text << "effects:\n  wind:\n    headwind_mps: 99\n";
@@ -187,6 +193,27 @@ TEST(EffectCatalogue, VehicleFileEffectsBlockIsReadStrictly) {
   EXPECT_THROW(load_vehicle_file(dir + "/ev_bad.yaml"), InputError);
   EXPECT_THROW(load_vehicle_file(dir + "/ev_range.yaml"), InputError);
   EXPECT_THROW(load_vehicle_file(dir + "/ev_unknown.yaml"), InputError);
+}
+
+TEST(EffectCatalogue, HvacAmbientFromAVehicleFileAndItsDeadBandError) {
+  // hvac_ambient switched on in `simulate` from a vehicle file (issue 10), and an upside-down dead band named.
+  const std::string dir = ::testing::TempDir();
+  const std::string text = ev_yaml_text();
+  std::ofstream(dir + "/ev_hvac.yaml") << text << "effects:\n  hvac_ambient:\n    heat_w_per_k: 60\n    ambient_temp_c: 3\n";
+  std::ofstream(dir + "/ev_hvac_bad.yaml") << text << "effects:\n  hvac_ambient:\n    heat_below_c: 25\n";
+  const Vehicle v = load_vehicle_file(dir + "/ev_hvac.yaml");
+  ASSERT_EQ(v.effects.size(), 1u);
+  EXPECT_EQ(v.effects[0].id, EffectId::hvac_ambient);
+  const DriveCycle c = load_cycle("wltc");
+  const SimulationResult r0 = simulate_replay(VehicleModel::assemble(vehicle("ev.yaml")), c), r1 = simulate_replay(VehicleModel::assemble(v), c);
+  EXPECT_NEAR(r1.energy.battery_terminal_j - r0.energy.battery_terminal_j, 60.0 * 15.0 * r0.duration_s, 1e-6 * r1.energy.battery_terminal_j);
+  try {
+    load_vehicle_file(dir + "/ev_hvac_bad.yaml");
+    FAIL() << "heat_below_c above cool_above_c was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("ev_hvac_bad.yaml"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("cool_above_c"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

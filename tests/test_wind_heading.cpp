@@ -2,6 +2,7 @@
 // steady wind named with its bearing on a winding route (issue 10).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "rollsim/common/units.hpp"
@@ -64,6 +65,18 @@ TEST(WindHeading, SteadyWindOnAWindingRouteIsNamedWithItsBearing) {
   EXPECT_LE(std::min(std::abs(from - 250.0), 360.0 - std::abs(from - 250.0)), 45.0) << from;
   EXPECT_NEAR(f.fitted.at("wind_speed_mps"), 4.0, 1.5);
   EXPECT_NE(f.description.find("from"), std::string::npos);
+  // The bearing's profile interval: closed, narrower than the half circle, holding the truth (unwrapped ends).
+  const auto p = std::find_if(f.parameters.begin(), f.parameters.end(), [](const auto& e) { return e.name == "wind_from_deg"; });
+  ASSERT_NE(p, f.parameters.end());
+  EXPECT_TRUE(p->profiled);
+  EXPECT_FALSE(p->ci_low_open || p->ci_high_open) << p->ci_low << " " << p->ci_high;
+  EXPECT_LT(p->ci_high - p->ci_low, 90.0) << p->ci_low << " " << p->ci_high;
+  EXPECT_LE(p->ci_low, p->value);
+  EXPECT_GE(p->ci_high, p->value);
+  const double truth = p->value + std::remainder(250.0 - p->value, 360.0);  // the truth on the interval's turn
+  EXPECT_GE(truth, p->ci_low) << p->ci_low << " " << p->ci_high;
+  EXPECT_LE(truth, p->ci_high) << p->ci_low << " " << p->ci_high;
+  EXPECT_NE(f.description.find("95 % profile interval"), std::string::npos) << f.description;
 }
 
 TEST(WindHeading, GustyWindOnAWindingRouteIsNamedWithItsMeanBearing) {

@@ -127,16 +127,82 @@ Eigen::VectorXd power_signature(const Observations& o, const std::vector<DriveCy
   return sig;
 }
 
+// hvac_ambient's dead band, as the catalogue's defaults (a car's thermostat is not recorded).
+double hvac_default_c(const std::string& parameter) {
+  for (const auto& p : effect_info(EffectId::hvac_ambient).parameters)
+    if (p.name == parameter) return p.neutral;
+  return 0.0;
+}
+
+double hvac_law_k(double ambient_k, double cool_per_heat) {
+  const double t_c = ambient_k - units::kKelvinOffset;
+  return std::max(0.0, hvac_default_c("heat_below_c") - t_c) + cool_per_heat * std::max(0.0, t_c - hvac_default_c("cool_above_c"));
+}
+
+namespace {
+
+// hvac_ambient needs what ambient_rrc needs, an electrical channel (a combustion car heats its cabin from the
+// coolant, and its A/C load is the engine's: a fuel excess, not a battery draw), and at least one recording outside
+// the dead band (else its law is zero on every trip).
+void note_hvac_setting(AmbientSetting& a, ChannelKind channel, const DiagnoseOptions& opt, std::vector<std::string>& notes) {
+  if (!a.testable) {
+    notes.push_back("hvac_ambient not tested: the recorded ambients span under " + fixed(opt.ambient_min_spread_k, 1) + " K");
+    return;
+  }
+  if (channel == ChannelKind::fuel_rate) {
+    notes.push_back("hvac_ambient not tested: fuel channel (a combustion car heats its cabin from the coolant)");
+    return;
+  }
+  a.hvac_testable = std::any_of(a.ambient_k.begin(), a.ambient_k.end(), [](double t) { return hvac_law_k(t, 1.0) > 0.0; });
+  notes.push_back(a.hvac_testable ? "hvac_ambient tested across " + std::to_string(a.ambient_k.size()) +
+                                        " recordings: each trip's constant electrical load regressed on its ambient"
+                                  : "hvac_ambient not tested: every recorded ambient is within its dead band (" +
+                                        fixed(hvac_default_c("heat_below_c"), 0) + " to " +
+                                        fixed(hvac_default_c("cool_above_c"), 0) + " degC)");
+}
+
+// hvac_ambient: a constant electrical load per trip, k_heat times the law at the trip's ambient, so per unit k_heat
+// aux_load's constant signature (per W, run through the powertrain) times the law on each recording's windows. The
+// ratio of cooling to heating per K is a shape from a grid: heating only, an A/C at half or at the heater's power
+// per K (a heat pump's).
+void add_hvac_candidates(const AmbientSetting& amb, const Observations& o, std::vector<Candidate>& cands) {
+  const auto aux = std::find_if(cands.begin(), cands.end(), [](const Candidate& c) { return c.id == EffectId::aux_load && c.shape.empty(); });
+  if (aux == cands.end()) return;
+  const Eigen::VectorXd& per_w = aux->signature;
+  const EffectInfo& info = effect_info(EffectId::hvac_ambient);
+  for (double ratio : {0.0, 0.5, 1.0}) {
+    Candidate c;
+    c.id = info.id;
+    c.amplitude = &info.amplitude();
+    c.across_trips = Candidate::TripLaw::aux_level;
+    c.cool_per_heat = ratio;
+    c.shape = {{"heat_below_c", hvac_default_c("heat_below_c")}, {"cool_above_c", hvac_default_c("cool_above_c")},
+               {"ambient_temp_c", 21.0}};
+    c.label = info.name + " (cool_w_per_k " + num(ratio) + " x heat_w_per_k)";
+    c.level_signature = per_w;
+    for (double t : amb.ambient_k) c.trip_law.push_back(hvac_law_k(t, ratio));
+    c.signature.resize(o.n());
+    for (Eigen::Index w = 0; w < o.n(); ++w) c.signature[w] = per_w[w] * c.trip_law[o.windows[static_cast<std::size_t>(w)].rec];
+    if (c.signature.norm() > 0.0) cands.push_back(std::move(c));
+  }
+}
+
+}  // namespace
+
 // Ambient temperature on RRC moves the RRC level from trip to trip, never within one: within one trip it is the
 // RRC level (a calibration quantity). It is a candidate only across recordings whose recorded ambients differ.
-AmbientSetting ambient_setting(const std::vector<Recording>& recordings, const DiagnoseOptions& opt, std::vector<std::string>& notes) {
+AmbientSetting ambient_setting(const std::vector<Recording>& recordings, ChannelKind channel, const DiagnoseOptions& opt,
+                               std::vector<std::string>& notes) {
   AmbientSetting a;
   if (recordings.size() < 2) {
     notes.push_back("ambient_rrc not tested: one recording (within one trip it is the RRC level, a calibration quantity)");
+    notes.push_back("hvac_ambient not tested: one recording (within one trip the ambient is constant, and so is its "
+                    "load: a constant aux_load)");
     return a;
   }
   if (!std::all_of(recordings.begin(), recordings.end(), [](const Recording& r) { return r.ambient_temp_k.has_value(); })) {
     notes.push_back("ambient_rrc not tested: not every recording has an ambient_temp_c column");
+    notes.push_back("hvac_ambient not tested: not every recording has an ambient_temp_c column");
     return a;
   }
   for (const auto& r : recordings) {
@@ -153,6 +219,7 @@ AmbientSetting ambient_setting(const std::vector<Recording>& recordings, const D
   // Reference: the recordings' mean ambient, so that the ambient signature is nearly orthogonal to the shared RRC
   // level (whose prior would otherwise push a level offset into the unpenalised ambient coefficient).
   for (double t : a.ambient_k) a.reference_k += t / static_cast<double>(a.ambient_k.size());
+  note_hvac_setting(a, channel, opt, notes);
   return a;
 }
 
@@ -171,10 +238,11 @@ Signatures compute_signatures(const Replayer& rp, const Observations& o, const V
       c.label = info.name;
       c.shape = {{"reference_temp_c", amb.reference_k - units::kKelvinOffset}, {"ambient_temp_c", amb.reference_k - units::kKelvinOffset}};
       c.amplitude = &amp;
-      c.across_trips = true;
+      c.across_trips = Candidate::TripLaw::rrc_level;
       s.candidates.push_back(std::move(c));
       continue;
     }
+    if (info.id == EffectId::hvac_ambient) continue;  // from aux_load's constant variant, below
     if (info.id == EffectId::wind_heading) {
       if (headings_known(rp.cycles)) add_bearing_candidates(info, ctx, extras, s.candidates);
       continue;
@@ -207,7 +275,7 @@ Signatures compute_signatures(const Replayer& rp, const Observations& o, const V
   std::size_t k = 2;
   std::vector<Candidate> kept;
   for (auto& c : s.candidates) {
-    if (c.across_trips) {
+    if (c.across_trips == Candidate::TripLaw::rrc_level) {
       // RRC factor 1 + c (T_ref - T_r) on recording r: per unit c, (T_ref - T_r) times the RRC-level signature
       // (the variant is +10 % RRC; rolling energy is linear in the RRC factor to first order).
       c.signature.resize(o.n());
@@ -232,6 +300,7 @@ Signatures compute_signatures(const Replayer& rp, const Observations& o, const V
     if (c.signature.norm() > 0.0) kept.push_back(std::move(c));
   }
   s.candidates = std::move(kept);
+  if (amb.hvac_testable) add_hvac_candidates(amb, o, s.candidates);
   for (auto& b : s.basis) {
     if (b.kind == BasisShape::force) {
       b.signature = vars[k].window_j - base.window_j;

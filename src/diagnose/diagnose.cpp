@@ -54,6 +54,18 @@ std::vector<DriveCycle> cycles_of(const std::vector<Recording>& recordings, cons
   return cycles;
 }
 
+// The bearing's profile interval in words ("": none), its ends taken back to 0-360 deg.
+std::string bearing_interval_text(const Finding& f) {
+  for (const auto& p : f.parameters) {
+    if (p.name != "wind_from_deg" || !p.profiled) continue;
+    if (p.ci_low_open && p.ci_high_open) return "; its bearing is not determined within a half circle";
+    auto wrap = [](double d) { return std::fmod(std::fmod(d, 360.0) + 360.0, 360.0); };
+    return "; 95 % profile interval " + fixed(wrap(p.ci_low), 0) + (p.ci_low_open ? " or beyond" : "") + " to " +
+           fixed(wrap(p.ci_high), 0) + (p.ci_high_open ? " or beyond" : "") + " deg clockwise";
+  }
+  return "";
+}
+
 // A steady wind is a head- or tailwind only relative to the heading: with it recorded, the wind's speed and bearing;
 // without it, a headwind along the trace, said so.
 void describe_wind(const std::vector<DriveCycle>& cycles, std::vector<Finding>& findings, std::vector<std::string>& notes) {
@@ -64,24 +76,29 @@ void describe_wind(const std::vector<DriveCycle>& cycles, std::vector<Finding>& 
       f.description += std::string(f.description.empty() ? "" : "; ") +
                        "the route's heading is unknown (no latitude and longitude recorded): a headwind along the trace, "
                        "not a wind's speed and direction";
-    if (f.effect == "wind_heading" && f.fitted.count("wind_speed_mps") && f.fitted.count("wind_from_deg") &&
-        f.fitted.at("wind_speed_mps") < 0.0) {
-      // Candidates cover half the compass with a signed speed: report the wind blowing from where it blows.
-      f.fitted["wind_speed_mps"] = -f.fitted.at("wind_speed_mps");
-      f.fitted["wind_from_deg"] = std::fmod(f.fitted.at("wind_from_deg") + 180.0, 360.0);
+    if (f.effect == "wind_heading" && f.fitted.count("wind_speed_mps") && f.fitted.count("wind_from_deg")) {
+      // Candidates and the bearing's profile cover half the compass with a signed speed: report the wind blowing
+      // from where it blows, its bearing in [0, 360) and its profile interval turned with it (unwrapped: its ends may
+      // pass 0 or 360 deg).
+      const bool reverse = f.fitted.at("wind_speed_mps") < 0.0;
+      const double from = f.fitted.at("wind_from_deg") + (reverse ? 180.0 : 0.0);
+      const double turn = std::fmod(std::fmod(from, 360.0) + 360.0, 360.0) - f.fitted.at("wind_from_deg");
+      if (reverse) f.fitted["wind_speed_mps"] = -f.fitted.at("wind_speed_mps");
+      f.fitted["wind_from_deg"] += turn;
       for (auto& p : f.parameters) {
-        if (p.name == "wind_speed_mps") {
+        if (p.name == "wind_speed_mps" && reverse) {
           const double low = -p.ci_high;
           p.ci_high = -p.ci_low, p.ci_low = low, p.value = -p.value;
         } else if (p.name == "wind_from_deg") {
-          p.value = std::fmod(p.value + 180.0, 360.0), p.ci_low = p.ci_high = p.value;
+          p.value += turn, p.ci_low += turn, p.ci_high += turn;
         }
       }
     }
     if (f.effect == "wind_heading" && f.fitted.count("wind_speed_mps") && f.fitted.count("wind_from_deg"))
       f.description += std::string(f.description.empty() ? "" : "; ") + "a steady wind of " +
                        fixed(f.fitted.at("wind_speed_mps"), 1) + " m/s from " + fixed(f.fitted.at("wind_from_deg"), 0) +
-                       " deg (clockwise from north, to 30 deg), its headwind turning with the recorded heading";
+                       " deg (clockwise from north, profiled in 1 deg steps" + bearing_interval_text(f) +
+                       "), its headwind turning with the recorded heading";
   }
 }
 
@@ -237,7 +254,7 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
   out.windows = static_cast<int>(obs.n());
   out.window_s = obs.window_s;
   const EffectContext ctx = effect_context(vehicle);
-  const AmbientSetting amb = ambient_setting(recordings, opt, out.notes);
+  const AmbientSetting amb = ambient_setting(recordings, obs.channel, opt, out.notes);
   Replayer rp{vehicle, cycles, {}, obs.channel == ChannelKind::soc, opt.threads};
   // Air density follows the recorded ambient (rho ~ 1 / T at one pressure, the vehicle's taken at 20 degC): known
   // physics of the replay where ambient_rrc is tested, not left for it to absorb.

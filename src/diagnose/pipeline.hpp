@@ -184,7 +184,13 @@ struct Candidate {
   EffectParameters shape;
   const EffectParameterInfo* amplitude = nullptr;
   Eigen::VectorXd signature;  // window energy per unit amplitude
-  bool across_trips = false;  // ambient_rrc: a per-recording level from the RRC-level variant (no own run)
+  /// Across-trip candidates (no own run): ambient_rrc a per-recording RRC level (from the RRC-level variant),
+  /// hvac_ambient a per-recording constant electrical load (from aux_load's constant variant) following a law of
+  /// the recorded ambient.
+  enum class TripLaw { none, rrc_level, aux_level } across_trips = TripLaw::none;
+  std::vector<double> trip_law;  // hvac_ambient: per recording, the load per unit amplitude [W per W/K]
+  double cool_per_heat = 0.0;    // hvac_ambient: k_cool / k_heat of this candidate (a shape from a small grid)
+  Eigen::VectorXd level_signature;  // hvac_ambient: aux_load's constant signature, per W
   /// wind_heading: mixed from the two runs with the wind from the north and from the east (no own run), as
   /// cos(theta) x north + sin(theta) x east: the headwind w cos(theta - psi) is linear in them.
   bool mixed_bearing = false;
@@ -210,11 +216,16 @@ Eigen::VectorXd power_signature(const Observations& o, const std::vector<DriveCy
 
 struct AmbientSetting {
   bool testable = false;
+  bool hvac_testable = false;  // also an electric channel and a recording outside hvac_ambient's dead band
   std::vector<double> ambient_k;  // per recording
   double reference_k = 0.0;
 };
-AmbientSetting ambient_setting(const std::vector<Recording>& recordings, const DiagnoseOptions& opt,
+AmbientSetting ambient_setting(const std::vector<Recording>& recordings, ChannelKind channel, const DiagnoseOptions& opt,
                                std::vector<std::string>& notes);
+/// hvac_ambient's law at a recording's ambient, per W/K of heating: max(0, T_heat - T) + r max(0, T - T_cool) [K].
+double hvac_law_k(double ambient_k, double cool_per_heat);
+/// hvac_ambient's default of a dead-band parameter ("heat_below_c", "cool_above_c") [degC].
+double hvac_default_c(const std::string& parameter);
 
 struct Signatures {
   Variant base, rrc, drag;
@@ -248,6 +259,14 @@ struct ProfileResult {
 };
 ProfileResult profile_time_constant(const Model& m, const TimeProfile& tp, const Eigen::VectorXd& selected_signature,
                                     const Scored& selected_score, double amp_min, double amp_max);
+
+/// wind_heading's bearing: the criterion profiled in 1 deg steps over the half circle centred on the selected
+/// candidate's bearing (the other half is the same wind with the opposite sign), each signature mixed from the north
+/// and east ones (no replay); its best adopted as profile_time_constant's is. The interval is where
+/// n_eff ln(RSS / RSS_min) < 3.84, unwrapped (it may pass 0 or 360 deg), open where it reaches +-90 deg.
+ProfileResult profile_bearing(const Model& m, double selected_deg, const Eigen::VectorXd& north, const Eigen::VectorXd& east,
+                              const Eigen::VectorXd& selected_signature, const Scored& selected_score, double amp_min,
+                              double amp_max);
 
 struct SelectionContext {
   const Replayer& replayer;

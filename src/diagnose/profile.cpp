@@ -4,16 +4,16 @@
 
 #include "pipeline.hpp"
 #include "rollsim/common/error.hpp"
+#include "rollsim/common/units.hpp"
 
 namespace rollsim {
 
-ProfileInterval profile_likelihood_interval(const std::vector<double>& grid, const std::vector<double>& rss, double n_eff,
-                                            double critical) {
-  if (grid.empty() || grid.size() != rss.size()) throw InputError("profile", "grid and RSS must be non-empty and of one length");
-  for (std::size_t i = 0; i < grid.size(); ++i) {
-    if (!(grid[i] > 0.0) || (i > 0 && !(grid[i] > grid[i - 1]))) throw InputError("profile", "grid must be positive and ascending");
-    if (!(rss[i] > 0.0)) throw InputError("profile", "RSS must be positive");
-  }
+namespace {
+
+// The interval about the least RSS of an ascending grid, its ends interpolated in log(parameter) (a scale parameter)
+// or linearly (an angle).
+ProfileInterval interval_on_grid(const std::vector<double>& grid, const std::vector<double>& rss, double n_eff, double critical,
+                                 bool log_axis) {
   ProfileInterval p;
   p.best = static_cast<std::size_t>(std::min_element(rss.begin(), rss.end()) - rss.begin());
   p.value = grid[p.best];
@@ -22,6 +22,7 @@ ProfileInterval profile_likelihood_interval(const std::vector<double>& grid, con
   auto crossing = [&](std::size_t i, std::size_t o) {
     const double si = stat(i), so = stat(o);
     const double f = so > si ? (critical - si) / (so - si) : 0.0;
+    if (!log_axis) return grid[i] + f * (grid[o] - grid[i]);
     return std::exp(std::log(grid[i]) + f * (std::log(grid[o]) - std::log(grid[i])));
   };
   std::size_t lo = p.best, hi = p.best;
@@ -32,6 +33,18 @@ ProfileInterval profile_likelihood_interval(const std::vector<double>& grid, con
   p.low = p.low_open ? grid.front() : crossing(lo, lo - 1);
   p.high = p.high_open ? grid.back() : crossing(hi, hi + 1);
   return p;
+}
+
+}  // namespace
+
+ProfileInterval profile_likelihood_interval(const std::vector<double>& grid, const std::vector<double>& rss, double n_eff,
+                                            double critical) {
+  if (grid.empty() || grid.size() != rss.size()) throw InputError("profile", "grid and RSS must be non-empty and of one length");
+  for (std::size_t i = 0; i < grid.size(); ++i) {
+    if (!(grid[i] > 0.0) || (i > 0 && !(grid[i] > grid[i - 1]))) throw InputError("profile", "grid must be positive and ascending");
+    if (!(rss[i] > 0.0)) throw InputError("profile", "RSS must be positive");
+  }
+  return interval_on_grid(grid, rss, n_eff, critical, true);
 }
 
 namespace diag {
@@ -48,6 +61,30 @@ std::vector<double> log_grid(double low, double high, int per_octave, double als
   std::sort(g.begin(), g.end());
   return g;
 }
+
+namespace {
+
+// Adopts the profile's best grid point (its signature and score) if its amplitude is within bounds and it also fits
+// better out of fold; otherwise the selection's value stays. The value kept is always inside the interval.
+void keep_best_if_better(const Model& m, const std::vector<double>& grid, const Eigen::VectorXd& best_signature, double selected,
+                         double amp_min, double amp_max, ProfileResult& r) {
+  double kept = selected;
+  if (grid[r.interval.best] != selected) {
+    Scored s = score_column(m, best_signature);
+    add_heldout(m, best_signature, s);
+    const double amp = s.amplitude();
+    if (amp >= amp_min && amp <= amp_max && rmse(s.heldout, *m.y) < rmse(r.score.heldout, *m.y)) {
+      r.score = s;
+      r.signature = best_signature;
+      kept = grid[r.interval.best];
+    }
+  }
+  r.interval.value = kept;
+  r.interval.low = std::min(r.interval.low, kept);
+  r.interval.high = std::max(r.interval.high, kept);
+}
+
+}  // namespace
 
 // Only for a found effect, so a recording with nothing to find costs nothing more.
 ProfileResult profile_time_constant(const Model& m, const TimeProfile& tp, const Eigen::VectorXd& selected_signature,
@@ -67,21 +104,24 @@ ProfileResult profile_time_constant(const Model& m, const TimeProfile& tp, const
     rss.push_back(inert ? m.fit.rss : least_squares(hcat(m.x, sigs.back()), *m.y, m.prior).rss);
   }
   ProfileResult r{profile_likelihood_interval(tp.grid, rss, m.n_eff), tp.parameter, selected_signature, selected_score, {}};
-  double kept = tp.selected;
-  if (tp.grid[r.interval.best] != tp.selected) {
-    Scored s = score_column(m, sigs[r.interval.best]);
-    add_heldout(m, sigs[r.interval.best], s);
-    const double amp = s.amplitude();
-    if (amp >= amp_min && amp <= amp_max && rmse(s.heldout, *m.y) < rmse(selected_score.heldout, *m.y)) {
-      r.score = s;
-      r.signature = sigs[r.interval.best];
-      kept = tp.grid[r.interval.best];
-    }
+  keep_best_if_better(m, tp.grid, sigs[r.interval.best], tp.selected, amp_min, amp_max, r);
+  return r;
+}
+
+ProfileResult profile_bearing(const Model& m, double selected_deg, const Eigen::VectorXd& north, const Eigen::VectorXd& east,
+                              const Eigen::VectorXd& selected_signature, const Scored& selected_score, double amp_min,
+                              double amp_max) {
+  constexpr double kStepDeg = 1.0, kHalfDeg = 90.0;
+  std::vector<double> grid, rss;
+  std::vector<Eigen::VectorXd> sigs;
+  for (double d = -kHalfDeg; d <= kHalfDeg + 1e-9; d += kStepDeg) {
+    const double th = units::deg_to_rad(selected_deg + d);
+    grid.push_back(d == 0.0 ? selected_deg : selected_deg + d);
+    sigs.push_back(std::cos(th) * north + std::sin(th) * east);
+    rss.push_back(least_squares(hcat(m.x, sigs.back()), *m.y, m.prior).rss);
   }
-  // The value kept is the selection's when the profile's best did not also fit better held out: keep it inside.
-  r.interval.value = kept;
-  r.interval.low = std::min(r.interval.low, kept);
-  r.interval.high = std::max(r.interval.high, kept);
+  ProfileResult r{interval_on_grid(grid, rss, m.n_eff, 3.84, false), "wind_from_deg", selected_signature, selected_score, {}};
+  keep_best_if_better(m, grid, sigs[r.interval.best], selected_deg, amp_min, amp_max, r);
   return r;
 }
 

@@ -30,6 +30,8 @@ std::string separating_test(const std::string& a, const std::string& b) {
       {"road_profile", "mass", "record elevation, or drive the route in both directions: hills reverse, a mass error does not"},
       {"road_profile", "aux_load", "log a standstill: a road does nothing to a standing car, a load draws"},
       {"road_profile", "tyre_warmup", "drive the route again warm: a road repeats at the same place, a warm-up does not"},
+      {"hvac_ambient", "ambient_rrc", "log a standstill of a few minutes on a cold and on a mild day: a cabin load draws standing, rolling resistance only rolling"},
+      {"hvac_ambient", "aux_load", "drive on days of different ambient, or log the HVAC's setting: a cabin load follows the ambient, other consumers do not"},
   };
   for (const auto& [x, y, text] : kTests) {
     if ((a == x && b == y) || (a == y && b == x)) return text;
@@ -64,6 +66,18 @@ constexpr ShapeParameter kShapeParameters[] = {
 struct TripLevel {
   double c = 0.0, se = 0.0, dbic = -1e300;
 };
+
+// GLS of the trips' levels `a` (covariance v) on an intercept and the law's regressor x: the slope and its variance.
+std::pair<double, double> gls_slope(const Eigen::MatrixXd& v, const Eigen::VectorXd& a, const Eigen::VectorXd& x) {
+  Eigen::MatrixXd design(a.size(), 2);
+  design.col(0).setOnes();
+  design.col(1) = x;
+  const Eigen::MatrixXd vinv = v.inverse();
+  const Eigen::MatrixXd cov = (design.transpose() * vinv * design).inverse();
+  const Eigen::VectorXd beta = cov * design.transpose() * vinv * a;
+  return {beta[1], cov(1, 1)};
+}
+
 TripLevel trip_level_ambient(const SelectionContext& sc, const Model& m) {
   TripLevel t;
   const Observations& o = sc.obs;
@@ -96,26 +110,87 @@ TripLevel trip_level_ambient(const SelectionContext& sc, const Model& m) {
     const double air_coef = ss > 0.0 ? sc.opt.trip_air_density_scatter * std::abs(s) / 0.1 * sa / ss : 0.0;
     v(r, r) += air_coef * air_coef;
   }
-  Eigen::MatrixXd design(nr, 2);
-  Eigen::VectorXd a(nr);
+  Eigen::VectorXd x(nr), a(nr);
   for (Eigen::Index r = 0; r < nr; ++r) {
-    design(r, 0) = 1.0;
-    design(r, 1) = sc.ambient.reference_k - sc.ambient.ambient_k[static_cast<std::size_t>(r)];
+    x[r] = sc.ambient.reference_k - sc.ambient.ambient_k[static_cast<std::size_t>(r)];
     a[r] = f.coef[1 + r];
   }
-  const Eigen::MatrixXd vinv = v.inverse();
-  const Eigen::MatrixXd cov = (design.transpose() * vinv * design).inverse();
-  const Eigen::VectorXd beta = cov * design.transpose() * vinv * a;
-  t.c = 0.1 * beta[1] / s;
-  t.se = 0.1 * std::sqrt(std::max(0.0, cov(1, 1))) / std::abs(s);
-  t.dbic = beta[1] * beta[1] / std::max(1e-300, cov(1, 1)) - std::log(static_cast<double>(nr));
+  const auto [beta, var] = gls_slope(v, a, x);
+  t.c = 0.1 * beta / s;
+  t.se = 0.1 * std::sqrt(std::max(0.0, var)) / std::abs(s);
+  t.dbic = beta * beta / std::max(1e-300, var) - std::log(static_cast<double>(nr));
+  return t;
+}
+
+// The coefficient of `b` in the least squares of `y` on the columns a and b over recording r's windows (0 if
+// singular): how much of y a trip-level change of b would take.
+double trip_projection(const Observations& o, Eigen::Index r, const Eigen::VectorXd& y, const Eigen::VectorXd& a,
+                       const Eigen::VectorXd& b) {
+  double aa = 0.0, ab = 0.0, bb = 0.0, ay = 0.0, by = 0.0;
+  for (Eigen::Index w = 0; w < o.n(); ++w) {
+    if (static_cast<Eigen::Index>(o.windows[static_cast<std::size_t>(w)].rec) != r) continue;
+    aa += a[w] * a[w], ab += a[w] * b[w], bb += b[w] * b[w], ay += a[w] * y[w], by += b[w] * y[w];
+  }
+  const double det = aa * bb - ab * ab;
+  return det > 1e-12 * std::max(1e-300, aa * bb) ? (aa * by - ab * ay) / det : 0.0;
+}
+
+// hvac_ambient's evidence on the trips, as ambient_rrc's: each trip's own constant electrical load, beside its own
+// RRC level (both split per recording, so that neither the trips' RRC scatter nor an ambient law of RRC becomes a
+// load: a load draws power in time, standing too, a rolling resistance a force over the distance, and each trip's
+// stops and speeds tell the two apart), regressed on the law at the trip's ambient by GLS with the fit's covariance
+// plus a scatter fixed in advance (the car's other consumers; the day's unrecorded air density projected onto the
+// trip's load). A found aux_load's column is dropped: the trips' own loads span it. Returns k_heat [W/K].
+TripLevel trip_level_aux(const SelectionContext& sc, const Model& m, const Candidate& c, const std::vector<EffectId>& chosen) {
+  TripLevel t;
+  const Observations& o = sc.obs;
+  const Eigen::Index n = o.n();
+  const auto nr = static_cast<Eigen::Index>(sc.recordings.size());
+  const Eigen::MatrixXd& xm = m.x;
+  std::vector<Eigen::Index> kept;
+  for (Eigen::Index j = 3; j < xm.cols(); ++j) {
+    const auto k = static_cast<std::size_t>(j - 3);
+    if (!(k < chosen.size() && chosen[k] == EffectId::aux_load)) kept.push_back(j);
+  }
+  const auto nk = static_cast<Eigen::Index>(kept.size()), load0 = 2 + nr + nk;
+  // Columns: scale, RRC per trip, aero, the found effects kept, load per trip.
+  Eigen::MatrixXd xt = Eigen::MatrixXd::Zero(n, load0 + nr);
+  xt.col(0) = xm.col(0);
+  xt.col(1 + nr) = xm.col(2);
+  for (Eigen::Index k = 0; k < nk; ++k) xt.col(2 + nr + k) = xm.col(kept[static_cast<std::size_t>(k)]);
+  for (Eigen::Index w = 0; w < n; ++w) {
+    const auto r = static_cast<Eigen::Index>(o.windows[static_cast<std::size_t>(w)].rec);
+    xt(w, 1 + r) = xm(w, 1);
+    xt(w, load0 + r) = c.level_signature[w];
+  }
+  Prior pt;
+  pt.boxes = {m.prior.boxes.front()};
+  for (Eigen::Index r = 0; r < nr; ++r) pt.rows.push_back({1 + r, m.prior.rows[0].weight, 0.0});
+  pt.rows.push_back({1 + nr, m.prior.rows[1].weight, 0.0});
+  const Fit f = least_squares(xt, o.measured_j, pt);
+  const double s = f.coef[0];
+  if (!(std::abs(s) > 0.0)) return t;
+  Eigen::MatrixXd v = f.cov.block(load0, load0, nr, nr) * (m.inflate * m.inflate);
+  Eigen::VectorXd x(nr), a(nr);
+  for (Eigen::Index r = 0; r < nr; ++r) {
+    const double own_w = sc.opt.trip_aux_scatter_w * std::abs(s);
+    const double air = sc.opt.trip_air_density_scatter * std::abs(s) / 0.1 *
+                       trip_projection(o, r, xm.col(2), xm.col(1), c.level_signature);  // aero column: per 10 %
+    v(r, r) += own_w * own_w + air * air;
+    x[r] = c.trip_law[static_cast<std::size_t>(r)];
+    a[r] = f.coef[load0 + r];
+  }
+  const auto [beta, var] = gls_slope(v, a, x);
+  t.c = beta / s;
+  t.se = std::sqrt(std::max(0.0, var)) / std::abs(s);
+  t.dbic = beta * beta / std::max(1e-300, var) - std::log(static_cast<double>(nr));
   return t;
 }
 
 struct Passing {
   std::size_t idx;
   Scored score;
-  double se_amplitude = 0.0;  // ambient_rrc: the trip-level standard error (else 0: the fit's own)
+  double se_amplitude = 0.0;  // across trips: the trip-level standard error (else 0: the fit's own)
   bool wrong_sign = false;    // the fit needs the physically impossible sign
   bool standing = false;      // passed on the standing residual's evidence (aux_load)
 };
@@ -142,9 +217,9 @@ std::vector<Passing> passing_candidates(const SelectionContext& sc, const std::v
     p.standing = c.id == EffectId::aux_load && !p.wrong_sign && standing_bic(sc) >= sc.opt.standing_bic_threshold;
     if (p.score.dbic < sc.opt.bic_threshold && !p.standing) continue;
     if (!p.wrong_sign && (amp < c.min() || amp > c.max())) continue;
-    if (c.across_trips) {
-      // It must also pass the same threshold on the trips' RRC levels, against trip-to-trip scatter.
-      const TripLevel t = trip_level_ambient(sc, m);
+    if (c.across_trips != Candidate::TripLaw::none) {
+      // It must also pass the same threshold on the trips' own levels, against trip-to-trip scatter.
+      const TripLevel t = c.across_trips == Candidate::TripLaw::rrc_level ? trip_level_ambient(sc, m) : trip_level_aux(sc, m, c, chosen);
       if (t.dbic < sc.opt.bic_threshold) continue;
       p.se_amplitude = t.se;
     }
@@ -166,8 +241,22 @@ bool switches_engine_off(const SelectionContext& sc) {
 
 // Each of the effect's shape parameters in turn, the later ones at the earlier ones' values; the first is the
 // finding's profile, the later ones travel as its profiled nuisance parameters.
-std::optional<ProfileResult> refine(const SelectionContext& sc, Candidate& c, const Model& m, Passing& best) {
+std::optional<ProfileResult> refine(const SelectionContext& sc, const std::vector<Candidate>& cands, Candidate& c, const Model& m,
+                                    Passing& best) {
   if (c.id == EffectId::aux_load) return refine_aux_decay(sc, c, m, best.score, kAuxDecayLow_s, kAuxDecayHigh_s);
+  if (c.mixed_bearing) {
+    // The north (0 deg) and east (90 deg) candidates' signatures span every bearing's.
+    const Eigen::VectorXd* axis[2] = {nullptr, nullptr};
+    for (const auto& o : cands)
+      if (o.mixed_bearing && (o.shape.at("wind_from_deg") == 0.0 || o.shape.at("wind_from_deg") == 90.0))
+        axis[o.shape.at("wind_from_deg") == 0.0 ? 0 : 1] = &o.signature;
+    if (!axis[0] || !axis[1]) return std::nullopt;
+    ProfileResult r = profile_bearing(m, c.shape.at("wind_from_deg"), *axis[0], *axis[1], c.signature, best.score, c.min(), c.max());
+    c.shape["wind_from_deg"] = r.interval.value;
+    c.signature = r.signature;
+    best.score = r.score;
+    return r;
+  }
   std::optional<ProfileResult> out;
   for (const auto& tp : kShapeParameters) {
     if (c.id != tp.effect) continue;
@@ -210,6 +299,23 @@ std::optional<ProfileResult> refine(const SelectionContext& sc, Candidate& c, co
   return out;
 }
 
+// hvac_ambient: the cooling coefficient as the candidate's ratio of the heating one (its interval scaled with it), and
+// the law in words.
+void describe_hvac(const SelectionContext& sc, const Candidate& c, double se, Finding& f) {
+  const ParameterEstimate heat = f.parameters.front();
+  const double r = c.cool_per_heat;
+  f.parameters.push_back({"cool_w_per_k", heat.unit, r * heat.value, r * heat.ci_low, r * heat.ci_high});
+  f.fitted["cool_w_per_k"] = r * heat.value;
+  const auto [lo, hi] = std::minmax_element(sc.ambient.ambient_k.begin(), sc.ambient.ambient_k.end());
+  f.description = "each trip's constant electrical load follows its ambient across the recordings (" +
+                  fixed(*lo - units::kKelvinOffset, 1) + " to " + fixed(*hi - units::kKelvinOffset, 1) + " degC): heating " +
+                  fixed(heat.value, 1) + " W/K [" + fixed(heat.value - 1.96 * se, 1) + ", " + fixed(heat.value + 1.96 * se, 1) +
+                  "] below " + fixed(hvac_default_c("heat_below_c"), 0) + " degC, cooling " + num(r) +
+                  " x that above " + fixed(hvac_default_c("cool_above_c"), 0) +
+                  " degC (ratio from 0, 0.5, 1); a load draws power in time and standing, unlike RRC's force over the "
+                  "distance; the written vehicle is neutral at 21 degC, set ambient_temp_c per trip";
+}
+
 Finding catalogue_finding(const SelectionContext& sc, const Candidate& c, const Passing& best,
                           const std::optional<ProfileResult>& prof, double inflate) {
   const EffectInfo& info = effect_info(c.id);
@@ -222,7 +328,8 @@ Finding catalogue_finding(const SelectionContext& sc, const Candidate& c, const 
   f.parameters.push_back({c.amplitude->name, c.amplitude->unit, value, value - 1.96 * se, value + 1.96 * se});
   f.fitted = c.shape;
   f.fitted[c.amplitude->name] = value;
-  if (c.across_trips) {
+  if (c.across_trips == Candidate::TripLaw::aux_level) describe_hvac(sc, c, se, f);
+  if (c.across_trips == Candidate::TripLaw::rrc_level) {
     const auto [lo, hi] = std::minmax_element(sc.ambient.ambient_k.begin(), sc.ambient.ambient_k.end());
     f.description = "RRC level follows ambient temperature across the recordings (" + fixed(*lo - units::kKelvinOffset, 1) + " to " +
                     fixed(*hi - units::kKelvinOffset, 1) + " degC): " + fixed(100.0 * value, 2) + " % per K colder, referred to " +
@@ -304,7 +411,7 @@ std::vector<Finding> select_effects(const SelectionContext& sc, const std::vecto
     if (best.wrong_sign) {
       f = wrong_sign_finding(c, best, m.inflate);
     } else {
-      const std::optional<ProfileResult> prof = refine(sc, c, m, best);
+      const std::optional<ProfileResult> prof = refine(sc, cands, c, m, best);
       f = catalogue_finding(sc, c, best, prof, m.inflate);
       add_confounders(f, c, cands, passing, m, sc.opt.collinear_corr);
     }

@@ -361,6 +361,11 @@ const std::vector<ConcealedTruthInfo>& concealed_truths() {
        "the steady GPS wind with along-wind Ornstein-Uhlenbeck gusts (sd 1.5 m/s, 15 s) about its mean, on the same "
        "winding routes",
        {2.0, 4.0, 6.0}, SyntheticChannel::battery_power, false, 0, false, "", "", 0.0, true},
+      // Issue 10's HVAC law of the ambient, across trips (appended: multi-trip rows have their own seed blocks).
+      {"hvac_cabin", "hvac_ambient", "W/K (cabin heat loss UA)",
+       "EV heater (PTC, COP 1) below the driver's 17-19 degC and A/C (COP 2.5-3.5 at 25 degC, falling 0.05 per K, sun "
+       "100-400 W) above 23-25 degC, blower 100-200 W while either runs; steady within a trip; trips at -5..35 degC",
+       {10, 20, 40}, SyntheticChannel::battery_power, true, +1, false, "", "", 0.0, false},
   };
   return kTruths;
 }
@@ -455,6 +460,10 @@ Recording generate_case(const Vehicle& vehicle, const SyntheticCase& o) {
       const double c_per_k = e.size * (1.0 + 0.1 * unit(truth_rng));
       const double c2_k = 150.0 + 30.0 * unit(truth_rng);
       truths.push_back(std::make_shared<AmbientCompoundTruth>(c_per_k, c2_k, *o.ambient_temp_c, t == "ambient_cold_start"));
+    } else if (t == "hvac_cabin") {
+      if (!o.ambient_temp_c) throw InputError("concealed truth 'hvac_cabin'", "needs the trip's ambient temperature");
+      if (o.channel == SyntheticChannel::fuel_rate) throw InputError("concealed truth 'hvac_cabin'", "needs an electric channel");
+      truths.push_back(hvac_cabin_truth(cabin_climate(e.size, truth_rng), *o.ambient_temp_c));
     } else if (t == "tyre_two_node") {
       truths.push_back(std::make_shared<TwoNodeTyreTruth>(e.size, o.time_reversed, c.duration_s()));
     } else if (t == "aux_compressor") {

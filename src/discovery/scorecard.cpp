@@ -202,6 +202,16 @@ std::vector<Case> build_cases(const BenchOptions& o) {
       add_trips("trips", "ambient_compound " + num(size) + " /K, 4 trips -5..30 degC", {{"ambient_compound", size}},
                 {"ambient_rrc"}, o.quick ? std::max(1, o.seeds / 2) : o.seeds, trip_block);
     }
+    // Cabin conditioning by the ambient: the same four trips over -5..35 degC (heating and cooling days).
+    const ConcealedTruthInfo& hvac = concealed_truth("hvac_cabin");
+    unsigned hvac_block = 110000;
+    for (double size : hvac.sweep) {
+      hvac_block += 1000;
+      if (o.quick) continue;
+      add_trips("trips", "hvac_cabin " + num(size) + " W/K, 4 trips -5..35 degC", {{"hvac_cabin", size}}, {"hvac_ambient"},
+                o.seeds, hvac_block);
+      cases.back().trips->ambient_max_c = 35.0;
+    }
     if (!o.quick) {
       // Cold starts: the tyre starts each trip at ambient, so a colder trip also warms up more (both effects true).
       add_trips("two", "ambient_cold_start 0.008 /K (+ tyre warm-up), 4 trips", {{"ambient_cold_start", 0.008}},
@@ -488,7 +498,7 @@ std::string bench_text(const BenchResult& r) {
       group = row.group;
       os << (group == "single"  ? "Single concealed effects (truth -> expected catalogue id)"
              : group == "pair"  ? "Confounded pairs"
-             : group == "trips" ? "Across trips: ambient temperature on RRC (4 trips diagnosed together, held out by trip)"
+             : group == "trips" ? "Across trips: ambient temperature on RRC and on the cabin's load (4 trips diagnosed together, held out by trip)"
                                 : "Two effects at once")
          << "\n"
          << std::left << std::setw(lw) << "case" << std::setw(18) << "expected" << std::right << std::setw(14) << "rollsim"

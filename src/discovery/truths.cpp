@@ -59,6 +59,16 @@ class WinterHeaterTruth final : public Effect {
   WinterCabin c_;
 };
 
+class HvacCabinTruth final : public Effect {
+ public:
+  explicit HvacCabinTruth(double power_w) : p_(power_w) {}
+  std::string id() const override { return "truth_hvac_cabin"; }
+  double extra_electric_power_w(const EffectInputs&, const double*) const override { return p_; }
+
+ private:
+  double p_;
+};
+
 class RisingRrcTruth final : public Effect {
  public:
   RisingRrcTruth(double rise, double duration_s, double power) : rise_(rise), t_(duration_s), p_(power) {}
@@ -235,6 +245,29 @@ WinterCabin winter_cabin(double max_power_w, std::mt19937& rng) {
 }
 
 std::shared_ptr<const Effect> winter_heater_truth(const WinterCabin& cabin) { return std::make_shared<WinterHeaterTruth>(cabin); }
+
+double CabinClimate::power_w(double ambient_c) const {
+  if (ambient_c < heat_below_c) return ua_w_per_k * (heat_below_c - ambient_c) + blower_w;
+  if (ambient_c <= cool_above_c) return 0.0;
+  const double cop = std::max(1.5, cop_at_25c - cop_per_k * (ambient_c - 25.0));
+  return (ua_w_per_k * (ambient_c - cool_above_c) + solar_w) / cop + blower_w;
+}
+
+CabinClimate cabin_climate(double ua_w_per_k, std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  CabinClimate c;
+  c.ua_w_per_k = ua_w_per_k;
+  c.heat_below_c = 17.0 + 2.0 * u(rng);
+  c.cool_above_c = 23.0 + 2.0 * u(rng);
+  c.solar_w = 100.0 + 300.0 * u(rng);
+  c.blower_w = 100.0 + 100.0 * u(rng);
+  c.cop_at_25c = 2.5 + u(rng);
+  return c;
+}
+
+std::shared_ptr<const Effect> hvac_cabin_truth(const CabinClimate& c, double ambient_c) {
+  return std::make_shared<HvacCabinTruth>(c.power_w(ambient_c));
+}
 
 std::shared_ptr<const Effect> rising_rrc_truth(double rise, double duration_s, double power) {
   return std::make_shared<RisingRrcTruth>(rise, duration_s, power);

@@ -70,6 +70,9 @@ struct DiagnoseOptions {
   /// Trip-to-trip scatter (sd) of the RRC level at one ambient (tyre pressure +-0.1 bar, road surface): ambient_rrc
   /// must explain the trips' RRC levels beyond it.
   double trip_rrc_scatter = 0.01;
+  /// Trip-to-trip scatter (sd) of a car's constant electrical load at one ambient [W] (lights, wipers, seat heaters
+  /// on some trips and not others): hvac_ambient must explain the trips' load levels beyond it.
+  double trip_aux_scatter_w = 50.0;
   /// Trip-to-trip scatter (sd) of the air density that the recorded ambient does not explain (barometric pressure,
   /// about +-10 hPa day to day), projected onto each trip's RRC level and added to the scatter above.
   double trip_air_density_scatter = 0.01;

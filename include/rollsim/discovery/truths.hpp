@@ -58,6 +58,23 @@ struct WinterCabin {
 /// 15-30 kJ/K, blower 100-200 W.
 WinterCabin winter_cabin(double max_power_w, std::mt19937& rng);
 std::shared_ptr<const Effect> winter_heater_truth(const WinterCabin& cabin);
+/// An electric car's cabin conditioning on a trip at one ambient, steady (the trip's mean): a PTC heater (COP 1)
+/// replacing the cabin's loss UA (T_heat - T_amb) below the driver's heating threshold, an A/C removing
+/// UA (T_amb - T_cool) plus the sun through the glass above the cooling one at a COP falling as the ambient rises,
+/// and a blower whenever either runs. Not the catalogue's law: the blower steps on at the thresholds, the sun is a
+/// load at any hot ambient, the COP bends the cooling branch, and the thresholds move from trip to trip.
+struct CabinClimate {
+  double ua_w_per_k = 50.0;  ///< the cabin's heat loss per K (glass, body, ventilation): the row's size
+  double heat_below_c = 18.0, cool_above_c = 24.0;
+  double solar_w = 200.0, blower_w = 150.0;
+  double cop_at_25c = 3.0, cop_per_k = 0.05;  ///< COP = cop_at_25c - cop_per_k (T - 25 degC), at least 1.5
+  double power_w(double ambient_c) const;     ///< the electrical power at that ambient
+};
+/// One trip's climate control (each trip its own draw: the driver's thresholds 17-19 and 23-25 degC, sun 100-400 W,
+/// blower 100-200 W, COP 2.5-3.5 at 25 degC falling 0.05 per K).
+CabinClimate cabin_climate(double ua_w_per_k, std::mt19937& rng);
+std::shared_ptr<const Effect> hvac_cabin_truth(const CabinClimate& c, double ambient_c);
+
 /// RRC rising over the trip (rain, a road surface turning rough, a slow puncture): factor 1 + rise (t / T)^p.
 std::shared_ptr<const Effect> rising_rrc_truth(double rise, double duration_s, double power);
 

@@ -28,6 +28,7 @@ enum class EffectId {
   road_grade,
   road_profile,
   wind_heading,
+  hvac_ambient,
 };
 
 /// What an effect needs to know about the car it is fitted to (set from the vehicle description).
