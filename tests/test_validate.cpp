@@ -466,6 +466,11 @@ TEST(CliValidate, JsonRowsAndANamedErrorForAFileWithoutTheColumns) {
   EXPECT_EQ(rows.size(), 40u);
   EXPECT_NE(rows.front().find("\"test_number\": \"KASX10055440\""), std::string::npos) << rows.front();
   EXPECT_NE(rows.front().find("\"error_pct\": "), std::string::npos);
+  // An FTP row (the first is the Aston Martin DBS's) carries its three predicted bags; a HWFET row none.
+  for (const char* key : {"\"predicted_bag1_mpg\": ", "\"predicted_bag2_mpg\": ", "\"predicted_bag3_mpg\": "}) {
+    EXPECT_NE(rows.front().find(key), std::string::npos) << rows.front();
+    EXPECT_EQ(rows[1].find(key), std::string::npos) << rows[1];
+  }
 }
 
 }  // namespace
