@@ -35,6 +35,9 @@ JsonObject row_json(const validate::RowOutcome& o) {
   }
   j.add("measured", o.measured).add("predicted", o.predicted).add("unit", o.unit).add("error_pct", o.error_pct());
   if (o.measured_from_kwh_per_100mi) j.add("measured_read_as", "kWh/100 mi");
+  if (r.cycle == validate::EpaCycle::ftp75) {
+    for (int b = 0; b < 3; ++b) j.add("predicted_bag" + std::to_string(b + 1) + "_mpg", o.predicted_bag_mpg[b]);
+  }
   return j;
 }
 

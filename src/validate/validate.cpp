@@ -329,6 +329,12 @@ Validation validate_epa_list(const std::vector<EpaTestRow>& rows, unsigned threa
     const EpaFuel fuel = rows[i].fuel;
     const double scale = fuel == EpaFuel::electricity ? electric_scale : fuel == EpaFuel::diesel ? diesel_scale : petrol_scale;
     v.rows[i].predicted = nominal_prediction(i) * scale;
+    if (rows[i].cycle != EpaCycle::ftp75) continue;
+    const Raw& w = raw[i];
+    const double bag1_cold_m3 = w.bag1_hot_m3 + f.defaults.cold_fuel_excess * w.cold_extra_per_k_m3;
+    v.rows[i].predicted_bag_mpg[0] = scale * miles(w.bag1_m) / gallons(bag1_cold_m3);
+    v.rows[i].predicted_bag_mpg[1] = scale * miles(w.bag2_m) / gallons(w.bag2_m3);
+    v.rows[i].predicted_bag_mpg[2] = scale * miles(w.bag1_m) / gallons(w.bag1_hot_m3);
   }
   return v;
 }

@@ -23,6 +23,9 @@ struct RowOutcome {
   std::string unit;             ///< "mpg" or "mpge"
   double measured = 0.0;        ///< in `unit`
   double predicted = 0.0;
+  /// FTP-75 rows: the predicted economy [mpg] of bags 1 (cold), 2 and 3 (hot), to compare with the list's FE Bag
+  /// 1..3; zero on other rows.
+  double predicted_bag_mpg[3] = {0.0, 0.0, 0.0};
   /// The row's RND_ADJ_FE was read as kWh per 100 miles (electric rows below 60 "MPG", see README).
   bool measured_from_kwh_per_100mi = false;
   double error_pct() const { return 100.0 * (predicted / measured - 1.0); }
