@@ -339,5 +339,23 @@ TEST(DiagnoseLimits, EngineWarmingInMinutesIsNotNamedATyreWarmup) {
   }
 }
 
+TEST(Diagnose, AGradeOffsetFoundBesideAPinnedRrcLevelNamesTheTyreAsItsAlternative) {
+  // Tyres 0.9 bar under-inflated on a trip without elevation: the RRC level wants beyond its +20 % box, and a climbing
+  // grade offset (the same constant force m g) takes the rest. The finding must say that a tyre rolling harder is the
+  // other reading, and how to tell them apart. Seed 1 is one where road_grade is found.
+  const Vehicle v = ev();
+  SyntheticCase c;
+  c.effects = {{"underinflated", -0.9}};
+  c.seed = 1;
+  const Diagnosis d = diagnose(v, {generate_case(v, c)});
+  ASSERT_FALSE(d.findings.empty());
+  const Finding& f = d.findings.front();
+  ASSERT_EQ(f.effect, "road_grade") << diagnosis_text(d);
+  const bool says = std::any_of(f.separating_tests.begin(), f.separating_tests.end(), [](const std::string& t) {
+    return t.find("RRC level") != std::string::npos && t.find("tyre pressures") != std::string::npos;
+  });
+  EXPECT_TRUE(says) << diagnosis_text(d);
+}
+
 }  // namespace
 }  // namespace rollsim

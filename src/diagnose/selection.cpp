@@ -395,6 +395,26 @@ void add_confounders(Finding& f, const Candidate& c, const std::vector<Candidate
   }
 }
 
+// The calibration's RRC level held at the top of its prior box (column 1 of the calibrated model).
+bool rrc_level_at_its_box(const Model& m) {
+  for (const auto& b : m.prior.boxes)
+    if (b.column == 1 && m.fit.coef.size() > 1) return m.fit.coef[1] >= b.high - 1e-9 * std::max(1.0, std::abs(b.high));
+  return false;
+}
+
+// A climbing grade offset and a tyre rolling harder than the prior allows (under-inflation, a worn or winter tyre)
+// are the same constant force m g on a trip without elevation; the RRC level is no catalogue effect, so this is said
+// in the finding's separating tests, not as a confounded effect.
+void add_rrc_level_alternative(Finding& f, const Candidate& c, const SelectionContext& sc, bool rrc_at_box) {
+  if (c.id != EffectId::road_grade || !rrc_at_box || f.parameters.empty() || !(f.parameters.front().value > 0.0)) return;
+  for (const auto& r : sc.recordings)
+    if (r.elevation_m || r.grade) return;
+  f.separating_tests.push_back(
+      "the RRC level (the calibration held it at the top of its prior box: a tyre under-inflated, worn or on a "
+      "rougher road rolls harder by the same constant force): check the tyre pressures, drive the route in both "
+      "directions or record elevation: a grade reverses with the direction, a tyre's rolling resistance does not");
+}
+
 }  // namespace
 
 // Adds the candidate with the largest BIC gain while one passes; confounded if another candidate's cleaned
@@ -402,6 +422,7 @@ void add_confounders(Finding& f, const Candidate& c, const std::vector<Candidate
 std::vector<Finding> select_effects(const SelectionContext& sc, const std::vector<Candidate>& cands, Model& m,
                                     std::vector<EffectId>& chosen) {
   std::vector<Finding> out;
+  const bool rrc_at_box = rrc_level_at_its_box(m);
   for (int round = 0; round < sc.opt.max_effects; ++round) {
     const std::vector<Passing> passing = passing_candidates(sc, cands, m, chosen);
     if (passing.empty()) break;
@@ -414,6 +435,7 @@ std::vector<Finding> select_effects(const SelectionContext& sc, const std::vecto
       const std::optional<ProfileResult> prof = refine(sc, cands, c, m, best);
       f = catalogue_finding(sc, c, best, prof, m.inflate);
       add_confounders(f, c, cands, passing, m, sc.opt.collinear_corr);
+      add_rrc_level_alternative(f, c, sc, rrc_at_box);
     }
     set_finding_metrics(f, m, c.signature, best.score);
     m = extended(m, c.signature, best.score);
