@@ -147,16 +147,16 @@ bool engine_off(const CsvTable& table, std::size_t row, std::size_t col, double 
 }
 
 // The simulator switches an engine off only on a standing segment (a moving car's engine-off flag would be ignored,
-// a silently wrong number): both ends of an off segment must stand still. All-running is no engine_off at all.
-void check_engine_off_standing(const CsvTable& table, std::size_t col, DriveCycle& c) {
-  for (std::size_t r = 0; r < c.engine_off.size(); ++r) {
-    if (!c.engine_off[r]) continue;
-    const std::size_t next = std::min(r + 1, c.speed_mps.size() - 1);
-    if (c.speed_mps[r] > 0.0 || c.speed_mps[next] > 0.0)
-      throw InputError(table.where(r, col), "0 (off) is not allowed while moving (" + format_value(units::mps_to_kmh(std::max(c.speed_mps[r], c.speed_mps[next]))) +
+// a silently wrong number): both ends of an off segment must stand still.
+void check_engine_off_standing(const CsvTable& table, std::size_t col, const std::vector<double>& speed_mps,
+                               const std::vector<bool>& off) {
+  for (std::size_t r = 0; r < off.size(); ++r) {
+    if (!off[r]) continue;
+    const std::size_t next = std::min(r + 1, speed_mps.size() - 1);
+    if (speed_mps[r] > 0.0 || speed_mps[next] > 0.0)
+      throw InputError(table.where(r, col), "0 (off) is not allowed while moving (" + format_value(units::mps_to_kmh(std::max(speed_mps[r], speed_mps[next]))) +
                                                 " km/h over the segment from here): the engine may be off only standing still");
   }
-  c.set_engine_off(std::move(c.engine_off));
 }
 
 }  // namespace
@@ -218,6 +218,7 @@ DriveCycle cycle_from_table(const CsvTable& table, const std::string& name) {
   c.speed_mps.resize(n);
   c.grade.assign(n, 0.0);
   std::vector<double> elevation;
+  std::vector<bool> off;
   for (std::size_t r = 0; r < n; ++r) {
     c.time_s[r] = number(r, *col_t);
     if (r > 0 && !(c.time_s[r] > c.time_s[r - 1])) {
@@ -253,9 +254,10 @@ DriveCycle cycle_from_table(const CsvTable& table, const std::string& name) {
     }
     if (col_elev) elevation.push_back(number(r, *col_elev));
     if (col_heading) c.heading_rad.push_back(heading_rad(table, r, *col_heading, number(r, *col_heading)));
-    if (col_engine) c.engine_off.push_back(engine_off(table, r, *col_engine, number(r, *col_engine)));
+    if (col_engine) off.push_back(engine_off(table, r, *col_engine, number(r, *col_engine)));
   }
-  if (col_engine) check_engine_off_standing(table, *col_engine, c);
+  if (col_engine) check_engine_off_standing(table, *col_engine, c.speed_mps, off);
+  c.set_engine_off(std::move(off));
 
   if (col_elev) {
     // Grade at each sample: elevation difference over the distance travelled across a window that grows

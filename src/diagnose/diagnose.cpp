@@ -54,14 +54,16 @@ std::vector<DriveCycle> cycles_of(const std::vector<Recording>& recordings, cons
   return cycles;
 }
 
+// A bearing taken into [0, 360) deg.
+double wrap_deg(double deg) { return std::fmod(std::fmod(deg, 360.0) + 360.0, 360.0); }
+
 // The bearing's profile interval in words ("": none), its ends taken back to 0-360 deg.
 std::string bearing_interval_text(const Finding& f) {
   for (const auto& p : f.parameters) {
     if (p.name != "wind_from_deg" || !p.profiled) continue;
     if (p.ci_low_open && p.ci_high_open) return "; its bearing is not determined within a half circle";
-    auto wrap = [](double d) { return std::fmod(std::fmod(d, 360.0) + 360.0, 360.0); };
-    return "; 95 % profile interval " + fixed(wrap(p.ci_low), 0) + (p.ci_low_open ? " or beyond" : "") + " to " +
-           fixed(wrap(p.ci_high), 0) + (p.ci_high_open ? " or beyond" : "") + " deg clockwise";
+    return "; 95 % profile interval " + fixed(wrap_deg(p.ci_low), 0) + (p.ci_low_open ? " or beyond" : "") + " to " +
+           fixed(wrap_deg(p.ci_high), 0) + (p.ci_high_open ? " or beyond" : "") + " deg clockwise";
   }
   return "";
 }
@@ -82,7 +84,7 @@ void describe_wind(const std::vector<DriveCycle>& cycles, std::vector<Finding>& 
       // pass 0 or 360 deg).
       const bool reverse = f.fitted.at("wind_speed_mps") < 0.0;
       const double from = f.fitted.at("wind_from_deg") + (reverse ? 180.0 : 0.0);
-      const double turn = std::fmod(std::fmod(from, 360.0) + 360.0, 360.0) - f.fitted.at("wind_from_deg");
+      const double turn = wrap_deg(from) - f.fitted.at("wind_from_deg");
       if (reverse) f.fitted["wind_speed_mps"] = -f.fitted.at("wind_speed_mps");
       f.fitted["wind_from_deg"] += turn;
       for (auto& p : f.parameters) {
