@@ -192,9 +192,12 @@ struct Raw {
 double miles(double m) { return m / units::kMPerMile; }
 double gallons(double m3) { return m3 / kM3PerGallon; }
 
+// Bag 1 from cold: the hot bag's fuel plus the fitted excess times its cold extra per unit excess.
+double bag1_cold_m3(const Raw& w, double cold_fuel_excess) { return w.bag1_hot_m3 + cold_fuel_excess * w.cold_extra_per_k_m3; }
+
 double ftp_composite_mpg(const Raw& w, double cold_fuel_excess) {
-  const double bag1_cold_m3 = w.bag1_hot_m3 + cold_fuel_excess * w.cold_extra_per_k_m3;
-  return ftp75_weighted_mpg(gallons(bag1_cold_m3), gallons(w.bag2_m3), gallons(w.bag1_hot_m3), miles(w.bag1_m), miles(w.bag2_m));
+  return ftp75_weighted_mpg(gallons(bag1_cold_m3(w, cold_fuel_excess)), gallons(w.bag2_m3), gallons(w.bag1_hot_m3),
+                            miles(w.bag1_m), miles(w.bag2_m));
 }
 
 Raw simulate_row(const EpaTestRow& r, const Cycles& c, const EpaDefaults& d) {
@@ -331,8 +334,7 @@ Validation validate_epa_list(const std::vector<EpaTestRow>& rows, unsigned threa
     v.rows[i].predicted = nominal_prediction(i) * scale;
     if (rows[i].cycle != EpaCycle::ftp75) continue;
     const Raw& w = raw[i];
-    const double bag1_cold_m3 = w.bag1_hot_m3 + f.defaults.cold_fuel_excess * w.cold_extra_per_k_m3;
-    v.rows[i].predicted_bag_mpg[0] = scale * miles(w.bag1_m) / gallons(bag1_cold_m3);
+    v.rows[i].predicted_bag_mpg[0] = scale * miles(w.bag1_m) / gallons(bag1_cold_m3(w, f.defaults.cold_fuel_excess));
     v.rows[i].predicted_bag_mpg[1] = scale * miles(w.bag2_m) / gallons(w.bag2_m3);
     v.rows[i].predicted_bag_mpg[2] = scale * miles(w.bag1_m) / gallons(w.bag1_hot_m3);
   }
