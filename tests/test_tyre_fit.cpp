@@ -206,7 +206,7 @@ TEST(J2452, SmallestEnclosingBallOfKnownPointSets) {
   EXPECT_NEAR(b.centre[1], 1.0 / std::sqrt(3.0), 1e-5);
 }
 
-TEST(J2452, NoCommonShapeReachesTheWorstTyreTargetWithRoomToSpare) {
+TEST(J2452, CommonShapeBoundLiesBetweenHalfTheWidestPairAndTheBestShapeFound) {
   // The bound is a lower bound for any model giving every tyre one shape: it must lie between half the largest
   // pairwise distance of two tyres' shapes and the worst error of the best shape found.
   const auto sets = load_j2452_csv(kJ2452Csv);
