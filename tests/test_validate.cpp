@@ -8,6 +8,7 @@
 #include <fstream>
 #include <iostream>
 #include <numbers>
+#include <stdexcept>
 #include <utility>
 
 #include "rollsim/powertrain/conventional.hpp"
@@ -271,6 +272,59 @@ TEST(PowertrainCapabilities, ABatteryAndAFuelTogetherGiveBothFiguresAndOneBalanc
   EXPECT_NEAR(r.energy.battery_terminal_j, 0.5 * r.energy.traction_j, 1e-6 * r.energy.traction_j);
 }
 
+validate::EpaTestRow electric_row(double rated_power_w) {
+  validate::EpaTestRow row;
+  row.fuel = validate::EpaFuel::electricity;
+  row.test_mass_kg = 2000.0;
+  row.road_a_n = 150.0;
+  row.road_b_n_s_per_m = 2.0;
+  row.road_c_n_s2_per_m2 = 0.4;
+  row.rated_power_w = rated_power_w;
+  row.engine_radps_per_mps = 40.0;
+  return row;
+}
+
+// The machine's loss at a shaft power, motoring (+) or generating (-), through the powertrain validate builds.
+double motor_loss_at(const VehicleModel& m, double shaft_power_w) {
+  const auto& pt = dynamic_cast<const ElectricPowertrain&>(*m.powertrain);
+  const double eta_red = pt.params().reduction.efficiency;
+  const double v_mps = 20.0;
+  // Braking: the machine takes its share of the braking force (blending), so ask for the force it must see.
+  const double regen_share = pt.params().regen.driven_axle_brake_fraction;
+  const double wheel_force_n = shaft_power_w > 0.0 ? shaft_power_w * eta_red / v_mps : shaft_power_w / (eta_red * v_mps * regen_share);
+  return pt.deliver(wheel_force_n, v_mps, 0, m.wheel_radius_m).motor_loss_w;
+}
+
+// validate's electric machine is FASTSim's default: efficiency against the fraction of peak output power, as in
+// FASTSim's BEV files (mcEffMap 0.84 0.86 0.88 0.90 0.91 0.92 0.94 0.95 0.95 0.94 0.93 at 0 2 4 6 8 10 20 40 60 80
+// 100 %), and for small machines blended towards its small-motor curve (0.42 at 10 %, weight 1 at 7.5 kW, 0 at 75).
+TEST(EpaCar, ElectricMachineLosesWhatFastsimsDefaultCurveGives) {
+  const VehicleModel m = validate::car_from_row(electric_row(255e3), validate::EpaDefaults{});
+  for (auto [fraction, eta] : {std::pair{0.10, 0.92}, std::pair{0.40, 0.95}, std::pair{0.03, 0.87}, std::pair{0.90, 0.935}}) {
+    const double p_w = fraction * 255e3;
+    EXPECT_NEAR(motor_loss_at(m, p_w), p_w * (1.0 / eta - 1.0), 1e-6 * p_w) << fraction;  // motoring: P / eta - P
+    EXPECT_NEAR(motor_loss_at(m, -p_w), p_w * (1.0 - eta), 1e-6 * p_w) << fraction;       // generating: P - eta P
+  }
+  // Half-way between 7.5 and 75 kW: the mean of the two curves at 10 %, (0.92 + 0.42) / 2.
+  const VehicleModel small = validate::car_from_row(electric_row(41.25e3), validate::EpaDefaults{});
+  EXPECT_NEAR(motor_loss_at(small, 4.125e3), 4.125e3 * (1.0 / 0.67 - 1.0), 1e-3);
+}
+
+TEST(ElectricPowertrain, RejectsAnEfficiencyCurveThatIsNotARisingFractionWithEfficienciesUpToOne) {
+  ElectricPowertrainParams p;
+  p.motor.max_power_w = 100e3;
+  p.motor.losses.output_fraction = {0.0, 1.0};
+  p.motor.losses.efficiency = {0.9, 0.95};
+  EXPECT_NO_THROW(ElectricPowertrain{p});
+  p.motor.losses.efficiency = {0.9, 1.05};
+  EXPECT_THROW(ElectricPowertrain{p}, std::invalid_argument);
+  p.motor.losses.efficiency = {0.9};
+  EXPECT_THROW(ElectricPowertrain{p}, std::invalid_argument);
+  p.motor.losses.output_fraction = {0.0, 0.5};
+  p.motor.losses.efficiency = {0.9, 0.95};
+  EXPECT_THROW(ElectricPowertrain{p}, std::invalid_argument);
+}
+
 TEST(EpaList, ReadsUnitsAsPublished) {
   const auto rows = validate::read_epa_test_car_list(kList);
   ASSERT_EQ(rows.size(), 3114u);
@@ -367,7 +421,7 @@ TEST(EpaList, WholeListSkipsByNameAndAgreesAsReportedOnTheHeldOutHalf) {
   EXPECT_NEAR(cold_ratio[cold_ratio.size() / 2], 1.0, 0.02);
 
   // Judged on the half the constants were not fitted on (README, "Validation"). The targets where they
-  // are met (petrol HWFET and US06: median |error| <= 5 %, 90th percentile <= 12 %; electric highway <= 6 %); elsewhere
+  // are met (petrol HWFET and US06: median |error| <= 5 %, 90th percentile <= 12 %; electric highway <= 6 % and <= 12 %); elsewhere
   // what the model does today, as a floor that catches a regression (README says what is not met).
   const auto c = validate::coverage(v, false);
   EXPECT_GE(c.simulated, 0.8 * c.eligible);
@@ -382,8 +436,11 @@ TEST(EpaList, WholeListSkipsByNameAndAgreesAsReportedOnTheHeldOutHalf) {
       EXPECT_LE(s.p90_abs_error_pct, 12.0);
     }
     if (s.powertrain == "petrol") EXPECT_LT(s.median_abs_error_pct, 7.0) << s.cycle;
-    if (s.powertrain == "electric" && s.cycle == "CD HWFET") EXPECT_LE(s.median_abs_error_pct, 6.0);
-    if (s.powertrain == "electric") EXPECT_LT(s.median_abs_error_pct, 13.0) << s.cycle;
+    if (s.powertrain == "electric" && s.cycle == "CD HWFET") {
+      EXPECT_LE(s.median_abs_error_pct, 6.0);
+      EXPECT_LE(s.p90_abs_error_pct, 12.0);
+    }
+    if (s.powertrain == "electric") EXPECT_LT(s.median_abs_error_pct, 8.0) << s.cycle;
   }
   // The fitted constants stay physical: gross indicated efficiency 0.3-0.5, charge efficiency below 1.
   EXPECT_GT(v.fitted.defaults.petrol_indicated_efficiency, 0.3);

@@ -3,14 +3,45 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include "rollsim/common/error.hpp"
 
 namespace rollsim {
 
+namespace {
+
+// Linear interpolation in a table whose x rises; clamped at both ends.
+double interpolate(const std::vector<double>& x, const std::vector<double>& y, double at) {
+  if (at <= x.front()) return y.front();
+  if (at >= x.back()) return y.back();
+  const auto hi = static_cast<std::size_t>(std::upper_bound(x.begin(), x.end(), at) - x.begin());
+  const double t = (at - x[hi - 1]) / (x[hi] - x[hi - 1]);
+  return y[hi - 1] + t * (y[hi] - y[hi - 1]);
+}
+
+}  // namespace
+
+ElectricPowertrain::ElectricPowertrain(const ElectricPowertrainParams& params) : p_(params) {
+  const auto& x = p_.motor.losses.output_fraction;
+  const auto& eta = p_.motor.losses.efficiency;
+  if (eta.empty() && x.empty()) return;
+  bool ok = x.size() == eta.size() && x.size() >= 2 && x.front() == 0.0 && x.back() == 1.0 && p_.motor.max_power_w > 0.0;
+  for (std::size_t i = 0; ok && i < x.size(); ++i) ok = (i == 0 || x[i] > x[i - 1]) && eta[i] > 0.0 && eta[i] <= 1.0;
+  if (!ok) {
+    throw std::invalid_argument("motor efficiency curve: output fractions must rise from 0 to 1, one efficiency in (0, 1] each, "
+                                "and the machine needs a rated power");
+  }
+}
+
 double ElectricPowertrain::motor_loss_w(double torque_nm, double speed_radps) const {
   const auto& l = p_.motor.losses;
   if (speed_radps <= 0.0 && torque_nm == 0.0) return 0.0;  // switched off at standstill
+  if (!l.efficiency.empty()) {
+    const double shaft_w = torque_nm * speed_radps;
+    const double eta = interpolate(l.output_fraction, l.efficiency, std::abs(shaft_w) / p_.motor.max_power_w);
+    return shaft_w >= 0.0 ? shaft_w * (1.0 / eta - 1.0) : -shaft_w * (1.0 - eta);
+  }
   return l.copper_w_per_nm2 * torque_nm * torque_nm + l.iron_w_s_per_rad * speed_radps +
          l.windage_w_s3_per_rad3 * speed_radps * speed_radps * speed_radps + l.constant_w;
 }

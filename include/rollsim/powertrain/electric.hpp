@@ -1,6 +1,8 @@
 // Battery-electric powertrain: battery, motor loss model, single-speed reduction, blended regenerative braking.
 #pragma once
 
+#include <vector>
+
 #include "rollsim/powertrain/powertrain.hpp"
 
 namespace rollsim {
@@ -14,6 +16,12 @@ struct MotorLossParams {
   double iron_w_s_per_rad = 0.0;       ///< k_fe [W/(rad/s)]
   double windage_w_s3_per_rad3 = 0.0;  ///< k_w  [W/(rad/s)^3]
   double constant_w = 0.0;             ///< P_0 [W], only while the machine turns
+  /// Optional efficiency curve against the fraction of rated power at the shaft (FASTSim's form: points
+  /// `output_fraction` rising from 0 to 1, `efficiency` in (0, 1] at each). When given, the loss is
+  /// |P| (1 / eta - 1) motoring and |P| (1 - eta) generating, eta interpolated linearly at |P| / max_power, and
+  /// it replaces the four terms above (a curve of power alone cannot tell torque from speed).
+  std::vector<double> output_fraction;
+  std::vector<double> efficiency;
 };
 
 struct ElectricMotorParams {
@@ -53,7 +61,8 @@ struct ElectricPowertrainParams {
 
 class ElectricPowertrain final : public Powertrain {
  public:
-  explicit ElectricPowertrain(const ElectricPowertrainParams& params) : p_(params) {}
+  /// Throws std::invalid_argument for an efficiency curve that is not a rising fraction 0..1 with efficiencies in (0, 1].
+  explicit ElectricPowertrain(const ElectricPowertrainParams& params);
   PowerFlow deliver(double wheel_force_n, double speed_mps, int gear, double wheel_radius_m) const override;
   int select_gear(double, int) const override { return 0; }
   std::vector<double> shift_speeds_mps(int) const override { return {}; }
