@@ -110,6 +110,8 @@ TEST(CamryFuelMap, BadEngineMapKeysAreNamedErrors) {
   expect_has(error_of("type: engine_map", "type: rotary"), {"powertrain.type", "rotary", "engine_map"});
   expect_has(error_of("lockup_min_gear: 2 ", "lockup_min_gear: 2.5 "), {"lockup_min_gear", "2.5", "gear number"});
   expect_has(error_of("max_load_pct: 60", "max_load_pct: 60\n    launch_engine_speed_rpm: 1400"), {"launch_engine_speed_rpm", "slipping clutch"});
+  expect_has(error_of("fuel_cut_min_speed_rpm: 1100\n", "fuel_cut_min_speed_rpm: 1100\n    fuel_cut_min_vehicle_speed_kmh: 500\n"),
+             {"fuel_cut_min_vehicle_speed_kmh", "500"});
 }
 
 // Issue 13, item 5: after the Camry's own calibration (one scale on its fuel, from its three tests together),

@@ -113,6 +113,9 @@ EngineMapParams engine_of(const EpaTestRow& row, const EpaDefaults& d) {
   e.knock_start_fraction = 0.6;
   e.knock_efficiency_loss_max = diesel ? 0.0 : 0.10;
   e.fuel_cut_min_speed_radps = 1100.0 * kRadpsPerRpm;
+  // ... and only above 5 m/s (18 km/h) of road speed: EPA's ALPHA enables deceleration fuel cut-off on
+  // '@veh_spd_mps>5' for the 2018 A25A-FKS engine it documents (ALPHA_Documentation/model_inputs.rst).
+  e.fuel_cut_min_vehicle_speed_mps = 5.0;
   return e;
 }
 
