@@ -193,6 +193,50 @@ TEST(J2452, OneLabelPointPredictsHeldOutTyresBetterThanEveryBaseline) {
   EXPECT_EQ(std::count_if(one.begin(), one.end(), [](double e) { return e <= 0.05; }), 8);
 }
 
+TEST(J2452, SmallestEnclosingBallOfKnownPointSets) {
+  Eigen::MatrixXd line(3, 1);
+  line << 0.0, 2.0, 0.5;  // on a line: the midpoint of the extremes, whatever lies between
+  const EnclosingBall a = smallest_enclosing_ball(line);
+  EXPECT_NEAR(a.centre[0], 1.0, 1e-6);
+  EXPECT_NEAR(a.radius, 1.0, 1e-6);
+  Eigen::MatrixXd triangle(3, 2);  // equilateral, side 2 (RMS over 2 columns: divide by sqrt 2)
+  triangle << 0.0, 0.0, 2.0, 0.0, 1.0, std::sqrt(3.0);
+  const EnclosingBall b = smallest_enclosing_ball(triangle);
+  EXPECT_NEAR(b.radius, 2.0 / std::sqrt(3.0) / std::sqrt(2.0), 1e-6);
+  EXPECT_NEAR(b.centre[1], 1.0 / std::sqrt(3.0), 1e-5);
+}
+
+TEST(J2452, CommonShapeBoundLiesBetweenHalfTheWidestPairAndTheBestShapeFound) {
+  // The bound is a lower bound for any model giving every tyre one shape: it must lie between half the largest
+  // pairwise distance of two tyres' shapes and the worst error of the best shape found.
+  const auto sets = load_j2452_csv(kJ2452Csv);
+  const auto& b = evaluation().common_shape;
+  ASSERT_EQ(b.rms.size(), sets.size());
+  const OperatingGrid grid = j2452_grid();
+  std::vector<std::vector<double>> shapes;
+  for (const auto& s : sets) {
+    const double ref = j2452_flat_rrc(s, 2.1e5, 4000.0, 80 / 3.6, kJ2452DrumRadius_m);
+    std::vector<double> x;
+    for (const auto& pt : sample_j2452(s, grid, kJ2452DrumRadius_m, s.name)) x.push_back(std::log(pt.rrc / ref));
+    shapes.push_back(x);
+  }
+  double half_widest = 0.0;
+  for (std::size_t i = 0; i < shapes.size(); ++i) {
+    for (std::size_t j = 0; j < i; ++j) {
+      double d2 = 0.0;
+      for (std::size_t g = 0; g < shapes[i].size(); ++g) d2 += std::pow(shapes[i][g] - shapes[j][g], 2);
+      half_widest = std::max(half_widest, 0.5 * std::sqrt(d2 / shapes[i].size()));
+    }
+  }
+  EXPECT_GE(b.worst_log_rms, half_widest - 1e-12);
+  const double best_found = *std::max_element(b.rms.begin(), b.rms.end());
+  EXPECT_LE(b.worst_log_rms, best_found * 1.05);
+  // A constant RRC is one common shape, so it cannot beat the bound.
+  double worst_constant = 0.0;
+  for (const auto& e : evaluation().tyres) worst_constant = std::max(worst_constant, e.constant_rms);
+  EXPECT_GT(worst_constant, b.worst_log_rms);
+}
+
 TEST(J2452, FullFitFollowsEachSurfaceAndItsMeasuredExponents) {
   for (const auto& e : evaluation().tyres) {
     EXPECT_LT(e.full_fit_rms, 0.01) << e.name;

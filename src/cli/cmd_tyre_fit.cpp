@@ -158,13 +158,13 @@ void run_evaluate(const std::string& path, const std::string& drum_text) {
   const J2452Evaluation ev = evaluate_j2452(sets, drum);
   std::cout << "RMS relative RRC error over 180-300 kPa x 3-6 kN x 15-115 km/h (150 points), %; one point = 210 kPa, "
                "4000 N, 80 km/h; shared constants fitted leave-one-tyre-out\n";
-  report::TextTable t({"tyre", "one-point", "max", "full fit", "thesis", "constant", "median J2452", "p exp meas",
+  report::TextTable t({"tyre", "RRC kg/t", "one-point", "max", "full fit", "thesis", "constant", "median J2452", "p exp meas",
                        "p exp 1pt", "p exp full", "Z exp meas", "Z exp 1pt", "Z exp full", "rise meas %",
                        "rise 1pt %", "rise full %"});
   t.set_left_aligned(0);
   std::vector<double> cols[6];
   for (const auto& e : ev.tyres) {
-    t.add_row({e.name, pct(e.one_point_rms), pct(e.one_point_max), pct(e.full_fit_rms), pct(e.thesis_rms, 1),
+    t.add_row({e.name, fixed(e.reference_rrc * 1e3, 2), pct(e.one_point_rms), pct(e.one_point_max), pct(e.full_fit_rms), pct(e.thesis_rms, 1),
                pct(e.constant_rms, 1), pct(e.median_shape_rms), fixed(e.measured.pressure_exponent, 3),
                fixed(e.one_point.pressure_exponent, 3), fixed(e.full_fit.pressure_exponent, 3),
                fixed(e.measured.load_exponent, 3), fixed(e.one_point.load_exponent, 3),
@@ -174,7 +174,7 @@ void run_evaluate(const std::string& path, const std::string& drum_text) {
     for (int k = 0; k < 6; ++k) cols[k].push_back(v[k]);
   }
   auto worst = [](const std::vector<double>& v) { return *std::max_element(v.begin(), v.end()); };
-  std::vector<std::string> med{"median"}, wst{"worst"};
+  std::vector<std::string> med{"median", ""}, wst{"worst", ""};
   for (int k = 0; k < 6; ++k) {
     med.push_back(pct(median(cols[k]), k >= 3 && k <= 4 ? 1 : 2));
     wst.push_back(pct(worst(cols[k]), k >= 3 && k <= 4 ? 1 : 2));
@@ -186,6 +186,11 @@ void run_evaluate(const std::string& path, const std::string& drum_text) {
   std::cout << "thesis model's own exponents (scaled): pressure " << fixed(ev.tyres.front().thesis.pressure_exponent, 3)
             << ", load " << fixed(ev.tyres.front().thesis.load_exponent, 3) << ", rise "
             << pct(ev.tyres.front().thesis.speed_rise, 1) << " % (" << ev.tyres.front().name << ")\n";
+  const CommonShapeBound& b = ev.common_shape;
+  std::cout << "best common shape in hindsight (all tyres seen, level set at the one point): worst tyre >= "
+            << pct(b.worst_log_rms) << " % (RMS of the log ratio); the best such shape's RMS error per tyre:";
+  for (std::size_t i = 0; i < b.rms.size(); ++i) std::cout << (i ? ", " : " ") << pct(b.rms[i]);
+  std::cout << " %\n";
   std::cout << "\nShared constants fitted on all " << sets.size() << " sets and, leave-one-tyre-out, without each:\n";
   report::TextTable s({"fitted without", "frequency_slope_per_hz", "deflection_exponent", "load_exponent",
                        "speed_loss_rrc_per_hz2", "speed_loss_load_exponent"});

@@ -131,9 +131,70 @@ HysteresisConstants fit_shared_constants(const std::vector<J2452Set>& training, 
   return constants(least_squares(residuals, m, x0).x);
 }
 
+EnclosingBall smallest_enclosing_ball(const Eigen::MatrixXd& shapes) {
+  const Eigen::Index n = shapes.rows();
+  const Eigen::MatrixXd gram = shapes * shapes.transpose() / static_cast<double>(shapes.cols());
+  Eigen::VectorXd w = Eigen::VectorXd::Constant(n, 1.0 / n);
+  // The dual f(w) = sum w_i G_ii - w'Gw is concave; every w on the simplex gives a lower bound on the radius^2
+  // (for any centre, the largest squared distance is at least the w-weighted mean one, itself at least f(w)).
+  // Frank-Wolfe with away steps (Lacoste-Julien and Jaggi 2015), which converges linearly here where the plain
+  // method crawls towards a face of the simplex.
+  for (int iter = 0; iter < 100000; ++iter) {
+    const Eigen::VectorXd grad = gram.diagonal() - 2.0 * gram * w;
+    const double at_w = grad.dot(w);
+    Eigen::Index j = 0, k = -1;
+    grad.maxCoeff(&j);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      if (w[i] > 0.0 && (k < 0 || grad[i] < grad[k])) k = i;
+    }
+    if (grad[j] - at_w < 1e-15) break;  // the duality gap: w is optimal to round-off
+    Eigen::VectorXd d = -w;
+    double max_step = 1.0;
+    if (grad[j] - at_w >= at_w - grad[k]) {
+      d[j] += 1.0;
+    } else {
+      d = w;
+      d[k] -= 1.0;
+      max_step = w[k] / (1.0 - w[k]);
+    }
+    const double curvature = d.dot(gram * d);
+    if (curvature <= 0.0) break;
+    w += std::clamp(grad.dot(d) / (2.0 * curvature), 0.0, max_step) * d;
+  }
+  EnclosingBall ball;
+  ball.centre = shapes.transpose() * w;
+  ball.radius = std::sqrt(std::max(0.0, gram.diagonal().dot(w) - w.dot(gram * w)));
+  return ball;
+}
+
+namespace {
+
+// Each tyre's log-RRC over the grid relative to its own reference point: its shape, as a one-point fit sees it.
+CommonShapeBound common_shape_bound(const std::vector<J2452Set>& sets, double drum_radius_m) {
+  const OperatingGrid grid = j2452_grid();
+  std::vector<std::vector<RrcPoint>> truth;
+  for (const auto& s : sets) truth.push_back(sample_j2452(s, grid, drum_radius_m, s.name));
+  Eigen::MatrixXd shapes(static_cast<Eigen::Index>(sets.size()), static_cast<Eigen::Index>(truth.front().size()));
+  for (std::size_t i = 0; i < sets.size(); ++i) {
+    const double ref = j2452_flat_rrc(sets[i], kRefPressure_pa, kRefLoad_n, kRefSpeed_mps, drum_radius_m);
+    for (std::size_t g = 0; g < truth[i].size(); ++g) shapes(i, g) = std::log(truth[i][g].rrc / ref);
+  }
+  const EnclosingBall ball = smallest_enclosing_ball(shapes);
+  CommonShapeBound out;
+  out.worst_log_rms = ball.radius;
+  for (Eigen::Index i = 0; i < shapes.rows(); ++i) {
+    const Eigen::ArrayXd e = (ball.centre.transpose() - shapes.row(i)).array().exp() - 1.0;
+    out.rms.push_back(std::sqrt(e.square().mean()));
+  }
+  return out;
+}
+
+}  // namespace
+
 J2452Evaluation evaluate_j2452(const std::vector<J2452Set>& sets, double drum_radius_m) {
   J2452Evaluation out;
   out.shared_all = fit_shared_constants(sets, drum_radius_m);
+  out.common_shape = common_shape_bound(sets, drum_radius_m);
   const OperatingGrid grid = j2452_grid();
   for (std::size_t i = 0; i < sets.size(); ++i) {
     const J2452Set& set = sets[i];
@@ -145,6 +206,7 @@ J2452Evaluation evaluate_j2452(const std::vector<J2452Set>& sets, double drum_ra
     const double ref_rrc = j2452_flat_rrc(set, kRefPressure_pa, kRefLoad_n, kRefSpeed_mps, drum_radius_m);
     TyreEvaluation e;
     e.name = set.name;
+    e.reference_rrc = ref_rrc;
     e.shared = fit_shared_constants(others, drum_radius_m);
     const Surface one_point = hysteresis_surface(one_point_tyre(set, e.shared, drum_radius_m));
     const ErrorStats op = grid_error(one_point, truth);

@@ -4,6 +4,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Dense>
+
 #include "rollsim/tyre/j2452.hpp"
 #include "rollsim/tyre/tyre_model.hpp"
 
@@ -18,6 +20,7 @@ struct SurfaceScaling {
 
 struct TyreEvaluation {
   std::string name;
+  double reference_rrc = 0.0;      ///< the measured (flat-road) RRC at the one point [-]
   // RMS (and largest) relative RRC error over the grid [-], every model scaled to the tyre at one point
   // (210 kPa, 4000 N, 80 km/h) except the full fit.
   double one_point_rms = 0.0;      ///< hysteresis model, shared constants fitted without this tyre
@@ -30,10 +33,27 @@ struct TyreEvaluation {
   HysteresisConstants shared;      ///< the constants fitted without this tyre
 };
 
+/// What any model that gives every tyre one common shape (scaled at the one point) could reach at best, chosen
+/// in hindsight with all tyres seen: the centre of the smallest ball holding every tyre's log-RRC shape over
+/// the grid. Its radius bounds the worst tyre from below for every such model, in RMS of the log ratio.
+struct CommonShapeBound {
+  double worst_log_rms = 0.0;      ///< the ball's radius: no common shape has a smaller worst-tyre log RMS
+  std::vector<double> rms;         ///< RMS relative RRC error of the centre shape, per tyre (the tyres' order)
+};
+
 struct J2452Evaluation {
   std::vector<TyreEvaluation> tyres;
   HysteresisConstants shared_all;  ///< shared constants fitted on every set (the shipped defaults)
+  CommonShapeBound common_shape;
 };
+
+/// The smallest enclosing ball of `shapes` (rows), in RMS over the columns: its centre and radius. Frank-Wolfe on
+/// the dual over the simplex of the rows' weights, which needs only their Gram matrix.
+struct EnclosingBall {
+  Eigen::VectorXd centre;
+  double radius = 0.0;
+};
+EnclosingBall smallest_enclosing_ball(const Eigen::MatrixXd& shapes);
 
 /// The model tyre of a set: geometry from its size designation, thesis constants, pressure 210 kPa.
 TyreState j2452_tyre(const J2452Set& set);
