@@ -190,6 +190,20 @@ TEST(ConventionalPowertrain, ConverterSlipsAtLaunchAndLocksUpAtSpeed) {
   EXPECT_EQ(ConventionalPowertrain(car(TransmissionKind::clutch)).deliver(0.0, 0.0, 0, 0.33).clutch_loss_w, 0.0);
 }
 
+// Deceleration fuel cut-off waits for the road speed it is enabled above (ALPHA: 5 m/s) even where the engine,
+// locked up in second gear, turns above its own cut-off speed: at 4.9 m/s the 9:1 gear turns the engine at
+// 134 rad/s (> 115), so without the road-speed condition the overrun would burn nothing.
+TEST(ConventionalPowertrain, FuelCutOffWaitsForTheRoadSpeedItIsEnabledAbove) {
+  auto p = car(TransmissionKind::automatic);
+  EXPECT_EQ(ConventionalPowertrain(p).deliver(-500.0, 4.9, 0, 0.33).fuel_power_w, 0.0);
+  p.engine.fuel_cut_min_vehicle_speed_mps = 5.0;
+  const ConventionalPowertrain at(p);
+  const PowerFlow slow = at.deliver(-500.0, 4.9, 0, 0.33);
+  EXPECT_GT(slow.fuel_power_w, 0.0);  // it idles until the car stops
+  EXPECT_EQ(slow.machine_speed_radps, p.engine.idle_speed_radps);
+  EXPECT_EQ(at.deliver(-500.0, 5.1, 0, 0.33).fuel_power_w, 0.0);
+}
+
 // Neutral idle control: standing in Drive the converter does not load the engine, which idles as a declutched
 // manual does; moving, nothing changes.
 TEST(ConventionalPowertrain, NeutralIdleStandsWithoutTheConvertersLoad) {

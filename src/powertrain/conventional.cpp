@@ -157,13 +157,14 @@ PowerFlow ConventionalPowertrain::deliver(double wheel_force_n, double speed_mps
     engine_radps = op.engine_speed_radps;
     engine_nm = op.engine_torque_nm;
   } else {
-    // Braking, coasting or standing: friction brakes hold the car. Coupled above the cut-off speed the engine is
-    // motored without fuel and the wheels carry the accessories too (all booked as braking); otherwise it idles.
+    // Braking, coasting or standing: friction brakes hold the car. Coupled above the cut-off speeds (engine and
+    // road) the engine is motored without fuel and the wheels carry the accessories too (all booked as braking);
+    // otherwise it idles.
     out.wheel_force_n = wheel_force_n;
     out.friction_brake_power_w = -wheel_force_n * v;
     if (v > 0.0) {
       const Operating op = operate(0.0, wheel_radps);
-      if (op.locked && op.engine_speed_radps > e.fuel_cut_min_speed_radps) {
+      if (op.locked && op.engine_speed_radps > e.fuel_cut_min_speed_radps && v > e.fuel_cut_min_vehicle_speed_mps) {
         out.aux_power_w = 0.0;
         out.machine_speed_radps = op.engine_speed_radps;
         return out;

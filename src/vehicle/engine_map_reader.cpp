@@ -37,6 +37,7 @@ EngineMapParams read_engine(YamlMap m) {
   e.max_power_w = m.number("max_power_kw", Range::open_low(0.0, 5000.0)) * 1e3;
   e.fuel_cut_min_speed_radps = m.number_or("fuel_cut_min_speed_rpm", 1.2 * e.idle_speed_radps / kRadpsPerRpm,
                                            Range::closed(0.0, 3e4)) * kRadpsPerRpm;
+  e.fuel_cut_min_vehicle_speed_mps = units::kmh_to_mps(m.number_or("fuel_cut_min_vehicle_speed_kmh", 0.0, Range::closed(0.0, 200.0)));
   if (e.rated_speed_radps <= e.idle_speed_radps) throw InputError(m.where("rated_speed_rpm"), "must exceed idle_speed_rpm");
   if (e.max_speed_radps < e.rated_speed_radps) throw InputError(m.where("max_speed_rpm"), "must be at least rated_speed_rpm");
   if (e.enrichment_start_fraction >= 1.0 && e.enrichment_max > 0.0)

@@ -36,6 +36,9 @@ struct EngineMapParams {
   double max_torque_nm = 0.0;      ///< plateau of the full-load curve
   double max_power_w = 0.0;        ///< rated power
   double fuel_cut_min_speed_radps = 0.0;  ///< overrun fuel cut-off above this speed
+  /// ... and only while the car moves faster than this: the controller refuels before the last metres of a stop
+  /// so the engine does not stall as the converter or clutch lets go (ALPHA: above 5 m/s).
+  double fuel_cut_min_vehicle_speed_mps = 0.0;
 };
 
 /// Evaluates the map: no state, so one map serves every thread.
