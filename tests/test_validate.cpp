@@ -11,6 +11,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "rollsim/common/error.hpp"
 #include "rollsim/powertrain/conventional.hpp"
 #include "rollsim/powertrain/electric.hpp"
 #include "rollsim/sim/simulation.hpp"
@@ -331,12 +332,12 @@ TEST(ElectricPowertrain, RejectsAnEfficiencyCurveThatIsNotARisingFractionWithEff
   p.motor.losses.efficiency = {0.9, 0.95};
   EXPECT_NO_THROW(ElectricPowertrain{p});
   p.motor.losses.efficiency = {0.9, 1.05};
-  EXPECT_THROW(ElectricPowertrain{p}, std::invalid_argument);
+  EXPECT_THROW(ElectricPowertrain{p}, ModelDomainError);
   p.motor.losses.efficiency = {0.9};
-  EXPECT_THROW(ElectricPowertrain{p}, std::invalid_argument);
+  EXPECT_THROW(ElectricPowertrain{p}, ModelDomainError);
   p.motor.losses.output_fraction = {0.0, 0.5};
   p.motor.losses.efficiency = {0.9, 0.95};
-  EXPECT_THROW(ElectricPowertrain{p}, std::invalid_argument);
+  EXPECT_THROW(ElectricPowertrain{p}, ModelDomainError);
 }
 
 TEST(EpaList, ReadsUnitsAsPublished) {

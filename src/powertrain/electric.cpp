@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <stdexcept>
 
 #include "rollsim/common/error.hpp"
 
@@ -29,7 +28,7 @@ ElectricPowertrain::ElectricPowertrain(const ElectricPowertrainParams& params) :
   bool ok = x.size() == eta.size() && x.size() >= 2 && x.front() == 0.0 && x.back() == 1.0 && p_.motor.max_power_w > 0.0;
   for (std::size_t i = 0; ok && i < x.size(); ++i) ok = (i == 0 || x[i] > x[i - 1]) && eta[i] > 0.0 && eta[i] <= 1.0;
   if (!ok) {
-    throw std::invalid_argument("motor efficiency curve: output fractions must rise from 0 to 1, one efficiency in (0, 1] each, "
+    throw ModelDomainError("motor efficiency curve: output fractions must rise from 0 to 1, one efficiency in (0, 1] each, "
                                 "and the machine needs a rated power");
   }
 }

@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <vector>
 #include <numbers>
+#include <vector>
 
 #include "rollsim/common/error.hpp"
 #include "rollsim/common/units.hpp"

@@ -61,7 +61,7 @@ struct ElectricPowertrainParams {
 
 class ElectricPowertrain final : public Powertrain {
  public:
-  /// Throws std::invalid_argument for an efficiency curve that is not a rising fraction 0..1 with efficiencies in (0, 1].
+  /// Throws ModelDomainError for an efficiency curve that is not a rising fraction 0..1 with efficiencies in (0, 1].
   explicit ElectricPowertrain(const ElectricPowertrainParams& params);
   PowerFlow deliver(double wheel_force_n, double speed_mps, int gear, double wheel_radius_m) const override;
   int select_gear(double, int) const override { return 0; }
