@@ -8,7 +8,6 @@
 #include <fstream>
 #include <iostream>
 #include <numbers>
-#include <stdexcept>
 #include <utility>
 
 #include "rollsim/common/error.hpp"
