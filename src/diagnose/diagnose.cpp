@@ -95,12 +95,11 @@ void describe_wind(const std::vector<DriveCycle>& cycles, std::vector<Finding>& 
           p.value += turn, p.ci_low += turn, p.ci_high += turn;
         }
       }
-    }
-    if (f.effect == "wind_heading" && f.fitted.count("wind_speed_mps") && f.fitted.count("wind_from_deg"))
       f.description += std::string(f.description.empty() ? "" : "; ") + "a steady wind of " +
                        fixed(f.fitted.at("wind_speed_mps"), 1) + " m/s from " + fixed(f.fitted.at("wind_from_deg"), 0) +
                        " deg (clockwise from north, profiled in 1 deg steps" + bearing_interval_text(f) +
                        "), its headwind turning with the recorded heading";
+    }
   }
 }
 

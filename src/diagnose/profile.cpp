@@ -116,7 +116,7 @@ ProfileResult profile_bearing(const Model& m, double selected_deg, const Eigen::
   std::vector<Eigen::VectorXd> sigs;
   for (double d = -kHalfDeg; d <= kHalfDeg + 1e-9; d += kStepDeg) {
     const double th = units::deg_to_rad(selected_deg + d);
-    grid.push_back(d == 0.0 ? selected_deg : selected_deg + d);
+    grid.push_back(selected_deg + d);  // d steps by whole degrees from -90: exactly 0 at the centre
     sigs.push_back(std::cos(th) * north + std::sin(th) * east);
     rss.push_back(least_squares(hcat(m.x, sigs.back()), *m.y, m.prior).rss);
   }
