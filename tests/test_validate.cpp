@@ -92,6 +92,18 @@ TEST(EngineMap, KnockRetardCostsEfficiencyFromItsStartToFullLoad) {
   EXPECT_NEAR(m.fuel_power_w(w, 0.8 * full) / c.fuel_power_w(w, 0.8 * full), 1.0 / 0.95, 1e-12);
 }
 
+// The idle controller's reserve is air and fuel for torque that is not delivered: at idle speed the map burns
+// what it would for the load plus the reserve; off idle, nothing.
+TEST(EngineMap, IdleTorqueReserveIsBurntAtIdleSpeedOnly) {
+  EngineMapParams p = petrol_map();
+  p.idle_torque_reserve_nm = 10.0;
+  const EngineMap with(p), without(petrol_map());
+  const double idle = p.idle_speed_radps;
+  EXPECT_DOUBLE_EQ(with.fuel_power_w(idle, 0.0), without.fuel_power_w(idle, 10.0));
+  EXPECT_DOUBLE_EQ(with.fuel_power_w(idle, 8.0), without.fuel_power_w(idle, 18.0));
+  EXPECT_DOUBLE_EQ(with.fuel_power_w(1.5 * idle, 8.0), without.fuel_power_w(1.5 * idle, 8.0));
+}
+
 validate::EpaTestRow petrol_row(double litres, double hp) {
   validate::EpaTestRow row;
   row.fuel = validate::EpaFuel::petrol;
@@ -122,6 +134,29 @@ TEST(EpaCar, BoostedEnginesLoseIndicatedEfficiencyWithTheirCompressionRatio) {
   EXPECT_NEAR(mid, (1.0 - std::pow(10.5, -0.3)) / (1.0 - std::pow(13.0, -0.3)), 1e-9);
 }
 
+// The engine's spin-up, worked by hand: 1/2 J (w1^2 - w0^2) with J = 0.2 kg m^2 on each rise (5 -> 10 m/s at
+// 20 rad per metre: +3000 J; after an upshift to 10 rad per metre, 12 -> 15 m/s: +810 J), given back only while
+// the engine drives on at one ratio (10 -> 9 m/s under power: -760 J), not at the upshift (-1800 J) nor braking.
+TEST(TransientFuel, EngineSpinUpFromTheTracesEngineSpeed) {
+  SimulationResult s;
+  s.fuel = FuelFigures{1e-3, 0.0};
+  const double samples[][3] = {{5.0, 100.0, 1e4}, {10.0, 200.0, 2e4}, {9.0, 180.0, 5e3}, {12.0, 120.0, 1e4}, {15.0, 150.0, 1e4}, {10.0, 100.0, 0.0}};
+  for (const auto& x : samples) {
+    TracePoint p{};
+    p.speed_mps = x[0];
+    p.machine_speed_radps = x[1];
+    p.traction_power_w = x[2];
+    s.trace.push_back(p);
+  }
+  EXPECT_NEAR(validate::engine_spin_up_j(s, 0.2), 3000.0 - 760.0 + 810.0, 1e-9);
+  validate::TransientFuelParams p;
+  p.fuel_density_kg_per_m3 = 743.0;
+  p.fuel_energy_j_per_m3 = 743.0 * 42.9e6;
+  p.engine_inertia_kg_m2 = 0.2;
+  p.indicated_efficiency = 0.4;
+  EXPECT_NEAR(validate::fuel_with_transients_m3(s, p), 1e-3 + 3050.0 / 0.4 / p.fuel_energy_j_per_m3, 1e-15);
+}
+
 // The transient additions read the trace alone: rises of the segment fuel rate, and entries into cut-off.
 TEST(TransientFuel, RisesAndCutOffsComeFromTheTrace) {
   SimulationResult s;
@@ -134,8 +169,10 @@ TEST(TransientFuel, RisesAndCutOffsComeFromTheTrace) {
   const auto e = validate::fuel_events(s);
   EXPECT_NEAR(e.rises_m3_per_s, 2e-6 + 2e-6 + 1e-6, 1e-18);
   EXPECT_EQ(e.cut_offs, 2);
-  const double idle = 0.3e-6, density = 743.0;
-  EXPECT_NEAR(validate::fuel_with_transients_m3(s, idle, density), 1e-3 + 0.15 * 5e-6 + 2 * (1.5 * idle + 0.3e-3 / density), 1e-15);
+  validate::TransientFuelParams p;
+  p.idle_fuel_m3_per_s = 0.3e-6;
+  p.fuel_density_kg_per_m3 = 743.0;
+  EXPECT_NEAR(validate::fuel_with_transients_m3(s, p), 1e-3 + 0.15 * 5e-6 + 2 * (1.5 * p.idle_fuel_m3_per_s + 0.3e-3 / 743.0), 1e-15);
 }
 
 ConventionalPowertrainParams car(TransmissionKind kind) {
@@ -474,7 +511,6 @@ TEST(CamryArgonne, CutOffEntriesMatchTheMeasuredFuelFlow) {
   }
   ASSERT_NE(row, nullptr);
   const VehicleModel car = validate::car_from_row(*row, validate::EpaDefaults{});
-  const double idle_m3_per_s = car.powertrain->deliver(0.0, 0.0, 0, car.wheel_radius_m).fuel_rate_m3_per_s;
   SimulationOptions traced;
   traced.record_trace = true;
   const std::string dir = std::string(ROLLSIM_SOURCE_DIR) + "/../shared/data/recordings/anl_d3_2018_toyota_camry/";
@@ -500,7 +536,7 @@ TEST(CamryArgonne, CutOffEntriesMatchTheMeasuredFuelFlow) {
     }
     const SimulationResult s = simulate_replay(car, c, traced);
     const int model_cut_offs = validate::fuel_events(s).cut_offs;
-    const double predicted_m3 = validate::fuel_with_transients_m3(s, idle_m3_per_s, car.powertrain->fuel()->density_kg_per_m3);
+    const double predicted_m3 = validate::fuel_with_transients_m3(s, validate::transient_fuel_params(car));
     std::cout << file << ": cut-off entries " << model_cut_offs << " (measured " << measured_cut_offs << ")\n";
     // Hot UDDS 68 against 63 measured, two HWFETs 34 against 28, two US06s 43 against 39: within a quarter.
     EXPECT_NEAR(model_cut_offs, measured_cut_offs, 0.25 * measured_cut_offs) << file;

@@ -32,7 +32,8 @@ double EngineMap::friction_power_w(double speed_radps) const {
 
 double EngineMap::fuel_power_w(double speed_radps, double brake_torque_nm) const {
   const double w = std::max(speed_radps, p_.idle_speed_radps);
-  const double torque_nm = std::max(brake_torque_nm, 0.0);
+  const bool idling = speed_radps <= p_.idle_speed_radps;
+  const double torque_nm = std::max(brake_torque_nm, 0.0) + (idling ? p_.idle_torque_reserve_nm : 0.0);
   const double bmep_pa = kFourStroke * torque_nm / p_.displacement_m3;
   const double fmep_pa = p_.friction_mep0_pa + w * (p_.friction_mep1_pa_s_per_rad + w * p_.friction_mep2_pa_s2_per_rad2);
   // Pumping falls linearly from its closed-throttle value to zero at the unthrottled imep; solved for the gross

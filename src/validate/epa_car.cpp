@@ -117,6 +117,9 @@ EngineMapParams engine_of(const EpaTestRow& row, const EpaDefaults& d) {
   // ... and only above 5 m/s (18 km/h) of road speed: EPA's ALPHA enables deceleration fuel cut-off on
   // '@veh_spd_mps>5' for the 2018 A25A-FKS engine it documents (ALPHA_Documentation/model_inputs.rst).
   e.fuel_cut_min_vehicle_speed_mps = 5.0;
+  // Rotating inertia: EPA's ALPHA gives its 2.46 l A25A-FKS 0.143 kg m^2 (ALPHA_Documentation/model_inputs.rst);
+  // crank, flywheel and pistons grow with the engine, taken here in proportion to displacement.
+  e.inertia_kg_m2 = 0.143 * e.displacement_m3 / 2.464e-3;
   return e;
 }
 

@@ -12,6 +12,7 @@
 #include "rollsim/common/statistics.hpp"
 #include "rollsim/common/units.hpp"
 #include "rollsim/cycle/drive_cycle.hpp"
+#include "rollsim/powertrain/conventional.hpp"
 
 namespace rollsim::validate {
 
@@ -173,11 +174,42 @@ FuelEvents fuel_events(const SimulationResult& s) {
   return e;
 }
 
-double fuel_with_transients_m3(const SimulationResult& s, double idle_fuel_m3_per_s, double fuel_density_kg_per_m3) {
+TransientFuelParams transient_fuel_params(const VehicleModel& car) {
+  TransientFuelParams p;
+  const FuelParams* fuel = car.powertrain->fuel();
+  if (!fuel) return p;
+  p.idle_fuel_m3_per_s = car.powertrain->deliver(0.0, 0.0, 0, car.wheel_radius_m).fuel_rate_m3_per_s;
+  p.fuel_density_kg_per_m3 = fuel->density_kg_per_m3;
+  p.fuel_energy_j_per_m3 = fuel->energy_j_per_m3();
+  if (const auto* engine_car = dynamic_cast<const ConventionalPowertrain*>(car.powertrain.get())) {
+    p.engine_inertia_kg_m2 = engine_car->params().engine.inertia_kg_m2;
+    p.indicated_efficiency = engine_car->params().engine.indicated_efficiency;
+  }
+  return p;
+}
+
+double engine_spin_up_j(const SimulationResult& s, double inertia_kg_m2) {
+  // Same ratio: within 2 %, well inside the smallest step of a 10-speed (~10 %), outside a locked drive's noise.
+  auto ratio = [](const TracePoint& p) { return p.speed_mps > 0.0 ? p.machine_speed_radps / p.speed_mps : 0.0; };
+  double j = 0.0;
+  for (std::size_t i = 1; i < s.trace.size(); ++i) {
+    const TracePoint &a = s.trace[i - 1], &b = s.trace[i];
+    const double de = 0.5 * inertia_kg_m2 * (b.machine_speed_radps * b.machine_speed_radps - a.machine_speed_radps * a.machine_speed_radps);
+    const bool driving_on = a.traction_power_w > 0.0 && b.traction_power_w > 0.0 && ratio(a) > 0.0 &&
+                            std::abs(ratio(b) / ratio(a) - 1.0) < 0.02;
+    if (de > 0.0 || driving_on) j += de;
+  }
+  return std::max(j, 0.0);
+}
+
+double fuel_with_transients_m3(const SimulationResult& s, const TransientFuelParams& p) {
   if (!s.fuel) return 0.0;
   const FuelEvents e = fuel_events(s);
+  const double spin_up_m3 = p.engine_inertia_kg_m2 > 0.0
+                                ? engine_spin_up_j(s, p.engine_inertia_kg_m2) / p.indicated_efficiency / p.fuel_energy_j_per_m3
+                                : 0.0;
   return s.fuel->volume_m3 + kTransientFuelTime_s * e.rises_m3_per_s +
-         e.cut_offs * (kCutOffDelay_s * idle_fuel_m3_per_s + kCatalystPurgeFuel_kg / fuel_density_kg_per_m3);
+         e.cut_offs * (kCutOffDelay_s * p.idle_fuel_m3_per_s + kCatalystPurgeFuel_kg / p.fuel_density_kg_per_m3) + spin_up_m3;
 }
 
 namespace {
@@ -212,9 +244,8 @@ Raw simulate_row(const EpaTestRow& r, const Cycles& c, const EpaDefaults& d) {
     w.mpg_or_mpge = kKwhPerGallonEquivalent / (wall_kwh / miles(s.distance_m));
     return w;
   }
-  const double idle_m3_per_s = car.powertrain->deliver(0.0, 0.0, 0, car.wheel_radius_m).fuel_rate_m3_per_s;
-  const double density = car.powertrain->fuel()->density_kg_per_m3;
-  auto fuel_m3 = [&](const SimulationResult& s) { return fuel_with_transients_m3(s, idle_m3_per_s, density); };
+  const TransientFuelParams transients = transient_fuel_params(car);
+  auto fuel_m3 = [&](const SimulationResult& s) { return fuel_with_transients_m3(s, transients); };
   SimulationOptions traced;
   traced.record_trace = true;
   if (r.cycle == EpaCycle::ftp75) {

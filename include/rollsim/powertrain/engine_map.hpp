@@ -31,6 +31,12 @@ struct EngineMapParams {
   double knock_start_fraction = 1.0;
   double knock_efficiency_loss_max = 0.0;
   double idle_speed_radps = 0.0;
+  /// Torque the idle controller keeps in hand at idle speed: air and fuel for this much more than the load, the
+  /// spark retarded so it is not delivered, so a load step does not stall the engine (EPA ALPHA's idle control).
+  double idle_torque_reserve_nm = 0.0;
+  /// Crank, flywheel and rotating parts: the engine must be spun up through the gear ratio as the car speeds up
+  /// (booked by validate::fuel_with_transients_m3 from the trace's engine speed, not by the replay).
+  double inertia_kg_m2 = 0.0;
   double rated_speed_radps = 0.0;  ///< speed of rated power
   double max_speed_radps = 0.0;    ///< rev limit
   double max_torque_nm = 0.0;      ///< plateau of the full-load curve

@@ -106,6 +106,7 @@ struct TracePoint {
   /// the trace adds up to the run's energy totals; the point values, a left-end rule, do not.
   double segment_battery_power_w, segment_battery_loss_w, segment_fuel_rate_m3_per_s;
   double rrc;  ///< rolling force / total normal load
+  double machine_speed_radps;  ///< engine or motor speed (0 with the engine off)
   double soc;  ///< state of charge, fraction (electric)
   int gear;
 };
