@@ -44,7 +44,6 @@ int regime(const Recording& r, std::size_t i) {
 // fuel), its fuel with what the steady-state map leaves out (validate::fuel_with_transients_m3).
 std::vector<CamryTest> camry_on_argonne(const Vehicle& vehicle) {
   const VehicleModel car = VehicleModel::assemble(vehicle);
-  const double idle_m3_per_s = car.powertrain->deliver(0.0, 0.0, 0, car.wheel_radius_m).fuel_rate_m3_per_s;
   SimulationOptions traced;
   traced.record_trace = true;
   std::vector<CamryTest> out;
@@ -64,7 +63,7 @@ std::vector<CamryTest> camry_on_argonne(const Vehicle& vehicle) {
       if (i < s.trace.size()) t.regime_model_m3[k] += s.trace[i].segment_fuel_rate_m3_per_s * dt;
     }
     t.measured_idle_m3_per_s = median(idle);
-    t.predicted_m3 = validate::fuel_with_transients_m3(s, idle_m3_per_s, vehicle.fuel()->density_kg_per_m3);
+    t.predicted_m3 = validate::fuel_with_transients_m3(s, validate::transient_fuel_params(car));
     out.push_back(t);
   }
   return out;
@@ -112,6 +111,8 @@ TEST(CamryFuelMap, BadEngineMapKeysAreNamedErrors) {
   expect_has(error_of("max_load_pct: 60", "max_load_pct: 60\n    launch_engine_speed_rpm: 1400"), {"launch_engine_speed_rpm", "slipping clutch"});
   expect_has(error_of("fuel_cut_min_vehicle_speed_kmh: 18 ", "fuel_cut_min_vehicle_speed_kmh: 500 "),
              {"fuel_cut_min_vehicle_speed_kmh", "500"});
+  expect_has(error_of("inertia_kgm2: 0.144 ", "inertia_kgm2: -0.144 "), {"inertia_kgm2", "-0.144"});
+  expect_has(error_of("idle_torque_reserve_nm: 10 ", "idle_torque_reserve_nm: 1000 "), {"idle_torque_reserve_nm", "1000"});
 }
 
 // The file's map against EPA's published map of its engine (the A25A-FKS Tier 2 ALPHA map package, 2020-07: brake
@@ -146,8 +147,9 @@ TEST(CamryFuelMap, EfficiencyAgainstEpasPublishedMapOfTheA25A) {
 
 // Issue 13, item 5: after the Camry's own calibration (one scale on its fuel, from its three tests together),
 // the issue asks each test within 3 % of its measured fuel. With the map read off EPA's published map of the
-// engine (validate's class values had the UDDS at +3.5 %, too much fuel cruising slowly) all three are. And the
-// engine idles at its stops in neutral, as the car does.
+// engine (validate's class values had the UDDS at +3.5 %, too much fuel cruising slowly) and EPA ALPHA's idle
+// torque reserve and engine inertia for it, all three are, out of sample within 4 %. And the engine idles at its
+// stops in neutral, as the car does.
 TEST(CamryFuelMap, ArgonneHotUddsHwfetUs06AfterItsOwnCalibration) {
   const Vehicle v = camry();
   const auto tests = camry_on_argonne(v);
@@ -178,14 +180,13 @@ TEST(CamryFuelMap, ArgonneHotUddsHwfetUs06AfterItsOwnCalibration) {
     for (std::size_t k = 0; k < 5; ++k) std::cout << " " << std::lround(t.regime_measured_m3[k] * 1e6) << "/" << std::lround(scale * t.regime_model_m3[k] * 1e6);
     std::cout << "\n";
     EXPECT_LT(std::abs(err_pct), 3.0) << t.file;
-    EXPECT_LT(std::abs(loo_err_pct), 5.0) << t.file;
-    // Neutral idle: nearer the car's standstill fuel flow than a stalled converter's load. The level is low (19 %
-    // below, where validate's class map was within 15 %): the published map itself burns 0.204 cm3/s at 774 rpm
-    // and 2.2 N m, as the car does, 25 % more than friction and pumping explain (EPA's ALPHA idles with a 10 N m
-    // torque reserve held on spark), and the map has no term for it (README).
+    EXPECT_LT(std::abs(loo_err_pct), 4.0) << t.file;
+    // Neutral idle: nearer the car's standstill fuel flow than a stalled converter's load, and within 15 % of it.
+    // The published map's friction and pumping alone idle 19 % low; the file's idle torque reserve (EPA ALPHA's
+    // 10 N m held on spark) is what the map burns at its idle corner, 0.204 cm3/s at 774 rpm and 2.2 N m.
     const double neutral = idle_m3_per_s / t.measured_idle_m3_per_s, loaded = stalled_idle_m3_per_s / t.measured_idle_m3_per_s;
     EXPECT_LT(std::abs(neutral - 1.0), std::abs(loaded - 1.0)) << t.file;
-    EXPECT_NEAR(neutral, 1.0, 0.25) << t.file;
+    EXPECT_NEAR(neutral, 1.0, 0.15) << t.file;
   }
 }
 
