@@ -149,6 +149,8 @@ TEST(TransientFuel, EngineSpinUpFromTheTracesEngineSpeed) {
     s.trace.push_back(p);
   }
   EXPECT_NEAR(validate::engine_spin_up_j(s, 0.2), 3000.0 - 760.0 + 810.0, 1e-9);
+  // Behind a variator the ratio change under power gives its drop back too (-1800 J); braking still does not.
+  EXPECT_NEAR(validate::engine_spin_up_j(s, 0.2, true), 3000.0 - 760.0 - 1800.0 + 810.0, 1e-9);
   validate::TransientFuelParams p;
   p.fuel_density_kg_per_m3 = 743.0;
   p.fuel_energy_j_per_m3 = 743.0 * 42.9e6;

@@ -184,11 +184,12 @@ TransientFuelParams transient_fuel_params(const VehicleModel& car) {
   if (const auto* engine_car = dynamic_cast<const ConventionalPowertrain*>(car.powertrain.get())) {
     p.engine_inertia_kg_m2 = engine_car->params().engine.inertia_kg_m2;
     p.indicated_efficiency = engine_car->params().engine.indicated_efficiency;
+    p.continuously_variable = engine_car->params().transmission.kind == TransmissionKind::cvt;
   }
   return p;
 }
 
-double engine_spin_up_j(const SimulationResult& s, double inertia_kg_m2) {
+double engine_spin_up_j(const SimulationResult& s, double inertia_kg_m2, bool continuously_variable) {
   // Same ratio: within 2 %, well inside the smallest step of a 10-speed (~10 %), outside a locked drive's noise.
   auto ratio = [](const TracePoint& p) { return p.speed_mps > 0.0 ? p.machine_speed_radps / p.speed_mps : 0.0; };
   double j = 0.0;
@@ -196,7 +197,7 @@ double engine_spin_up_j(const SimulationResult& s, double inertia_kg_m2) {
     const TracePoint &a = s.trace[i - 1], &b = s.trace[i];
     const double de = 0.5 * inertia_kg_m2 * (b.machine_speed_radps * b.machine_speed_radps - a.machine_speed_radps * a.machine_speed_radps);
     const bool driving_on = a.traction_power_w > 0.0 && b.traction_power_w > 0.0 && ratio(a) > 0.0 &&
-                            std::abs(ratio(b) / ratio(a) - 1.0) < 0.02;
+                            (continuously_variable || std::abs(ratio(b) / ratio(a) - 1.0) < 0.02);
     if (de > 0.0 || driving_on) j += de;
   }
   return std::max(j, 0.0);
@@ -206,7 +207,8 @@ double fuel_with_transients_m3(const SimulationResult& s, const TransientFuelPar
   if (!s.fuel) return 0.0;
   const FuelEvents e = fuel_events(s);
   const double spin_up_m3 = p.engine_inertia_kg_m2 > 0.0
-                                ? engine_spin_up_j(s, p.engine_inertia_kg_m2) / p.indicated_efficiency / p.fuel_energy_j_per_m3
+                                ? engine_spin_up_j(s, p.engine_inertia_kg_m2, p.continuously_variable) / p.indicated_efficiency /
+                                      p.fuel_energy_j_per_m3
                                 : 0.0;
   return s.fuel->volume_m3 + kTransientFuelTime_s * e.rises_m3_per_s +
          e.cut_offs * (kCutOffDelay_s * p.idle_fuel_m3_per_s + kCatalystPurgeFuel_kg / p.fuel_density_kg_per_m3) + spin_up_m3;
