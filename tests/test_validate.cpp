@@ -134,18 +134,21 @@ TEST(EpaCar, BoostedEnginesLoseIndicatedEfficiencyWithTheirCompressionRatio) {
   EXPECT_NEAR(mid, (1.0 - std::pow(10.5, -0.3)) / (1.0 - std::pow(13.0, -0.3)), 1e-9);
 }
 
-// The engine's spin-up, worked by hand: 1/2 J (w1^2 - w0^2) with J = 0.2 kg m^2 on each rise (5 -> 10 m/s at
-// 20 rad per metre: +3000 J; after an upshift to 10 rad per metre, 12 -> 15 m/s: +810 J), given back only while
-// the engine drives on at one ratio (10 -> 9 m/s under power: -760 J), not at the upshift (-1800 J) nor braking.
+// The engine's spin-up, worked by hand: 1/2 J (w1^2 - w0^2) with J = 0.2 kg m^2 on each rise under power (5 -> 10
+// m/s in a gear of 20 rad per metre: +3000 J; after the upshift to 10, 12 -> 15 m/s: +810 J), given back only while
+// the engine drives on in one gear (10 -> 9 m/s under power: -760 J), not at the upshift (-1800 J) nor braking; a
+// downshift while coasting (100 -> 120 rad/s, +440 J) is paid by the wheels.
 TEST(TransientFuel, EngineSpinUpFromTheTracesEngineSpeed) {
   SimulationResult s;
   s.fuel = FuelFigures{1e-3, 0.0};
-  const double samples[][3] = {{5.0, 100.0, 1e4}, {10.0, 200.0, 2e4}, {9.0, 180.0, 5e3}, {12.0, 120.0, 1e4}, {15.0, 150.0, 1e4}, {10.0, 100.0, 0.0}};
+  const double samples[][4] = {{5.0, 100.0, 1e4, 20.0}, {10.0, 200.0, 2e4, 20.0}, {9.0, 180.0, 5e3, 20.0}, {12.0, 120.0, 1e4, 10.0},
+                               {15.0, 150.0, 1e4, 10.0}, {10.0, 100.0, 0.0, 10.0},  {6.0, 120.0, 0.0, 20.0}};
   for (const auto& x : samples) {
     TracePoint p{};
     p.speed_mps = x[0];
     p.machine_speed_radps = x[1];
     p.traction_power_w = x[2];
+    p.gear_ratio = x[3];
     s.trace.push_back(p);
   }
   EXPECT_NEAR(validate::engine_spin_up_j(s, 0.2), 3000.0 - 760.0 + 810.0, 1e-9);
@@ -155,8 +158,10 @@ TEST(TransientFuel, EngineSpinUpFromTheTracesEngineSpeed) {
   p.fuel_density_kg_per_m3 = 743.0;
   p.fuel_energy_j_per_m3 = 743.0 * 42.9e6;
   p.engine_inertia_kg_m2 = 0.2;
-  p.indicated_efficiency = 0.4;
+  p.marginal_efficiency = 0.4;
   EXPECT_NEAR(validate::fuel_with_transients_m3(s, p), 1e-3 + 3050.0 / 0.4 / p.fuel_energy_j_per_m3, 1e-15);
+  p.fuel_energy_j_per_m3 = 0.0;
+  EXPECT_THROW(validate::fuel_with_transients_m3(s, p), ModelDomainError);
 }
 
 // The transient additions read the trace alone: rises of the segment fuel rate, and entries into cut-off.

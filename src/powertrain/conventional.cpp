@@ -156,6 +156,7 @@ PowerFlow ConventionalPowertrain::deliver(double wheel_force_n, double speed_mps
     out.clutch_loss_w = op.slip_loss_w;
     engine_radps = op.engine_speed_radps;
     engine_nm = op.engine_torque_nm;
+    out.gear_ratio = op.ratio;
   } else {
     // Braking, coasting or standing: friction brakes hold the car. Coupled above the cut-off speeds (engine and
     // road) the engine is motored without fuel and the wheels carry the accessories too (all booked as braking);
@@ -167,6 +168,7 @@ PowerFlow ConventionalPowertrain::deliver(double wheel_force_n, double speed_mps
       if (op.locked && op.engine_speed_radps > e.fuel_cut_min_speed_radps && v > e.fuel_cut_min_vehicle_speed_mps) {
         out.aux_power_w = 0.0;
         out.machine_speed_radps = op.engine_speed_radps;
+        out.gear_ratio = op.ratio;
         return out;
       }
     } else if (p_.transmission.kind != TransmissionKind::clutch && !p_.transmission.converter.neutral_at_standstill) {

@@ -299,6 +299,7 @@ TracePoint trace_point(const VehicleModel& m, double t, double target_mps, doubl
   const double normal_n = m.mass_kg * units::kStandardGravity_mps2 / std::sqrt(1.0 + grade * grade);
   p.rrc = s.rolling_n / normal_n;
   p.machine_speed_radps = s.flow.machine_speed_radps;
+  p.gear_ratio = s.flow.gear_ratio;
   p.soc = soc;
   p.gear = gear;
   return p;

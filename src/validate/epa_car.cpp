@@ -20,11 +20,17 @@ constexpr double kFourStroke = 4.0 * std::numbers::pi;
 // speed, so any radius gives the same car.
 constexpr double kWheelRadius_m = 0.33;
 
-// Rotating inertia on the dynamometer: the rolls simulate the equivalent test weight; the driven axle's wheels,
-// driveline and engine spin on the rolls and add their own inertia; the other axle stands still on a
-// two-wheel-drive dynamometer. 40 CFR 1066.310 lets coast-down analysis take a vehicle's rotating mass as
-// 1.5 % of its test mass; half of it (one axle) turns on a 2WD dynamometer, all of it on a 4WD one.
+// Rotating inertia on the dynamometer: the rolls simulate the equivalent test weight; the driven axle's wheels
+// and driveline spin on the rolls and add their own inertia; the other axle stands still on a two-wheel-drive
+// dynamometer. 40 CFR 1066.310 lets coast-down analysis take a vehicle's rotating mass as 1.5 % of its test mass
+// (a coast-down runs in neutral, so the engine is not in it); half of it (one axle) turns on a 2WD dynamometer,
+// all of it on a 4WD one. The engine's own inertia, spun up through the gears, is booked from the trace instead
+// (validate::engine_spin_up_j).
 constexpr double kRotatingMassShare = 0.015;
+
+// EPA's ALPHA gives its 2.46 l A25A-FKS 0.143 kg m^2 (ALPHA_Documentation/model_inputs.rst); crank, flywheel and
+// pistons grow with the engine, taken here in proportion to displacement.
+constexpr double kEngineInertiaPerDisplacement_kg_m2_per_m3 = 0.143 / 2.464e-3;
 
 // Ratio spread (first / top gear) by number of gears, from the published ratio sets of common 2015-2022
 // transmissions: Aisin and GM 6-speeds ~6.0, ZF 8HP 7.07, Aisin 8-speeds ~7.0, ZF 9HP 9.8, GM/Ford 10-speed 7.4,
@@ -117,9 +123,7 @@ EngineMapParams engine_of(const EpaTestRow& row, const EpaDefaults& d) {
   // ... and only above 5 m/s (18 km/h) of road speed: EPA's ALPHA enables deceleration fuel cut-off on
   // '@veh_spd_mps>5' for the 2018 A25A-FKS engine it documents (ALPHA_Documentation/model_inputs.rst).
   e.fuel_cut_min_vehicle_speed_mps = 5.0;
-  // Rotating inertia: EPA's ALPHA gives its 2.46 l A25A-FKS 0.143 kg m^2 (ALPHA_Documentation/model_inputs.rst);
-  // crank, flywheel and pistons grow with the engine, taken here in proportion to displacement.
-  e.inertia_kg_m2 = 0.143 * e.displacement_m3 / 2.464e-3;
+  e.inertia_kg_m2 = kEngineInertiaPerDisplacement_kg_m2_per_m3 * e.displacement_m3;
   return e;
 }
 

@@ -182,23 +182,24 @@ TransientFuelParams transient_fuel_params(const VehicleModel& car) {
   p.fuel_density_kg_per_m3 = fuel->density_kg_per_m3;
   p.fuel_energy_j_per_m3 = fuel->energy_j_per_m3();
   if (const auto* engine_car = dynamic_cast<const ConventionalPowertrain*>(car.powertrain.get())) {
-    p.engine_inertia_kg_m2 = engine_car->params().engine.inertia_kg_m2;
-    p.indicated_efficiency = engine_car->params().engine.indicated_efficiency;
+    const EngineMapParams& e = engine_car->params().engine;
+    p.engine_inertia_kg_m2 = e.inertia_kg_m2;
+    // At part load more brake work also opens the throttle, so the pumping falls as the torque rises: the fuel per
+    // extra brake work is 1 / (eta (1 + closed-throttle pumping / unthrottled imep)), not 1 / eta (EngineMap).
+    p.marginal_efficiency = e.indicated_efficiency * (e.unthrottled_imep_pa > 0.0 ? 1.0 + e.pumping_mep_closed_pa / e.unthrottled_imep_pa : 1.0);
     p.continuously_variable = engine_car->params().transmission.kind == TransmissionKind::cvt;
   }
   return p;
 }
 
 double engine_spin_up_j(const SimulationResult& s, double inertia_kg_m2, bool continuously_variable) {
-  // Same ratio: within 2 %, well inside the smallest step of a 10-speed (~10 %), outside a locked drive's noise.
-  auto ratio = [](const TracePoint& p) { return p.speed_mps > 0.0 ? p.machine_speed_radps / p.speed_mps : 0.0; };
   double j = 0.0;
   for (std::size_t i = 1; i < s.trace.size(); ++i) {
     const TracePoint &a = s.trace[i - 1], &b = s.trace[i];
     const double de = 0.5 * inertia_kg_m2 * (b.machine_speed_radps * b.machine_speed_radps - a.machine_speed_radps * a.machine_speed_radps);
-    const bool driving_on = a.traction_power_w > 0.0 && b.traction_power_w > 0.0 && ratio(a) > 0.0 &&
-                            (continuously_variable || std::abs(ratio(b) / ratio(a) - 1.0) < 0.02);
-    if (de > 0.0 || driving_on) j += de;
+    const bool one_gear = a.gear_ratio > 0.0 && (continuously_variable || a.gear_ratio == b.gear_ratio);
+    const bool driving_on = a.traction_power_w > 0.0 && b.traction_power_w > 0.0 && one_gear;
+    if ((de > 0.0 && b.traction_power_w > 0.0) || (de < 0.0 && driving_on)) j += de;
   }
   return std::max(j, 0.0);
 }
@@ -206,8 +207,11 @@ double engine_spin_up_j(const SimulationResult& s, double inertia_kg_m2, bool co
 double fuel_with_transients_m3(const SimulationResult& s, const TransientFuelParams& p) {
   if (!s.fuel) return 0.0;
   const FuelEvents e = fuel_events(s);
+  if (e.cut_offs > 0 && p.fuel_density_kg_per_m3 <= 0.0) throw ModelDomainError("transient fuel: fuel density must be positive");
+  if (p.engine_inertia_kg_m2 > 0.0 && (p.fuel_energy_j_per_m3 <= 0.0 || p.marginal_efficiency <= 0.0))
+    throw ModelDomainError("transient fuel: an engine with inertia needs a positive fuel energy and efficiency");
   const double spin_up_m3 = p.engine_inertia_kg_m2 > 0.0
-                                ? engine_spin_up_j(s, p.engine_inertia_kg_m2, p.continuously_variable) / p.indicated_efficiency /
+                                ? engine_spin_up_j(s, p.engine_inertia_kg_m2, p.continuously_variable) / p.marginal_efficiency /
                                       p.fuel_energy_j_per_m3
                                 : 0.0;
   return s.fuel->volume_m3 + kTransientFuelTime_s * e.rises_m3_per_s +

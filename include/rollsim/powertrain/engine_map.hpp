@@ -58,7 +58,9 @@ class EngineMap {
   double max_torque_nm(double speed_radps) const;
 
   /// Fuel power [W] (lower heating value) at a brake torque >= 0 and a speed >= idle. Fired: a motored engine
-  /// (negative torque) is the caller's case (fuel cut-off or idle).
+  /// (negative torque) is the caller's case (fuel cut-off or idle). At idle speed the idle controller's torque
+  /// reserve is burnt on top of the load (read from the speed: the powertrain holds the engine at idle speed only
+  /// while idling, creeping on its converter or slipping a clutch at launch, all with the controller on).
   double fuel_power_w(double speed_radps, double brake_torque_nm) const;
 
   /// The friction power [W] at a speed: what the engine absorbs when motored with no fuel.

@@ -48,6 +48,7 @@ struct PowerFlow {
   double battery_current_a = 0.0;       ///< signed: + discharging
   double machine_speed_radps = 0.0;     ///< motor or engine speed
   double machine_torque_nm = 0.0;       ///< motor or engine torque
+  double gear_ratio = 0.0;              ///< the engaged gear's (or a CVT's) input per output speed; 0 when none is
   bool force_limited = false;           ///< true when the request exceeded what the powertrain can deliver
 };
 

@@ -107,6 +107,7 @@ struct TracePoint {
   double segment_battery_power_w, segment_battery_loss_w, segment_fuel_rate_m3_per_s;
   double rrc;  ///< rolling force / total normal load
   double machine_speed_radps;  ///< engine or motor speed (0 with the engine off)
+  double gear_ratio;           ///< the powertrain's engaged gear ratio (0: none, or a powertrain without gears)
   double soc;  ///< state of charge, fraction (electric)
   int gear;
 };

@@ -61,24 +61,24 @@ struct TransientFuelParams {
   double idle_fuel_m3_per_s = 0.0;
   double fuel_density_kg_per_m3 = 0.0;
   double fuel_energy_j_per_m3 = 0.0;
-  double engine_inertia_kg_m2 = 0.0;  ///< 0: a powertrain without an engine map
-  double indicated_efficiency = 1.0;  ///< what spinning the engine up costs at the margin
+  double engine_inertia_kg_m2 = 0.0;   ///< 0: a powertrain without an engine map
+  double marginal_efficiency = 1.0;    ///< brake work per fuel energy at the margin, what spinning the engine up costs
   bool continuously_variable = false;  ///< a variator, not clutches, changes the ratio
 };
 /// Read off the car's powertrain (its standstill fuel rate, fuel, and the engine map's inertia and efficiency).
 TransientFuelParams transient_fuel_params(const VehicleModel& car);
 
-/// The engine's kinetic energy [J] a run's trace asks the fuel for: every rise of 1/2 J w^2 between samples, less
-/// what the engine gives back while it drives on at one gear ratio (the car slowing under power) or, behind a
-/// variator, at any ratio (the belt passes the inertia's torque to the wheels). A stepped upshift's drop (the
-/// clutches and the spark retard of the shift take it) and a drop while coasting or braking (fuel is cut or the
-/// brakes take it) give nothing back. The gear ratio is the engine speed over the road speed.
+/// The engine's kinetic energy [J] a run's trace asks the fuel for: every rise of 1/2 J w^2 between samples that
+/// ends under power (a rise while coasting, a downshift, is paid by the wheels), less what the engine gives back
+/// while it drives on in one gear (the car slowing under power) or, behind a variator, at any ratio (the belt
+/// passes the inertia's torque to the wheels). A stepped upshift's drop (the clutches and the spark retard of the
+/// shift take it) and a drop while coasting or braking (fuel is cut or the brakes take it) give nothing back.
 double engine_spin_up_j(const SimulationResult& s, double inertia_kg_m2, bool continuously_variable = false);
 
 /// The run's fuel [m3] with what a steady-state map leaves out (validate.cpp, after SAE 2017-01-0533): transient
 /// fuelling (0.15 s of each rise of the fuel rate), per cut-off 1.5 s at the idle rate before it and a 0.3 g
-/// catalyst purge after it, and the engine's spin-up (engine_spin_up_j) at the indicated efficiency. Needs the
-/// run's trace.
+/// catalyst purge after it, and the engine's spin-up (engine_spin_up_j) at the marginal efficiency. Needs the
+/// run's trace; a density, fuel energy or efficiency that is not positive where it is needed is a ModelDomainError.
 double fuel_with_transients_m3(const SimulationResult& s, const TransientFuelParams& p);
 
 /// FTP-75 fuel economy [mpg] from its bags (40 CFR 600.113): 0.43 x the cold UDDS (bags 1 + 2) and 0.57 x the hot
