@@ -12,7 +12,8 @@ keys (displacement, full-load curve, unthrottled imep 11 bar, closed-throttle pu
 indicated efficiency, friction f0 + f1 krpm + f2 krpm^2, knock onset and loss, enrichment onset and amount;
 least squares of log(model fuel / published fuel) over the points above 5 N m. Below it is the map's 2.2 N m
 row, the idle corner, where the engine burns 10-25 % more than friction and pumping explain (EPA's ALPHA holds a
-10 N m torque reserve on spark at idle), which EngineMap has no term for; fitting it too moves friction by 0.06 bar. The part-load points fix friction + pumping as a sum only (the slope and the
+10 N m torque reserve on spark at idle), which the file books separately (idle_torque_reserve_nm); fitting it
+too moves friction by 0.06 bar. The part-load points fix friction + pumping as a sum only (the slope and the
 intercept of fuel against bmep); the pumping share is not in the map, so the class value stays (the map's fit is
 as good with 0 as with 0.9 bar). No recording enters: the Argonne tests judge the result.
 Run: python3 scripts/fit_engine_map.py MAP.csv
@@ -53,6 +54,8 @@ def published(path):
     out = []
     for r in rows:
         rpm, torque_nm, fuel_gps = float(r[0]), float(r[1]), float(r[2])
+        if fuel_gps <= 0.0:  # a motored row burns nothing: no efficiency to fit
+            continue
         power_w = torque_nm * rpm * math.pi / 30.0
         out.append((rpm, torque_nm, power_w / (fuel_gps * LHV_J_PER_G)))
     return out

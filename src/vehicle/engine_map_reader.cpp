@@ -39,7 +39,7 @@ EngineMapParams read_engine(YamlMap m) {
                                            Range::closed(0.0, 3e4)) * kRadpsPerRpm;
   e.fuel_cut_min_vehicle_speed_mps = units::kmh_to_mps(m.number_or("fuel_cut_min_vehicle_speed_kmh", 0.0, Range::closed(0.0, 200.0)));
   e.idle_torque_reserve_nm = m.number_or("idle_torque_reserve_nm", 0.0, Range::closed(0.0, 100.0));
-  e.inertia_kg_m2 = m.number_or("inertia_kgm2", 0.0, Range::closed(0.0, 5.0));
+  e.inertia_kg_m2 = m.number_or("inertia_kg_m2", 0.0, Range::closed(0.0, 5.0));
   if (e.rated_speed_radps <= e.idle_speed_radps) throw InputError(m.where("rated_speed_rpm"), "must exceed idle_speed_rpm");
   if (e.max_speed_radps < e.rated_speed_radps) throw InputError(m.where("max_speed_rpm"), "must be at least rated_speed_rpm");
   if (e.enrichment_start_fraction >= 1.0 && e.enrichment_max > 0.0)
