@@ -66,6 +66,10 @@ TEST(EngineMap, PumpingVanishesAtTheUnthrottledLoadAndEnrichmentAtFullLoad) {
   const double willans_w = p.unthrottled_imep_pa * p.displacement_m3 * w / four_pi / p.indicated_efficiency;
   EXPECT_NEAR(m.fuel_power_w(w, t_wot), willans_w, 1e-6 * willans_w);
   EXPECT_NEAR(m.fuel_power_w(w, t_wot - 1e-6), m.fuel_power_w(w, t_wot + 1e-6), 1e-2);  // slope ~750 W/(N m)
+  // At part load a step of torque costs what part_load_marginal_efficiency says (the pumping falls as it rises).
+  const double step_nm = 1.0, step_fuel_w = m.fuel_power_w(w, 41.0) - m.fuel_power_w(w, 40.0);
+  EXPECT_NEAR(step_nm * w / step_fuel_w, m.part_load_marginal_efficiency(), 1e-9);
+  EXPECT_NEAR(m.part_load_marginal_efficiency(), p.indicated_efficiency * (1.0 + 0.9 / 11.0), 1e-12);
   // At light load the throttle costs fuel beyond the Willans line.
   EngineMapParams open = p;
   open.pumping_mep_closed_pa = 0.0;

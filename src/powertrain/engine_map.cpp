@@ -30,6 +30,11 @@ double EngineMap::friction_power_w(double speed_radps) const {
   return fmep_pa * p_.displacement_m3 * w / kFourStroke;
 }
 
+double EngineMap::part_load_marginal_efficiency() const {
+  const double pc = p_.pumping_mep_closed_pa, a = p_.unthrottled_imep_pa;
+  return p_.indicated_efficiency * (pc > 0.0 && a > 0.0 ? 1.0 + pc / a : 1.0);
+}
+
 double EngineMap::fuel_power_w(double speed_radps, double brake_torque_nm) const {
   const double w = std::max(speed_radps, p_.idle_speed_radps);
   const bool idling = speed_radps <= p_.idle_speed_radps;

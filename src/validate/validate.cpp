@@ -182,11 +182,8 @@ TransientFuelParams transient_fuel_params(const VehicleModel& car) {
   p.fuel_density_kg_per_m3 = fuel->density_kg_per_m3;
   p.fuel_energy_j_per_m3 = fuel->energy_j_per_m3();
   if (const auto* engine_car = dynamic_cast<const ConventionalPowertrain*>(car.powertrain.get())) {
-    const EngineMapParams& e = engine_car->params().engine;
-    p.engine_inertia_kg_m2 = e.inertia_kg_m2;
-    // At part load more brake work also opens the throttle, so the pumping falls as the torque rises: the fuel per
-    // extra brake work is 1 / (eta (1 + closed-throttle pumping / unthrottled imep)), not 1 / eta (EngineMap).
-    p.marginal_efficiency = e.indicated_efficiency * (e.unthrottled_imep_pa > 0.0 ? 1.0 + e.pumping_mep_closed_pa / e.unthrottled_imep_pa : 1.0);
+    p.engine_inertia_kg_m2 = engine_car->params().engine.inertia_kg_m2;
+    p.marginal_efficiency = EngineMap(engine_car->params().engine).part_load_marginal_efficiency();
     p.continuously_variable = engine_car->params().transmission.kind == TransmissionKind::cvt;
   }
   return p;

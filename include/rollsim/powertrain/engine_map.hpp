@@ -63,6 +63,11 @@ class EngineMap {
   /// while idling, creeping on its converter or slipping a clutch at launch, all with the controller on).
   double fuel_power_w(double speed_radps, double brake_torque_nm) const;
 
+  /// Brake work per fuel energy for a small step of torque at part load (throttled, below the knock and enrichment
+  /// loads): more torque also opens the throttle, so the pumping falls as the torque rises and the step costs
+  /// 1 / (eta (1 + closed-throttle pumping / unthrottled imep)) of fuel, less than 1 / eta.
+  double part_load_marginal_efficiency() const;
+
   /// The friction power [W] at a speed: what the engine absorbs when motored with no fuel.
   double friction_power_w(double speed_radps) const;
 
