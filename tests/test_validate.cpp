@@ -125,7 +125,7 @@ validate::EpaTestRow petrol_row(double litres, double hp) {
 
 double indicated_efficiency_of(const validate::EpaTestRow& row) {
   const auto m = validate::car_from_row(row, validate::EpaDefaults{});
-  return dynamic_cast<const ConventionalPowertrain&>(*m.powertrain).params().engine.indicated_efficiency;
+  return m.powertrain->engine_map()->params().indicated_efficiency;
 }
 
 // A boosted engine (high output per litre) runs a lower compression ratio: 13 up to 85 hp/l, 9 from 200 hp/l.

@@ -12,7 +12,7 @@
 #include "rollsim/common/statistics.hpp"
 #include "rollsim/common/units.hpp"
 #include "rollsim/cycle/drive_cycle.hpp"
-#include "rollsim/powertrain/conventional.hpp"
+#include "rollsim/powertrain/engine_map.hpp"
 
 namespace rollsim::validate {
 
@@ -181,10 +181,10 @@ TransientFuelParams transient_fuel_params(const VehicleModel& car) {
   p.idle_fuel_m3_per_s = car.powertrain->deliver(0.0, 0.0, 0, car.wheel_radius_m).fuel_rate_m3_per_s;
   p.fuel_density_kg_per_m3 = fuel->density_kg_per_m3;
   p.fuel_energy_j_per_m3 = fuel->energy_j_per_m3();
-  if (const auto* engine_car = dynamic_cast<const ConventionalPowertrain*>(car.powertrain.get())) {
-    p.engine_inertia_kg_m2 = engine_car->params().engine.inertia_kg_m2;
-    p.marginal_efficiency = EngineMap(engine_car->params().engine).part_load_marginal_efficiency();
-    p.continuously_variable = engine_car->params().transmission.kind == TransmissionKind::cvt;
+  if (const EngineMap* map = car.powertrain->engine_map()) {
+    p.engine_inertia_kg_m2 = map->params().inertia_kg_m2;
+    p.marginal_efficiency = map->part_load_marginal_efficiency();
+    p.continuously_variable = car.powertrain->continuously_variable();
   }
   return p;
 }

@@ -67,6 +67,8 @@ class ConventionalPowertrain final : public Powertrain {
   std::vector<double> regime_speeds_mps() const override { return {}; }
   double max_wheel_force_n(int gear, double speed_mps, double wheel_radius_m) const override;
   const FuelParams* fuel() const override { return &p_.fuel; }
+  const EngineMap* engine_map() const override { return &map_; }
+  bool continuously_variable() const override { return p_.transmission.kind == TransmissionKind::cvt; }
   void add_electric_load(double power_w, PowerFlow& flow) const override;
   const ConventionalPowertrainParams& params() const { return p_; }
 

@@ -23,6 +23,7 @@ struct FuelParams {
 };
 
 struct PowerFlow;
+class EngineMap;
 
 /// Books an electric load of `power_w` carried by an engine through its alternator: the fuel it costs at the
 /// engine's indicated efficiency, and the loss that is not the load. One rule for every fuel-burning powertrain.
@@ -86,6 +87,12 @@ class Powertrain {
 
   /// The fuel of the powertrain's fuel converter, or nullptr when it has none.
   virtual const FuelParams* fuel() const { return nullptr; }
+
+  /// The engine's fuel map, or nullptr when the powertrain has none (an electric drive, a Willans line).
+  virtual const EngineMap* engine_map() const { return nullptr; }
+
+  /// True when the gearbox varies its ratio continuously (a CVT): the engine can slow down while it drives on.
+  virtual bool continuously_variable() const { return false; }
 
   /// Adds an extra electrical load `power_w` (an effect's consumer) to `flow`, drawn where this powertrain
   /// draws its electricity (battery terminals, or an alternator on the engine).
