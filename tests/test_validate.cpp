@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "rollsim/common/error.hpp"
+#include "rollsim/common/units.hpp"
 #include "rollsim/powertrain/conventional.hpp"
 #include "rollsim/powertrain/electric.hpp"
 #include "rollsim/sim/simulation.hpp"
@@ -119,7 +120,7 @@ validate::EpaTestRow petrol_row(double litres, double hp) {
   row.road_c_n_s2_per_m2 = 0.4;
   row.displacement_m3 = litres * 1e-3;
   row.rated_power_w = hp * 745.69987158;
-  row.engine_radps_per_mps = 25.0 * 0.2341889;  // 25 rpm/mph
+  row.engine_radps_per_mps = 25.0 * units::kRadpsPerRpm / units::kMpsPerMph;  // 25 rpm/mph
   return row;
 }
 
@@ -136,6 +137,26 @@ TEST(EpaCar, BoostedEnginesLoseIndicatedEfficiencyWithTheirCompressionRatio) {
   EXPECT_NEAR(indicated_efficiency_of(petrol_row(2.0, 420.0)) / reference, 0.900, 0.001);  // 210 hp/l
   const double mid = indicated_efficiency_of(petrol_row(2.0, 230.0)) / reference;  // 115 hp/l: ratio 10.5
   EXPECT_NEAR(mid, (1.0 - std::pow(10.5, -0.3)) / (1.0 - std::pow(13.0, -0.3)), 1e-9);
+}
+
+double shift_floor_rpm(validate::EpaTestRow row, double nv_rpm_per_mph) {
+  row.engine_radps_per_mps = nv_rpm_per_mph * units::kRadpsPerRpm / units::kMpsPerMph;
+  const auto m = validate::car_from_row(row, validate::EpaDefaults{});
+  return dynamic_cast<const ConventionalPowertrain&>(*m.powertrain).params().transmission.min_engine_speed_radps / units::kRadpsPerRpm;
+}
+
+// The shift floor holds its source values (1100 rpm behind a converter, 1400 with a clutch) at and below the
+// median gearing (25.7 rpm/mph) and rises as the fourth root of the N/V ratio above it: twice the median's N/V,
+// 2^(1/4) = 1.189 times the floor.
+TEST(EpaCar, ShiftFloorRisesWithShorterGearingOnly) {
+  validate::EpaTestRow row = petrol_row(2.5, 200.0);
+  EXPECT_NEAR(shift_floor_rpm(row, 18.0), 1100.0, 1e-9);
+  EXPECT_NEAR(shift_floor_rpm(row, 25.7), 1100.0, 1e-9);
+  EXPECT_NEAR(shift_floor_rpm(row, 51.4), 1100.0 * std::pow(2.0, 0.25), 1e-9);
+  row.transmission = validate::EpaTransmission::clutch;
+  row.gears = 6;
+  EXPECT_NEAR(shift_floor_rpm(row, 20.0), 1400.0, 1e-9);
+  EXPECT_NEAR(shift_floor_rpm(row, 51.4), 1400.0 * std::pow(2.0, 0.25), 1e-9);
 }
 
 // The engine's spin-up, worked by hand: 1/2 J (w1^2 - w0^2) with J = 0.2 kg m^2 on each rise under power (5 -> 10
