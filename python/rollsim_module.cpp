@@ -15,6 +15,7 @@
 #include "rollsim/common/yaml_reader.hpp"
 #include "rollsim/cycle/drive_cycle.hpp"
 #include "rollsim/diagnose/diagnose.hpp"
+#include "rollsim/powertrain/engine_map.hpp"
 #include "rollsim/recording/recording.hpp"
 #include "rollsim/report/simulation_report.hpp"
 #include "rollsim/selection/front_end.hpp"
@@ -225,6 +226,34 @@ py::object api_diagnose(py::object vehicle, std::vector<std::string> recordings,
   return from_json(json);
 }
 
+// One argument's value checked against what the map is defined for, named as the Python argument.
+double checked(double v, const char* argument, Range range) {
+  if (!range.contains(v)) throw InputError(argument, format_value(v) + " is not allowed: " + range.describe_for(v));
+  return v;
+}
+
+// The library's EngineMap built by the vehicle reader from a dict of the `powertrain.engine` block's keys, at each
+// (speed, torque) pair; numpy broadcasts the two, scalars give scalars.
+py::dict api_engine_map(py::dict engine, py::object speed_rpm, py::object torque_nm) {
+  const EngineMap map(read_engine_block(YamlMap::load_text(to_json(engine), "engine dict")));
+  const Range rpm_range = Range::closed(0.0, 3e4), torque_range = Range::closed(0.0, 1e5);
+  auto fuel = py::vectorize([&](double rpm, double torque) {
+    return map.fuel_power_w(checked(rpm, "speed_rpm", rpm_range) * units::kRadpsPerRpm,
+                            checked(torque, "torque_nm", torque_range));
+  });
+  auto full_load = py::vectorize([&](double rpm) {
+    return map.max_torque_nm(checked(rpm, "speed_rpm", rpm_range) * units::kRadpsPerRpm);
+  });
+  const auto speeds = py::array_t<double, py::array::forcecast>::ensure(speed_rpm);
+  const auto torques = py::array_t<double, py::array::forcecast>::ensure(torque_nm);
+  if (!speeds) throw InputError("speed_rpm", "must be a number or an array of numbers");
+  if (!torques) throw InputError("torque_nm", "must be a number or an array of numbers");
+  py::dict out;
+  out["fuel_power_w"] = fuel(speeds, torques);
+  out["max_torque_nm"] = full_load(speeds);
+  return out;
+}
+
 }  // namespace
 
 PYBIND11_MODULE(rollsim, m) {
@@ -279,6 +308,15 @@ load), speed_kmh [km/h]. With vehicle (and cycle) each point is a forward simula
 threads, default every core). Returns a list of dicts, one per point: the swept values (e.g. pressure_bar),
 load_n, speed_kmh, rrc, rr_force_n, rr_power_w, and the car's kwh_per_10km or l_per_100km. A range leaving the
 model's domain stops with a warning and returns the valid points.)");
+
+  m.def("engine_map", &api_engine_map, "engine"_a, "speed_rpm"_a, "torque_nm"_a,
+        R"(The library's fuel map (EngineMap) of an engine_map vehicle's `powertrain.engine` block.
+
+engine: a dict with that block's keys (displacement_l, gross_indicated_efficiency, friction_mep_bar, ...), read by
+the vehicle file's own reader (same defaults, bounds and errors). speed_rpm [rpm] and torque_nm [N m, brake, >= 0]:
+numbers or arrays (broadcast). Returns {'fuel_power_w': fuel power [W] at the fuel's lower heating value (at or
+below idle speed the idle controller's torque reserve is burnt too), 'max_torque_nm': full-load torque [N m] at
+speed_rpm}.)");
 
   m.def("diagnose", &api_diagnose, "vehicle"_a, "recordings"_a, "columns"_a = py::dict(), "scales"_a = py::dict(),
         "preset"_a = "", "tyre"_a = py::none(),

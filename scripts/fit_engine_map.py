@@ -7,48 +7,51 @@ torques. It is not shipped here; give its table as a CSV whose first three colum
 and fuel rate [g/s] after one header row (e.g. the copy in github.com/Ricardo-Luis/me-2,
 data/PowerMap/2018 Toyota 2.5L A25A-FKS.csv).
 
-The fit: the EngineMap equations (src/powertrain/engine_map.cpp, written out again below) with the file's fixed
-keys (displacement, full-load curve, unthrottled imep 11 bar, closed-throttle pumping 0.9 bar), and free: gross
+The fit: the library's own EngineMap (src/powertrain/engine_map.cpp), evaluated through the Python module
+(rollsim.engine_map, which reads the keys with the vehicle file's reader), with the file's fixed keys
+(displacement, full-load curve, unthrottled imep 11 bar, closed-throttle pumping 0.9 bar), and free: gross
 indicated efficiency, friction f0 + f1 krpm + f2 krpm^2, knock onset and loss, enrichment onset and amount;
 least squares of log(model fuel / published fuel) over the points above 5 N m. Below it is the map's 2.2 N m
 row, the idle corner, where the engine burns 10-25 % more than friction and pumping explain (EPA's ALPHA holds a
-10 N m torque reserve on spark at idle), which the file books separately (idle_torque_reserve_nm); fitting it
-too moves friction by 0.06 bar. The part-load points fix friction + pumping as a sum only (the slope and the
-intercept of fuel against bmep); the pumping share is not in the map, so the class value stays (the map's fit is
-as good with 0 as with 0.9 bar). No recording enters: the Argonne tests judge the result.
-Run: python3 scripts/fit_engine_map.py MAP.csv
+10 N m torque reserve on spark at idle), which the file books separately (idle_torque_reserve_nm, so the fit
+sets it to 0); fitting it too moves friction by 0.06 bar. The part-load points fix friction + pumping as a sum
+only (the slope and the intercept of fuel against bmep); the pumping share is not in the map, so the class value
+stays (the map's fit is as good with 0 as with 0.9 bar). No recording enters: the Argonne tests judge the result.
+Run (after the build): PYTHONPATH=build/python /usr/bin/python3 scripts/fit_engine_map.py MAP.csv
 """
 import csv
 import math
 import sys
+from pathlib import Path
 
-DISPLACEMENT_M3, LHV_J_PER_G = 2.487e-3, 42.9e3
-IDLE_RPM, RATED_RPM, MAX_TORQUE_NM, MAX_POWER_W = 700.0, 6600.0, 250.0, 151e3
-PUMPING_BAR, UNTHROTTLED_BAR = 0.9, 11.0
+import numpy as np
+import yaml
 
+import rollsim
 
-def full_load_nm(rpm):  # EngineMap::max_torque_nm
-    w = rpm * math.pi / 30.0
-    t = min(MAX_TORQUE_NM, MAX_POWER_W / w)
-    knee = 0.5 * RATED_RPM
-    if rpm < knee:
-        t *= 0.7 + 0.3 * min(max((rpm - IDLE_RPM) / (knee - IDLE_RPM), 0.0), 1.0)
-    return t
+VEHICLE = Path(__file__).resolve().parents[1] / "vehicles" / "camry_2018_map.yaml"
+LHV_J_PER_G = 42.9e3  # the map's Tier 2 certification fuel
 
 
-def fuel_mep_bar(p, rpm, torque_nm):  # EngineMap::fuel_power_w as a mean effective pressure
+def fixed_keys():
+    """The file's engine block: the keys the map cannot give, and the reader's units for all of them."""
+    with open(VEHICLE) as f:
+        engine = yaml.safe_load(f)["powertrain"]["engine"]
+    # The idle controller's reserve is booked on the idle corner, which the fit leaves out (above).
+    return dict(engine, idle_torque_reserve_nm=0)
+
+
+def engine_keys(fixed, p):
+    """The free parameters (fractions, as the fit steps them) written as the file's keys (percent)."""
     eta, f0, f1, f2, ks, kl, es, em = p
-    bmep = 4.0 * math.pi * torque_nm / DISPLACEMENT_M3 / 1e5
-    k = rpm / 1000.0
-    imep = bmep + f0 + f1 * k + f2 * k * k
-    if imep < UNTHROTTLED_BAR:
-        imep = (imep + PUMPING_BAR) / (1.0 + PUMPING_BAR / UNTHROTTLED_BAR)
-    load = torque_nm / full_load_nm(rpm)
-    above = lambda s: min(max((load - s) / (1.0 - s), 0.0), 1.0) if s < 1.0 else 0.0
-    return imep / eta * (1.0 + em * above(es)) / (1.0 - kl * above(ks))
+    return dict(fixed, gross_indicated_efficiency=eta, friction_mep_bar=f0, friction_mep_bar_per_krpm=f1,
+                friction_mep_bar_per_krpm2=f2, knock_start_load_pct=100 * ks,
+                knock_efficiency_loss_at_full_load_pct=100 * kl, enrichment_start_load_pct=100 * es,
+                enrichment_at_full_load_pct=100 * em)
 
 
 def published(path):
+    """The map's fired points as arrays: speed [rpm], torque [N m], fuel power [W] at the fuel's LHV."""
     with open(path, newline="") as f:
         rows = list(csv.reader(f))[1:]
     out = []
@@ -56,19 +59,19 @@ def published(path):
         rpm, torque_nm, fuel_gps = float(r[0]), float(r[1]), float(r[2])
         if fuel_gps <= 0.0:  # a motored row burns nothing: no efficiency to fit
             continue
-        power_w = torque_nm * rpm * math.pi / 30.0
-        out.append((rpm, torque_nm, power_w / (fuel_gps * LHV_J_PER_G)))
-    return out
+        out.append((rpm, torque_nm, fuel_gps * LHV_J_PER_G))
+    return np.array(out).T
 
 
-def rms_log(p, points):
+def rms_log(p, fixed, points):
     if not (0 < p[0] < 0.6 and min(p[1:4]) >= 0 and 0 <= p[4] <= 1 and 0 <= p[5] < 0.5 and 0 <= p[6] <= 1 and 0 <= p[7] < 0.5):
         return 1e9
-    s = 0.0
-    for rpm, torque_nm, bte in points:
-        bmep = 4.0 * math.pi * torque_nm / DISPLACEMENT_M3 / 1e5
-        s += math.log(fuel_mep_bar(p, rpm, torque_nm) * bte / bmep) ** 2
-    return math.sqrt(s / len(points))
+    rpm, torque_nm, fuel_w = points
+    try:
+        model_w = rollsim.engine_map(engine_keys(fixed, p), rpm, torque_nm)["fuel_power_w"]
+    except rollsim.InputError:  # keys the vehicle file could not hold (e.g. knock onset at 100 % with a loss)
+        return 1e9
+    return math.sqrt(np.mean(np.log(model_w / fuel_w) ** 2))
 
 
 def nelder_mead(f, x0, step, iterations=3000):
@@ -97,7 +100,9 @@ def nelder_mead(f, x0, step, iterations=3000):
 
 
 def main():
-    points = [q for q in published(sys.argv[1]) if q[1] > 5.0]
+    points = published(sys.argv[1])
+    points = points[:, points[1] > 5.0]
+    fixed = fixed_keys()
     names = ["gross_indicated_efficiency", "friction_mep_bar", "friction_mep_bar_per_krpm", "friction_mep_bar_per_krpm2",
              "knock_start (fraction)", "knock_loss (fraction)", "enrichment_start (fraction)", "enrichment (fraction)"]
     classes = [0.478, 0.97, 0.15, 0.05, 0.6, 0.10, 0.9, 0.15]
@@ -105,10 +110,10 @@ def main():
     for start in ([0.45, 0.8, 0.05, 0.04, 0.8, 0.15, 0.95, 0.05], [0.43, 0.5, 0.1, 0.03, 0.7, 0.1, 0.9, 0.1]):
         x, v = start, None
         for step in ([0.02, 0.2, 0.05, 0.01, 0.05, 0.05, 0.03, 0.05], [0.01, 0.1, 0.02, 0.005, 0.05, 0.03, 0.03, 0.03]):
-            x, v = nelder_mead(lambda p: rms_log(p, points), x, step)  # restarted: the simplex collapses early
+            x, v = nelder_mead(lambda p: rms_log(p, fixed, points), x, step)  # restarted: the simplex collapses early
         best = (x, v) if best is None or v < best[1] else best
     x, v = best
-    print(f"{len(points)} published points; rms log fuel error: class values {rms_log(classes, points):.4f}, fitted {v:.4f}")
+    print(f"{points.shape[1]} published points; rms log fuel error: class values {rms_log(classes, fixed, points):.4f}, fitted {v:.4f}")
     for n, c, f in zip(names, classes, x):
         print(f"  {n:32s} class {c:7.4f}  fitted {f:7.4f}")
 

@@ -14,7 +14,9 @@ double pct(YamlMap& m, const std::string& key, double fallback_pct) {
   return m.number_or(key, fallback_pct, Range::closed(0.0, 100.0)) / 100.0;
 }
 
-EngineMapParams read_engine(YamlMap m) {
+}  // namespace
+
+EngineMapParams read_engine_block(YamlMap m) {
   EngineMapParams e;
   e.displacement_m3 = m.number("displacement_l", Range::open_low(0.0, 30.0)) * units::kM3PerLitre;
   e.indicated_efficiency = m.number("gross_indicated_efficiency", Range::open_low(0.0, 0.6));
@@ -49,6 +51,8 @@ EngineMapParams read_engine(YamlMap m) {
   m.finish();
   return e;
 }
+
+namespace {
 
 TransmissionKind transmission_kind(YamlMap& m) {
   const std::string kind = m.string("kind");
@@ -103,7 +107,7 @@ TransmissionParams read_transmission(YamlMap m, double max_torque_nm) {
 
 ConventionalPowertrainParams read_engine_map_powertrain(YamlMap& pt) {
   ConventionalPowertrainParams p;
-  p.engine = read_engine(pt.map("engine"));
+  p.engine = read_engine_block(pt.map("engine"));
   p.transmission = read_transmission(pt.map("transmission"), p.engine.max_torque_nm);
   p.fuel = read_fuel(pt.map("fuel"));
   p.aux_power_w = pt.number_or("aux_power_w", 0.0, Range::closed(0.0, 1e5));

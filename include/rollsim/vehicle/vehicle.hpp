@@ -65,6 +65,9 @@ Vehicle load_vehicle_file(const std::string& path);
 Vehicle load_vehicle_text(const std::string& text, const std::string& name);
 /// The same for a mapping already read; its file() names the source.
 Vehicle load_vehicle(YamlMap root);
+/// A vehicle file's `powertrain.engine` block (type engine_map) in SI, read as load_vehicle reads it: one place for
+/// its key names, defaults, bounds and unit conversions (the Python module's engine_map evaluates it too).
+EngineMapParams read_engine_block(YamlMap engine);
 
 /// What the effect models need to know of this car (its test mass and air density x drag area).
 EffectContext effect_context(const Vehicle& vehicle);
