@@ -226,23 +226,17 @@ py::object api_diagnose(py::object vehicle, std::vector<std::string> recordings,
   return from_json(json);
 }
 
-// One argument's value checked against what the map is defined for, named as the Python argument.
-double checked(double v, const char* argument, Range range) {
-  if (!range.contains(v)) throw InputError(argument, format_value(v) + " is not allowed: " + range.describe_for(v));
-  return v;
-}
-
 // The library's EngineMap built by the vehicle reader from a dict of the `powertrain.engine` block's keys, at each
 // (speed, torque) pair; numpy broadcasts the two, scalars give scalars.
 py::dict api_engine_map(py::dict engine, py::object speed_rpm, py::object torque_nm) {
   const EngineMap map(read_engine_block(YamlMap::load_text(to_json(engine), "engine dict")));
   const Range rpm_range = Range::closed(0.0, 3e4), torque_range = Range::closed(0.0, 1e5);
   auto fuel = py::vectorize([&](double rpm, double torque) {
-    return map.fuel_power_w(checked(rpm, "speed_rpm", rpm_range) * units::kRadpsPerRpm,
-                            checked(torque, "torque_nm", torque_range));
+    return map.fuel_power_w(checked_number(rpm, "speed_rpm", rpm_range) * units::kRadpsPerRpm,
+                            checked_number(torque, "torque_nm", torque_range));
   });
   auto full_load = py::vectorize([&](double rpm) {
-    return map.max_torque_nm(checked(rpm, "speed_rpm", rpm_range) * units::kRadpsPerRpm);
+    return map.max_torque_nm(checked_number(rpm, "speed_rpm", rpm_range) * units::kRadpsPerRpm);
   });
   const auto speeds = py::array_t<double, py::array::forcecast>::ensure(speed_rpm);
   const auto torques = py::array_t<double, py::array::forcecast>::ensure(torque_nm);

@@ -132,8 +132,7 @@ double YamlMap::to_number(const YAML::Node& n, const std::string& key, Range ran
       throw InputError(where(key), "'" + text + "' is not a number");
     }
   }
-  if (!range.contains(v)) throw InputError(where(key), format_value(v) + " is not allowed: " + range.describe_for(v));
-  return v;
+  return checked_number(v, where(key), range);
 }
 
 double YamlMap::number(const std::string& key, Range range) { return to_number(get(key, true), key, range); }
@@ -255,7 +254,11 @@ double parse_option_number(const std::string& text, const std::string& option, R
   if (text.empty() || end != text.c_str() + text.size()) {
     throw InputError(option, "'" + text + "' is not a number; " + range.describe());
   }
-  if (!range.contains(v)) throw InputError(option, format_value(v) + " is not allowed: " + range.describe_for(v));
+  return checked_number(v, option, range);
+}
+
+double checked_number(double v, const std::string& where, Range range) {
+  if (!range.contains(v)) throw InputError(where, format_value(v) + " is not allowed: " + range.describe_for(v));
   return v;
 }
 

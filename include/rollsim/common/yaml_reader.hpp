@@ -30,6 +30,10 @@ struct Range {
   std::string describe_for(double v) const;
 };
 
+/// `v` if `range` allows it; otherwise an InputError naming `where` (a key, an option, an argument), the value
+/// and what is allowed. The one check behind every number a user gives.
+double checked_number(double v, const std::string& where, Range range);
+
 /// A number given as text on the command line or by the Python API: parsed whole and checked against `range`;
 /// throws InputError naming `option`, the text or value, and what is allowed (strtod alone would accept "nan").
 double parse_option_number(const std::string& text, const std::string& option, Range range);
