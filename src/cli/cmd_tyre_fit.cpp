@@ -191,6 +191,24 @@ void run_evaluate(const std::string& path, const std::string& drum_text) {
             << pct(b.worst_log_rms) << " % (RMS of the log ratio); the best such shape's RMS error per tyre:";
   for (std::size_t i = 0; i < b.rms.size(); ++i) std::cout << (i ? ", " : " ") << pct(b.rms[i]);
   std::cout << " %\n";
+  std::cout << "\nMore points measured on the held-out tyre besides the one point, the rest as above (RMS %):\n";
+  std::vector<std::string> head{"measured besides", "fitted", "median", "worst"};
+  for (const auto& e : ev.tyres) head.push_back(e.name);
+  report::TextTable m(head);
+  m.set_left_aligned(0);
+  m.set_left_aligned(1);
+  for (std::size_t k = 0; k < ev.plans.size(); ++k) {
+    std::vector<RrcPoint> points{{2.1e5, 4000.0, units::kmh_to_mps(80.0), 0.01, ""}};
+    for (const auto& o : ev.plans[k].extra) points.push_back({o.pressure_pa, o.load_n, o.speed_mps, 0.01, ""});
+    std::string fitted;
+    for (const auto p : identifiable_params(points)) fitted += (fitted.empty() ? "" : ", ") + std::string(hysteresis_param_key(p));
+    std::vector<double> rms;
+    for (const auto& e : ev.tyres) rms.push_back(e.plan_rms[k]);
+    std::vector<std::string> cells{ev.plans[k].name, fitted, pct(median(rms)), pct(worst(rms))};
+    for (const double x : rms) cells.push_back(pct(x));
+    m.add_row(cells);
+  }
+  std::cout << m.render();
   std::cout << "\nShared constants fitted on all " << sets.size() << " sets and, leave-one-tyre-out, without each:\n";
   report::TextTable s({"fitted without", "frequency_slope_per_hz", "deflection_exponent", "load_exponent",
                        "speed_loss_rrc_per_hz2", "speed_loss_load_exponent"});

@@ -95,7 +95,41 @@ constexpr HysteresisParam kShared[] = {HysteresisParam::FrequencySlope, Hysteres
                                        HysteresisParam::LoadExponent, HysteresisParam::SpeedLoss,
                                        HysteresisParam::SpeedLossLoadExponent};
 
+// The plan's points on the tyre's surface, its reference point first, fitted from the shared constants.
+double plan_rms(const MeasurementPlan& plan, const J2452Set& set, const HysteresisConstants& shared,
+                const std::vector<RrcPoint>& truth, double drum_radius_m) {
+  FitRequest request;  // free: what the points determine
+  const auto measure = [&](const OperatingPoint& o, const std::string& where) {
+    request.points.push_back({o.pressure_pa, o.load_n, o.speed_mps,
+                              j2452_flat_rrc(set, o.pressure_pa, o.load_n, o.speed_mps, drum_radius_m), where});
+  };
+  measure({kRefPressure_pa, kRefLoad_n, kRefSpeed_mps}, "reference point");
+  for (const auto& o : plan.extra) measure(o, plan.name);
+  const TyreFit fit = fit_hysteresis(one_point_tyre(set, shared, drum_radius_m), request);
+  return grid_error(hysteresis_surface(fit.tyre), truth).rms;
+}
+
 }  // namespace
+
+std::vector<MeasurementPlan> j2452_measurement_plans() {
+  const OperatingPoint v15{kRefPressure_pa, kRefLoad_n, units::kmh_to_mps(15.0)};
+  const OperatingPoint v115{kRefPressure_pa, kRefLoad_n, units::kmh_to_mps(115.0)};
+  const OperatingPoint p180{180e3, kRefLoad_n, kRefSpeed_mps}, p300{300e3, kRefLoad_n, kRefSpeed_mps};
+  const OperatingPoint z3{kRefPressure_pa, 3000.0, kRefSpeed_mps}, z6{kRefPressure_pa, 6000.0, kRefSpeed_mps};
+  return {{"+15 km/h", {v15}},
+          {"+115 km/h", {v115}},
+          {"+180 kPa", {p180}},
+          {"+300 kPa", {p300}},
+          {"+3 kN", {z3}},
+          {"+6 kN", {z6}},
+          {"+15 km/h, +180 kPa", {v15, p180}},
+          {"+15 km/h, +300 kPa", {v15, p300}},
+          {"+115 km/h, +180 kPa", {v115, p180}},
+          {"+115 km/h, +300 kPa", {v115, p300}},
+          {"+15 km/h, +115 km/h", {v15, v115}},
+          {"+15 km/h, +115 km/h, +180 kPa", {v15, v115, p180}},
+          {"+15 km/h, +115 km/h, +300 kPa", {v15, v115, p300}}};
+}
 
 TyreState j2452_tyre(const J2452Set& set) {
   const TyreSize size = parse_tyre_size(set.size, "J2452 set '" + set.name + "'");
@@ -195,6 +229,7 @@ J2452Evaluation evaluate_j2452(const std::vector<J2452Set>& sets, double drum_ra
   J2452Evaluation out;
   out.shared_all = fit_shared_constants(sets, drum_radius_m);
   out.common_shape = common_shape_bound(sets, drum_radius_m);
+  out.plans = j2452_measurement_plans();
   const OperatingGrid grid = j2452_grid();
   for (std::size_t i = 0; i < sets.size(); ++i) {
     const J2452Set& set = sets[i];
@@ -212,6 +247,7 @@ J2452Evaluation evaluate_j2452(const std::vector<J2452Set>& sets, double drum_ra
     const ErrorStats op = grid_error(one_point, truth);
     e.one_point_rms = op.rms;
     e.one_point_max = op.max;
+    for (const auto& plan : out.plans) e.plan_rms.push_back(plan_rms(plan, set, e.shared, truth, drum_radius_m));
 
     TyreState full_start = one_point_tyre(set, out.shared_all, drum_radius_m);
     FitRequest request;

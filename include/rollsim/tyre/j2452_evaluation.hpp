@@ -18,6 +18,25 @@ struct SurfaceScaling {
   double speed_rise = 0.0;         ///< F(115 km/h) / F(15 km/h) - 1 at 210 kPa, 4000 N
 };
 
+/// An operating point of a measurement plan.
+struct OperatingPoint {
+  double pressure_pa = 0.0;
+  double load_n = 0.0;
+  double speed_mps = 0.0;
+};
+
+/// What a user measures on a tyre besides the one label-like point (210 kPa, 4000 N, 80 km/h): extra points,
+/// each read off the held-out tyre's surface. The fit frees what the points determine (identifiable_params), as
+/// `rollsim tyre fit --point ... --point ...` does, and keeps the leave-one-tyre-out shared constants for the rest.
+struct MeasurementPlan {
+  std::string name;  ///< e.g. "+15 km/h, +300 kPa"
+  std::vector<OperatingPoint> extra;
+};
+
+/// The plans judged: every single extra point at an edge of the grid (15 or 115 km/h, 180 or 300 kPa, 3 or 6 kN),
+/// every pair of one extra speed and one extra pressure, both speeds, and both speeds with either pressure.
+std::vector<MeasurementPlan> j2452_measurement_plans();
+
 struct TyreEvaluation {
   std::string name;
   double reference_rrc = 0.0;      ///< the measured (flat-road) RRC at the one point [-]
@@ -29,6 +48,7 @@ struct TyreEvaluation {
   double thesis_rms = 0.0;         ///< thesis model with its constants, scaled
   double constant_rms = 0.0;       ///< a constant RRC
   double median_shape_rms = 0.0;   ///< median J2452 exponents and speed terms of the other tyres, scaled
+  std::vector<double> plan_rms;    ///< hysteresis model fitted to each measurement plan's points (J2452Evaluation::plans)
   SurfaceScaling measured, one_point, full_fit, thesis;
   HysteresisConstants shared;      ///< the constants fitted without this tyre
 };
@@ -44,6 +64,7 @@ struct CommonShapeBound {
 struct J2452Evaluation {
   std::vector<TyreEvaluation> tyres;
   HysteresisConstants shared_all;  ///< shared constants fitted on every set (the shipped defaults)
+  std::vector<MeasurementPlan> plans;
   CommonShapeBound common_shape;
 };
 
