@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
-#include <numbers>
 
 #include "rollsim/common/csv.hpp"
 #include "rollsim/common/error.hpp"
@@ -146,7 +145,7 @@ std::vector<EpaTestRow> read_epa_test_car_list(const std::string& path) {
     if (const auto v = number(c_disp)) r.displacement_m3 = *v * units::kM3PerLitre;
     if (const auto v = number(c_hp)) r.rated_power_w = *v * units::kWPerHp;
     if (const auto v = number(c_gears); v && *v == std::floor(*v) && *v >= 0 && *v < 100) r.gears = static_cast<int>(*v);
-    if (const auto v = number(c_nv)) r.engine_radps_per_mps = *v * 2.0 * std::numbers::pi / 60.0 / kMpsPerMph;
+    if (const auto v = number(c_nv)) r.engine_radps_per_mps = *v * units::kRadpsPerRpm / kMpsPerMph;
     if (const auto v = number(c_a)) r.road_a_n = *v * kNPerLbf;
     if (const auto v = number(c_b)) r.road_b_n_s_per_m = *v * kNPerLbf / kMpsPerMph;
     if (const auto v = number(c_c)) r.road_c_n_s2_per_m2 = *v * kNPerLbf / (kMpsPerMph * kMpsPerMph);
