@@ -27,6 +27,8 @@ using rollsim::test::temp_dir;
 namespace {
 
 const std::string kJ2452Csv = std::string(ROLLSIM_SHARED_DIR) + "/data/tyres/j2452_michelin_part.csv";
+// Eight more Michelin sets, added after the model and its constants were fixed on the nine (tyres/measured).
+const std::string kHeldOutCsv = std::string(ROLLSIM_SOURCE_DIR) + "/tyres/measured/j2452_michelin_holdout.csv";
 
 TyreState hysteresis_tyre() {
   TyreState t;
@@ -46,6 +48,23 @@ double median(std::vector<double> v) {
 const J2452Evaluation& evaluation() {
   static const J2452Evaluation ev = evaluate_j2452(load_j2452_csv(kJ2452Csv), kJ2452DrumRadius_m);
   return ev;
+}
+
+const J2452Evaluation& held_out_evaluation() {
+  static const J2452Evaluation ev =
+      evaluate_j2452_held_out(load_j2452_csv(kJ2452Csv), load_j2452_csv(kHeldOutCsv), kJ2452DrumRadius_m);
+  return ev;
+}
+
+std::vector<double> plan_rms(const J2452Evaluation& ev, const std::string& plan) {
+  for (std::size_t k = 0; k < ev.plans.size(); ++k) {
+    if (ev.plans[k].name != plan) continue;
+    std::vector<double> rms;
+    for (const auto& e : ev.tyres) rms.push_back(e.plan_rms.at(k));
+    return rms;
+  }
+  ADD_FAILURE() << "no plan " << plan;
+  return {};
 }
 
 CmdResult fit(const std::string& args) { return rollsim::test::run_rollsim("tyre fit " + args); }
@@ -209,6 +228,56 @@ TEST(J2452, AThirdPointAtLowSpeedAndAnotherPressureMeetsBothTargets) {
     EXPECT_LE(*std::max_element(rms.begin(), rms.end()), 0.05) << ev.plans[k].name;
   }
   EXPECT_EQ(judged, 2);
+}
+
+// --- eight measured tyres the model never saw ---
+
+TEST(J2452HeldOut, TheFileHoldsEightSetsAndOneFlaggedReading) {
+  const auto sets = load_j2452_csv(kHeldOutCsv);
+  ASSERT_EQ(sets.size(), 8u);
+  const auto flagged = std::count_if(sets.begin(), sets.end(), [](const J2452Set& s) { return s.flagged; });
+  EXPECT_EQ(flagged, 1);
+  // P235/70R16 LO at 210 kPa, 4000 N, 80 km/h from the ADVISOR file's coefficients by hand.
+  const auto lo = std::find_if(sets.begin(), sets.end(), [](const J2452Set& s) { return s.name == "P235/70R16 LO"; });
+  ASSERT_NE(lo, sets.end());
+  const double f = std::pow(210.0, -0.4704) * std::pow(4000.0, 1.0129) * (0.0849 + 1.16e-4 * 80 + 2.64e-6 * 6400);
+  EXPECT_NEAR(j2452_flat_rrc(*lo, 2.1e5, 4000.0, 80 / 3.6, 0.85), f * std::sqrt(0.85 / 1.205) / 4000.0, 1e-12);
+  for (const auto& s : load_j2452_csv(kJ2452Csv)) EXPECT_FALSE(s.flagged) << s.name;  // no column: none flagged
+}
+
+TEST(J2452HeldOut, OnePointPredictsTyresItNeverSawAsWellAsItsOwn) {
+  const auto& ev = held_out_evaluation();
+  ASSERT_EQ(ev.tyres.size(), 8u);
+  std::vector<double> one, thesis, constant;
+  for (const auto& e : ev.tyres) {
+    one.push_back(e.one_point_rms);
+    thesis.push_back(e.thesis_rms);
+    constant.push_back(e.constant_rms);
+    EXPECT_LT(e.full_fit_rms, 0.01) << e.name;  // the model's form holds each new surface too
+  }
+  EXPECT_LE(median(one), 0.025);  // the median target, on tyres no constant was fitted to
+  EXPECT_LT(median(one), 0.25 * median(thesis));
+  EXPECT_LT(median(one), 0.25 * median(constant));
+}
+
+TEST(J2452HeldOut, ThreePointsMeetBothTargetsOnTyresItNeverSaw) {
+  for (const char* plan : {"+15 km/h, +180 kPa", "+15 km/h, +300 kPa"}) {
+    const auto rms = plan_rms(held_out_evaluation(), plan);
+    ASSERT_EQ(rms.size(), 8u);
+    EXPECT_LE(median(rms), 0.025) << plan;
+    EXPECT_LE(*std::max_element(rms.begin(), rms.end()), 0.05) << plan;
+  }
+}
+
+TEST(J2452HeldOut, JudgedWithTheShippedSharedConstants) {
+  const HysteresisConstants shipped;
+  for (const auto& e : held_out_evaluation().tyres) {
+    for (auto p : {HysteresisParam::FrequencySlope, HysteresisParam::DeflectionExponent, HysteresisParam::LoadExponent,
+                   HysteresisParam::SpeedLoss, HysteresisParam::SpeedLossLoadExponent}) {
+      const double want = hysteresis_param_value(shipped, p);
+      EXPECT_NEAR(hysteresis_param_value(e.shared, p), want, 2e-3 * std::abs(want) + 1e-9) << e.name;
+    }
+  }
 }
 
 TEST(J2452, SmallestEnclosingBallOfKnownPointSets) {
@@ -398,6 +467,24 @@ TEST(CliTyreFit, EvaluationTablePrintsEveryTyreAndTheSharedConstants) {
   EXPECT_TRUE(has(r.out, "median"));
   EXPECT_TRUE(has(r.out, "(none: all sets)"));
   for (const auto& plan : evaluation().plans) EXPECT_TRUE(has(r.out, plan.name)) << plan.name;
+}
+
+TEST(CliTyreFit, HeldOutEvaluationJudgesTheOtherFileAndNeedsTheFirst) {
+  const CmdResult r = fit("--evaluate-j2452 '" + kJ2452Csv + "' --held-out-j2452 '" + kHeldOutCsv + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const auto& s : load_j2452_csv(kHeldOutCsv)) EXPECT_TRUE(has(r.out, s.name)) << s.name;
+  EXPECT_TRUE(has(r.out, "fitted once on the 9 sets"));
+  EXPECT_TRUE(has(r.out, "P235/75R15 HI *"));  // the flagged reading is marked
+  const CmdResult alone = fit("--held-out-j2452 '" + kHeldOutCsv + "'");
+  EXPECT_NE(alone.exit_code, 0);
+  EXPECT_TRUE(has(alone.err, "--held-out-j2452")) << alone.err;
+  EXPECT_EQ(lines(alone.err).size(), 1u) << alone.err;
+  const auto dir = temp_dir();
+  std::ofstream(dir / "bad.csv") << "size,rr_class,alpha,beta,a,b,c,wh_radius_m,value_flagged\n"
+                                 << "P205/60R15,LO,-0.48,1.0,0.068,2.3E-04,1.2E-06,0.304,maybe\n";
+  const CmdResult bad = fit("--evaluate-j2452 '" + kJ2452Csv + "' --held-out-j2452 '" + (dir / "bad.csv").string() + "'");
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_TRUE(has(bad.err, "maybe") && has(bad.err, "bad.csv")) << bad.err;
 }
 
 // --- tyre files choose their model ---

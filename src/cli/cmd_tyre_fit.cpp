@@ -31,7 +31,7 @@ namespace {
 struct FitOptions {
   std::string size, label, j2452, measured, output, name, pressure_bar, free, uncertainty_pct, drum_radius_m;
   std::vector<std::string> points;
-  std::string evaluate_j2452;
+  std::string evaluate_j2452, held_out_j2452;
 };
 
 double number_in(const std::string& text, const std::string& where, const std::string& what) {
@@ -151,20 +151,25 @@ void print_fit(const TyreFit& fit, const std::optional<LabelBand>& band, const s
   }
 }
 
-void run_evaluate(const std::string& path, const std::string& drum_text) {
+void run_evaluate(const std::string& path, const std::string& held_out_path, const std::string& drum_text) {
   const double drum = drum_text.empty() ? kJ2452DrumRadius_m : number_in(drum_text, "--drum-radius-m", "drum radius");
   const auto sets = load_j2452_csv(path);
   if (sets.size() < 3) throw InputError(path, "too few sets for leave-one-tyre-out: need 3 or more");
-  const J2452Evaluation ev = evaluate_j2452(sets, drum);
+  const bool held_out = !held_out_path.empty();
+  const J2452Evaluation ev = held_out ? evaluate_j2452_held_out(sets, load_j2452_csv(held_out_path), drum)
+                                      : evaluate_j2452(sets, drum);
   std::cout << "RMS relative RRC error over 180-300 kPa x 3-6 kN x 15-115 km/h (150 points), %; one point = 210 kPa, "
-               "4000 N, 80 km/h; shared constants fitted leave-one-tyre-out\n";
+               "4000 N, 80 km/h; "
+            << (held_out ? "shared constants and median J2452 shape fitted once on the " + std::to_string(sets.size()) +
+                               " sets of " + path + ", none of the tyres below\n"
+                         : std::string("shared constants fitted leave-one-tyre-out\n"));
   report::TextTable t({"tyre", "RRC kg/t", "one-point", "max", "full fit", "thesis", "constant", "median J2452", "p exp meas",
                        "p exp 1pt", "p exp full", "Z exp meas", "Z exp 1pt", "Z exp full", "rise meas %",
                        "rise 1pt %", "rise full %"});
   t.set_left_aligned(0);
   std::vector<double> cols[6];
   for (const auto& e : ev.tyres) {
-    t.add_row({e.name, fixed(e.reference_rrc * 1e3, 2), pct(e.one_point_rms), pct(e.one_point_max), pct(e.full_fit_rms), pct(e.thesis_rms, 1),
+    t.add_row({e.name + (e.flagged ? " *" : ""), fixed(e.reference_rrc * 1e3, 2), pct(e.one_point_rms), pct(e.one_point_max), pct(e.full_fit_rms), pct(e.thesis_rms, 1),
                pct(e.constant_rms, 1), pct(e.median_shape_rms), fixed(e.measured.pressure_exponent, 3),
                fixed(e.one_point.pressure_exponent, 3), fixed(e.full_fit.pressure_exponent, 3),
                fixed(e.measured.load_exponent, 3), fixed(e.one_point.load_exponent, 3),
@@ -183,6 +188,9 @@ void run_evaluate(const std::string& path, const std::string& drum_text) {
   t.add_row(med);
   t.add_row(wst);
   std::cout << t.render();
+  if (std::any_of(ev.tyres.begin(), ev.tyres.end(), [](const TyreEvaluation& e) { return e.flagged; })) {
+    std::cout << "* value_flagged in the file: a value read with the correction its source note gives\n";
+  }
   std::cout << "thesis model's own exponents (scaled): pressure " << fixed(ev.tyres.front().thesis.pressure_exponent, 3)
             << ", load " << fixed(ev.tyres.front().thesis.load_exponent, 3) << ", rise "
             << pct(ev.tyres.front().thesis.speed_rise, 1) << " % (" << ev.tyres.front().name << ")\n";
@@ -193,7 +201,7 @@ void run_evaluate(const std::string& path, const std::string& drum_text) {
   std::cout << " %\n";
   std::cout << "\nMore points measured on the held-out tyre besides the one point, the rest as above (RMS %):\n";
   std::vector<std::string> head{"measured besides", "fitted", "median", "worst"};
-  for (const auto& e : ev.tyres) head.push_back(e.name);
+  for (const auto& e : ev.tyres) head.push_back(e.name + (e.flagged ? " *" : ""));
   report::TextTable m(head);
   m.set_left_aligned(0);
   m.set_left_aligned(1);
@@ -209,8 +217,9 @@ void run_evaluate(const std::string& path, const std::string& drum_text) {
     m.add_row(cells);
   }
   std::cout << m.render();
-  std::cout << "\nShared constants fitted on all " << sets.size() << " sets and, leave-one-tyre-out, without each:\n";
-  report::TextTable s({"fitted without", "frequency_slope_per_hz", "deflection_exponent", "load_exponent",
+  std::cout << "\nShared constants fitted on all " << sets.size() << " sets of " << path
+            << (held_out ? ":\n" : " and, leave-one-tyre-out, without each:\n");
+  report::TextTable s({held_out ? "fitted on" : "fitted without", "frequency_slope_per_hz", "deflection_exponent", "load_exponent",
                        "speed_loss_rrc_per_hz2", "speed_loss_load_exponent"});
   s.set_left_aligned(0);
   auto row = [&](const std::string& name, const HysteresisConstants& c) {
@@ -222,13 +231,18 @@ void run_evaluate(const std::string& path, const std::string& drum_text) {
     std::snprintf(b[4], 32, "%.5g", c.speed_loss_load_exponent);
     s.add_row({name, b[0], b[1], b[2], b[3], b[4]});
   };
-  row("(none: all sets)", ev.shared_all);
-  for (const auto& e : ev.tyres) row(e.name, e.shared);
+  row(held_out ? "all sets" : "(none: all sets)", ev.shared_all);
+  if (!held_out) {
+    for (const auto& e : ev.tyres) row(e.name, e.shared);
+  }
   std::cout << s.render();
 }
 
 void run_fit(const FitOptions& o) {
-  if (!o.evaluate_j2452.empty()) return run_evaluate(o.evaluate_j2452, o.drum_radius_m);
+  if (!o.held_out_j2452.empty() && o.evaluate_j2452.empty()) {
+    throw InputError("--held-out-j2452", "needs --evaluate-j2452 FILE: the sets the shared constants are fitted on");
+  }
+  if (!o.evaluate_j2452.empty()) return run_evaluate(o.evaluate_j2452, o.held_out_j2452, o.drum_radius_m);
   if (o.size.empty()) throw InputError("--size", "missing: the tyre's size designation, e.g. \"205/55 R16 91V\"");
   if (o.output.empty()) throw InputError("--output", "missing: the tyre file to write, e.g. --output my-tyre.yaml");
   const TyreSize size = parse_tyre_size(o.size, "--size");
@@ -316,6 +330,9 @@ void register_tyre_fit_command(CLI::App& tyre) {
   sub->add_option("--output", o->output, "Tyre file to write")->type_name("T.yaml");
   sub->add_option("--evaluate-j2452", o->evaluate_j2452,
                   "Instead of fitting: judge the model on a CSV of J2452 sets, leave-one-tyre-out, with baselines")
+      ->type_name("FILE");
+  sub->add_option("--held-out-j2452", o->held_out_j2452,
+                  "With --evaluate-j2452: fit the shared constants once on its sets and judge them on these instead")
       ->type_name("FILE");
   sub->callback([o] { run_fit(*o); });
 }

@@ -52,6 +52,7 @@ std::vector<J2452Set> load_j2452_csv(const std::string& path) {
   };
   const std::size_t size = col("size"), cls = col("rr_class"), al = col("alpha"), be = col("beta"), a = col("a"),
                     b = col("b"), c = col("c"), r = col("wh_radius_m");
+  const auto flag = t.column("value_flagged");
   std::vector<J2452Set> out;
   for (std::size_t i = 0; i < t.rows.size(); ++i) {
     auto num = [&](std::size_t k) {
@@ -63,6 +64,11 @@ std::vector<J2452Set> load_j2452_csv(const std::string& path) {
                num(b), num(c), num(r)};
     if (!(s.rolling_radius_m > 0.1 && s.rolling_radius_m < 1.0)) {
       throw InputError(t.where(i, r), format_value(s.rolling_radius_m) + " m is not allowed: must be in (0.1, 1) m");
+    }
+    if (flag) {
+      const std::string f = trim(t.rows[i][*flag]);
+      if (f != "yes" && f != "no") throw InputError(t.where(i, *flag), "'" + f + "' is not allowed: yes or no");
+      s.flagged = f == "yes";
     }
     out.push_back(s);
   }

@@ -225,56 +225,79 @@ CommonShapeBound common_shape_bound(const std::vector<J2452Set>& sets, double dr
 
 }  // namespace
 
+namespace {
+
+// One tyre judged with shared constants fitted without it: the one point, the measurement plans, a full fit
+// (started from `full_fit_start`), and the baselines, the median J2452 shape taken from `others`.
+TyreEvaluation evaluate_tyre(const J2452Set& set, const HysteresisConstants& shared, const std::vector<J2452Set>& others,
+                             const HysteresisConstants& full_fit_start, const std::vector<MeasurementPlan>& plans,
+                             double drum_radius_m) {
+  const auto truth = sample_j2452(set, j2452_grid(), drum_radius_m, set.name);
+  const double ref_rrc = j2452_flat_rrc(set, kRefPressure_pa, kRefLoad_n, kRefSpeed_mps, drum_radius_m);
+  TyreEvaluation e;
+  e.name = set.name;
+  e.flagged = set.flagged;
+  e.reference_rrc = ref_rrc;
+  e.shared = shared;
+  const Surface one_point = hysteresis_surface(one_point_tyre(set, shared, drum_radius_m));
+  const ErrorStats op = grid_error(one_point, truth);
+  e.one_point_rms = op.rms;
+  e.one_point_max = op.max;
+  for (const auto& plan : plans) e.plan_rms.push_back(plan_rms(plan, set, shared, truth, drum_radius_m));
+
+  FitRequest request;
+  request.points = truth;
+  request.free = {HysteresisParam::RrcRef,   HysteresisParam::FrequencySlope, HysteresisParam::DeflectionExponent,
+                  HysteresisParam::LoadExponent, HysteresisParam::SpeedLoss, HysteresisParam::SpeedLossLoadExponent};
+  const TyreFit full = fit_hysteresis(one_point_tyre(set, full_fit_start, drum_radius_m), request);
+  const Surface full_surface = hysteresis_surface(full.tyre);
+  e.full_fit_rms = grid_error(full_surface, truth).rms;
+
+  const TyreState thesis_tyre = j2452_tyre(set);
+  const Surface thesis = scaled_at_reference(
+      [thesis_tyre](double p, double z, double v) {
+        TyreState t = thesis_tyre;
+        t.pressure_pa = p;
+        return evaluate_rolling_resistance(t, z, v).rrc;
+      },
+      ref_rrc);
+  e.thesis_rms = grid_error(thesis, truth).rms;
+  e.constant_rms = grid_error([ref_rrc](double, double, double) { return ref_rrc; }, truth).rms;
+  e.median_shape_rms = grid_error(scaled_at_reference(median_shape_of(others), ref_rrc), truth).rms;
+
+  e.measured = scaling_of(j2452_surface(set, drum_radius_m));
+  e.one_point = scaling_of(one_point);
+  e.full_fit = scaling_of(full_surface);
+  e.thesis = scaling_of(thesis);
+  return e;
+}
+
+}  // namespace
+
 J2452Evaluation evaluate_j2452(const std::vector<J2452Set>& sets, double drum_radius_m) {
   J2452Evaluation out;
   out.shared_all = fit_shared_constants(sets, drum_radius_m);
   out.common_shape = common_shape_bound(sets, drum_radius_m);
   out.plans = j2452_measurement_plans();
-  const OperatingGrid grid = j2452_grid();
   for (std::size_t i = 0; i < sets.size(); ++i) {
-    const J2452Set& set = sets[i];
     std::vector<J2452Set> others;
     for (std::size_t j = 0; j < sets.size(); ++j) {
       if (j != i) others.push_back(sets[j]);
     }
-    const auto truth = sample_j2452(set, grid, drum_radius_m, set.name);
-    const double ref_rrc = j2452_flat_rrc(set, kRefPressure_pa, kRefLoad_n, kRefSpeed_mps, drum_radius_m);
-    TyreEvaluation e;
-    e.name = set.name;
-    e.reference_rrc = ref_rrc;
-    e.shared = fit_shared_constants(others, drum_radius_m);
-    const Surface one_point = hysteresis_surface(one_point_tyre(set, e.shared, drum_radius_m));
-    const ErrorStats op = grid_error(one_point, truth);
-    e.one_point_rms = op.rms;
-    e.one_point_max = op.max;
-    for (const auto& plan : out.plans) e.plan_rms.push_back(plan_rms(plan, set, e.shared, truth, drum_radius_m));
+    out.tyres.push_back(evaluate_tyre(sets[i], fit_shared_constants(others, drum_radius_m), others, out.shared_all,
+                                      out.plans, drum_radius_m));
+  }
+  return out;
+}
 
-    TyreState full_start = one_point_tyre(set, out.shared_all, drum_radius_m);
-    FitRequest request;
-    request.points = truth;
-    request.free = {HysteresisParam::RrcRef,   HysteresisParam::FrequencySlope, HysteresisParam::DeflectionExponent,
-                    HysteresisParam::LoadExponent, HysteresisParam::SpeedLoss, HysteresisParam::SpeedLossLoadExponent};
-    const TyreFit full = fit_hysteresis(full_start, request);
-    const Surface full_surface = hysteresis_surface(full.tyre);
-    e.full_fit_rms = grid_error(full_surface, truth).rms;
-
-    const TyreState thesis_tyre = j2452_tyre(set);
-    const Surface thesis = scaled_at_reference(
-        [thesis_tyre](double p, double z, double v) {
-          TyreState t = thesis_tyre;
-          t.pressure_pa = p;
-          return evaluate_rolling_resistance(t, z, v).rrc;
-        },
-        ref_rrc);
-    e.thesis_rms = grid_error(thesis, truth).rms;
-    e.constant_rms = grid_error([ref_rrc](double, double, double) { return ref_rrc; }, truth).rms;
-    e.median_shape_rms = grid_error(scaled_at_reference(median_shape_of(others), ref_rrc), truth).rms;
-
-    e.measured = scaling_of(j2452_surface(set, drum_radius_m));
-    e.one_point = scaling_of(one_point);
-    e.full_fit = scaling_of(full_surface);
-    e.thesis = scaling_of(thesis);
-    out.tyres.push_back(e);
+J2452Evaluation evaluate_j2452_held_out(const std::vector<J2452Set>& training, const std::vector<J2452Set>& test,
+                                        double drum_radius_m) {
+  J2452Evaluation out;
+  out.shared_all = fit_shared_constants(training, drum_radius_m);
+  out.common_shape = common_shape_bound(test, drum_radius_m);
+  out.plans = j2452_measurement_plans();
+  for (const auto& set : test) {
+    out.tyres.push_back(evaluate_tyre(set, out.shared_all, training, out.shared_all, out.plans, drum_radius_m));
   }
   return out;
 }

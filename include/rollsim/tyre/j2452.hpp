@@ -14,6 +14,7 @@ struct J2452Set {
   std::string size;        ///< designation, e.g. "P205/60R15"
   double alpha = 0.0, beta = 0.0, a = 0.0, b = 0.0, c = 0.0;
   double rolling_radius_m = 0.0;  ///< the tyre's radius for the drum-to-flat correction
+  bool flagged = false;           ///< the file's value_flagged: a value read with a correction its source note gives
 };
 
 /// The drum radius of the shipped Michelin sets (data/tyres/SOURCES.md) [m].
@@ -30,8 +31,9 @@ double j2452_flat_rrc(const J2452Set& set, double pressure_pa, double load_n, do
 /// Parses "ALPHA,BETA,A,B,C" (--j2452); throws InputError(where, ...) naming the field.
 J2452Set parse_j2452_text(const std::string& text, const std::string& where);
 
-/// Reads sets from a CSV with columns size, rr_class, alpha, beta, a, b, c, wh_radius_m (as shipped in
-/// shared/data/tyres); throws InputError naming file, line and column.
+/// Reads sets from a CSV with columns size, rr_class, alpha, beta, a, b, c, wh_radius_m and optionally
+/// value_flagged (yes/no) (as shipped in shared/data/tyres and tyres/measured); throws InputError naming file,
+/// line and column.
 std::vector<J2452Set> load_j2452_csv(const std::string& path);
 
 /// The evaluation grid of the issue: 180-300 kPa (5) x 3-6 kN (5) x 15-115 km/h (6), 150 points.

@@ -39,6 +39,7 @@ std::vector<MeasurementPlan> j2452_measurement_plans();
 
 struct TyreEvaluation {
   std::string name;
+  bool flagged = false;            ///< the set's values were read with a correction (J2452Set::flagged)
   double reference_rrc = 0.0;      ///< the measured (flat-road) RRC at the one point [-]
   // RMS (and largest) relative RRC error over the grid [-], every model scaled to the tyre at one point
   // (210 kPa, 4000 N, 80 km/h) except the full fit.
@@ -50,7 +51,7 @@ struct TyreEvaluation {
   double median_shape_rms = 0.0;   ///< median J2452 exponents and speed terms of the other tyres, scaled
   std::vector<double> plan_rms;    ///< hysteresis model fitted to each measurement plan's points (J2452Evaluation::plans)
   SurfaceScaling measured, one_point, full_fit, thesis;
-  HysteresisConstants shared;      ///< the constants fitted without this tyre
+  HysteresisConstants shared;      ///< the shared constants it was judged with, fitted without this tyre
 };
 
 /// What any model that gives every tyre one common shape (scaled at the one point) could reach at best, chosen
@@ -85,5 +86,11 @@ HysteresisConstants fit_shared_constants(const std::vector<J2452Set>& training, 
 
 /// Leave-one-tyre-out evaluation of every set, with the baselines and the all-sets shared constants.
 J2452Evaluation evaluate_j2452(const std::vector<J2452Set>& sets, double drum_radius_m);
+
+/// The same judgement of `test` tyres with the shared constants (and the median J2452 shape) fitted once on
+/// `training`: tyres the model never saw. `shared_all` is the training fit; the common-shape bound is the test
+/// tyres'.
+J2452Evaluation evaluate_j2452_held_out(const std::vector<J2452Set>& training, const std::vector<J2452Set>& test,
+                                        double drum_radius_m);
 
 }  // namespace rollsim
