@@ -151,25 +151,19 @@ void print_fit(const TyreFit& fit, const std::optional<LabelBand>& band, const s
   }
 }
 
-void run_evaluate(const std::string& path, const std::string& held_out_path, const std::string& drum_text) {
-  const double drum = drum_text.empty() ? kJ2452DrumRadius_m : number_in(drum_text, "--drum-radius-m", "drum radius");
-  const auto sets = load_j2452_csv(path);
-  if (sets.size() < 3) throw InputError(path, "too few sets for leave-one-tyre-out: need 3 or more");
-  const bool held_out = !held_out_path.empty();
-  const J2452Evaluation ev = held_out ? evaluate_j2452_held_out(sets, load_j2452_csv(held_out_path), drum)
-                                      : evaluate_j2452(sets, drum);
-  std::cout << "RMS relative RRC error over 180-300 kPa x 3-6 kN x 15-115 km/h (150 points), %; one point = 210 kPa, "
-               "4000 N, 80 km/h; "
-            << (held_out ? "shared constants and median J2452 shape fitted once on the " + std::to_string(sets.size()) +
-                               " sets of " + path + ", none of the tyres below\n"
-                         : std::string("shared constants fitted leave-one-tyre-out\n"));
+std::string tyre_label(const TyreEvaluation& e) { return e.name + (e.flagged ? " *" : ""); }
+
+double worst_of(const std::vector<double>& v) { return *std::max_element(v.begin(), v.end()); }
+
+// Each tyre from one point against the baselines, with the exponents each gives.
+void print_one_point_table(const J2452Evaluation& ev) {
   report::TextTable t({"tyre", "RRC kg/t", "one-point", "max", "full fit", "thesis", "constant", "median J2452", "p exp meas",
                        "p exp 1pt", "p exp full", "Z exp meas", "Z exp 1pt", "Z exp full", "rise meas %",
                        "rise 1pt %", "rise full %"});
   t.set_left_aligned(0);
   std::vector<double> cols[6];
   for (const auto& e : ev.tyres) {
-    t.add_row({e.name + (e.flagged ? " *" : ""), fixed(e.reference_rrc * 1e3, 2), pct(e.one_point_rms), pct(e.one_point_max), pct(e.full_fit_rms), pct(e.thesis_rms, 1),
+    t.add_row({tyre_label(e), fixed(e.reference_rrc * 1e3, 2), pct(e.one_point_rms), pct(e.one_point_max), pct(e.full_fit_rms), pct(e.thesis_rms, 1),
                pct(e.constant_rms, 1), pct(e.median_shape_rms), fixed(e.measured.pressure_exponent, 3),
                fixed(e.one_point.pressure_exponent, 3), fixed(e.full_fit.pressure_exponent, 3),
                fixed(e.measured.load_exponent, 3), fixed(e.one_point.load_exponent, 3),
@@ -178,11 +172,10 @@ void run_evaluate(const std::string& path, const std::string& held_out_path, con
     const double v[6] = {e.one_point_rms, e.one_point_max, e.full_fit_rms, e.thesis_rms, e.constant_rms, e.median_shape_rms};
     for (int k = 0; k < 6; ++k) cols[k].push_back(v[k]);
   }
-  auto worst = [](const std::vector<double>& v) { return *std::max_element(v.begin(), v.end()); };
   std::vector<std::string> med{"median", ""}, wst{"worst", ""};
   for (int k = 0; k < 6; ++k) {
     med.push_back(pct(median(cols[k]), k >= 3 && k <= 4 ? 1 : 2));
-    wst.push_back(pct(worst(cols[k]), k >= 3 && k <= 4 ? 1 : 2));
+    wst.push_back(pct(worst_of(cols[k]), k >= 3 && k <= 4 ? 1 : 2));
   }
   for (int k = 0; k < 9; ++k) med.push_back(""), wst.push_back("");
   t.add_row(med);
@@ -199,25 +192,30 @@ void run_evaluate(const std::string& path, const std::string& held_out_path, con
             << pct(b.worst_log_rms) << " % (RMS of the log ratio); the best such shape's RMS error per tyre:";
   for (std::size_t i = 0; i < b.rms.size(); ++i) std::cout << (i ? ", " : " ") << pct(b.rms[i]);
   std::cout << " %\n";
+}
+
+// What more measured points buy: one row per measurement plan.
+void print_plans_table(const J2452Evaluation& ev) {
   std::cout << "\nMore points measured on the held-out tyre besides the one point, the rest as above (RMS %):\n";
   std::vector<std::string> head{"measured besides", "fitted", "median", "worst"};
-  for (const auto& e : ev.tyres) head.push_back(e.name + (e.flagged ? " *" : ""));
+  for (const auto& e : ev.tyres) head.push_back(tyre_label(e));
   report::TextTable m(head);
   m.set_left_aligned(0);
   m.set_left_aligned(1);
   for (std::size_t k = 0; k < ev.plans.size(); ++k) {
-    std::vector<RrcPoint> points{{2.1e5, 4000.0, units::kmh_to_mps(80.0), 0.01, ""}};
-    for (const auto& o : ev.plans[k].extra) points.push_back({o.pressure_pa, o.load_n, o.speed_mps, 0.01, ""});
     std::string fitted;
-    for (const auto p : identifiable_params(points)) fitted += (fitted.empty() ? "" : ", ") + std::string(hysteresis_param_key(p));
+    for (const auto p : ev.plans[k].fitted) fitted += (fitted.empty() ? "" : ", ") + std::string(hysteresis_param_key(p));
     std::vector<double> rms;
     for (const auto& e : ev.tyres) rms.push_back(e.plan_rms[k]);
-    std::vector<std::string> cells{ev.plans[k].name, fitted, pct(median(rms)), pct(worst(rms))};
+    std::vector<std::string> cells{ev.plans[k].name, fitted, pct(median(rms)), pct(worst_of(rms))};
     for (const double x : rms) cells.push_back(pct(x));
     m.add_row(cells);
   }
   std::cout << m.render();
-  std::cout << "\nShared constants fitted on all " << sets.size() << " sets of " << path
+}
+
+void print_shared_constants(const J2452Evaluation& ev, std::size_t sets, const std::string& path, bool held_out) {
+  std::cout << "\nShared constants fitted on all " << sets << " sets of " << path
             << (held_out ? ":\n" : " and, leave-one-tyre-out, without each:\n");
   report::TextTable s({held_out ? "fitted on" : "fitted without", "frequency_slope_per_hz", "deflection_exponent", "load_exponent",
                        "speed_loss_rrc_per_hz2", "speed_loss_load_exponent"});
@@ -236,6 +234,23 @@ void run_evaluate(const std::string& path, const std::string& held_out_path, con
     for (const auto& e : ev.tyres) row(e.name, e.shared);
   }
   std::cout << s.render();
+}
+
+void run_evaluate(const std::string& path, const std::string& held_out_path, const std::string& drum_text) {
+  const double drum = drum_text.empty() ? kJ2452DrumRadius_m : number_in(drum_text, "--drum-radius-m", "drum radius");
+  const auto sets = load_j2452_csv(path);
+  if (sets.size() < 3) throw InputError(path, "too few sets for leave-one-tyre-out: need 3 or more");
+  const bool held_out = !held_out_path.empty();
+  const J2452Evaluation ev = held_out ? evaluate_j2452_held_out(sets, load_j2452_csv(held_out_path), drum)
+                                      : evaluate_j2452(sets, drum);
+  std::cout << "RMS relative RRC error over 180-300 kPa x 3-6 kN x 15-115 km/h (150 points), %; one point = 210 kPa, "
+               "4000 N, 80 km/h; "
+            << (held_out ? "shared constants and median J2452 shape fitted once on the " + std::to_string(sets.size()) +
+                               " sets of " + path + ", none of the tyres below\n"
+                         : std::string("shared constants fitted leave-one-tyre-out\n"));
+  print_one_point_table(ev);
+  print_plans_table(ev);
+  print_shared_constants(ev, sets.size(), path, held_out);
 }
 
 void run_fit(const FitOptions& o) {

@@ -31,6 +31,7 @@ struct OperatingPoint {
 struct MeasurementPlan {
   std::string name;  ///< e.g. "+15 km/h, +300 kPa"
   std::vector<OperatingPoint> extra;
+  std::vector<HysteresisParam> fitted;  ///< what the fit frees for these points with the reference point
 };
 
 /// The plans judged: every single extra point at an edge of the grid (15 or 115 km/h, 180 or 300 kPa, 3 or 6 kN),
