@@ -245,6 +245,31 @@ TEST(J2452HeldOut, TheFileHoldsEightSetsAndOneFlaggedReading) {
   for (const auto& s : load_j2452_csv(kJ2452Csv)) EXPECT_FALSE(s.flagged) << s.name;  // no column: none flagged
 }
 
+TEST(J2452, CsvCoefficientsAreHeldToTheRangesOfTheCommandLineSet) {
+  // The same ranges as --j2452: a file's set that the option would refuse is refused, naming line and column.
+  const auto dir = temp_dir();
+  const std::string head = "size,rr_class,alpha,beta,a,b,c,wh_radius_m\n";
+  const struct {
+    std::string row, column;
+  } cases[] = {{"P205/60R15,LO,0.7,1.0,0.068,2.3E-04,1.2E-06,0.304", "alpha"},
+               {"P205/60R15,LO,-0.48,2.5,0.068,2.3E-04,1.2E-06,0.304", "beta"},
+               {"P205/60R15,LO,-0.48,1.0,0,2.3E-04,1.2E-06,0.304", "a"},
+               {"P205/60R15,LO,-0.48,1.0,0.068,-2.3E-04,1.2E-06,0.304", "b"},
+               {"P205/60R15,LO,-0.48,1.0,0.068,2.3E-04,-1.2E-06,0.304", "c"},
+               {"P235/75R15,HI,-0.26,0.83,0.2,0.250-04,4.18-06,0.352", "b"}};  // the ADVISOR file's typo as written
+  for (const auto& c : cases) {
+    const auto path = (dir / "sets.csv").string();
+    std::ofstream(path) << head << c.row << "\n";
+    try {
+      load_j2452_csv(path);
+      ADD_FAILURE() << c.row;
+    } catch (const InputError& e) {
+      const std::string what = e.what();
+      EXPECT_TRUE(has(what, "line 2") && has(what, "'" + c.column + "'")) << what;
+    }
+  }
+}
+
 TEST(J2452HeldOut, OnePointPredictsTyresItNeverSawAsWellAsItsOwn) {
   const auto& ev = held_out_evaluation();
   ASSERT_EQ(ev.tyres.size(), 8u);

@@ -1,6 +1,7 @@
 #include "rollsim/tyre/j2452.hpp"
 
 #include <cmath>
+#include <optional>
 #include <sstream>
 
 #include "rollsim/common/csv.hpp"
@@ -20,6 +21,24 @@ double j2452_flat_rrc(const J2452Set& s, double pressure_pa, double load_n, doub
   return drum_force_n * drum_to_flat_factor(drum_radius_m, s.rolling_radius_m) / load_n;
 }
 
+namespace {
+
+// The range each coefficient must lie in: the first field (0 alpha .. 4 c) outside it with what is allowed, or none.
+struct FieldError {
+  int field;
+  std::string allowed;
+};
+std::optional<FieldError> coefficient_error(const J2452Set& s) {
+  if (!(s.alpha > -2.0 && s.alpha < 0.5)) return FieldError{0, "must be in (-2, 0.5)"};
+  if (!(s.beta > 0.3 && s.beta < 2.0)) return FieldError{1, "must be in (0.3, 2)"};
+  if (!(s.a > 0.0)) return FieldError{2, "must be > 0"};
+  if (!(s.b >= 0.0)) return FieldError{3, "must be >= 0 (RR does not fall with speed)"};
+  if (!(s.c >= 0.0)) return FieldError{4, "must be >= 0 (RR does not fall with speed)"};
+  return std::nullopt;
+}
+
+}  // namespace
+
 J2452Set parse_j2452_text(const std::string& text, const std::string& where) {
   static const char* kNames[] = {"ALPHA", "BETA", "A", "B", "C"};
   std::vector<std::string> cells;
@@ -36,10 +55,9 @@ J2452Set parse_j2452_text(const std::string& text, const std::string& where) {
     v[i] = *x;
   }
   J2452Set s{"--j2452", "", v[0], v[1], v[2], v[3], v[4], 0.0};
-  if (!(s.alpha > -2.0 && s.alpha < 0.5)) throw InputError(where, "ALPHA " + cells[0] + " is not allowed: must be in (-2, 0.5)");
-  if (!(s.beta > 0.3 && s.beta < 2.0)) throw InputError(where, "BETA " + cells[1] + " is not allowed: must be in (0.3, 2)");
-  if (!(s.a > 0.0)) throw InputError(where, "A " + cells[2] + " is not allowed: must be > 0");
-  if (!(s.b >= 0.0) || !(s.c >= 0.0)) throw InputError(where, "B and C must be >= 0 (RR does not fall with speed)");
+  if (const auto e = coefficient_error(s)) {
+    throw InputError(where, std::string(kNames[e->field]) + " " + cells[e->field] + " is not allowed: " + e->allowed);
+  }
   return s;
 }
 
@@ -62,6 +80,10 @@ std::vector<J2452Set> load_j2452_csv(const std::string& path) {
     };
     J2452Set s{trim(t.rows[i][size]) + " " + trim(t.rows[i][cls]), trim(t.rows[i][size]), num(al), num(be), num(a),
                num(b), num(c), num(r)};
+    if (const auto e = coefficient_error(s)) {
+      const std::size_t column[] = {al, be, a, b, c};
+      throw InputError(t.where(i, column[e->field]), "'" + t.rows[i][column[e->field]] + "' is not allowed: " + e->allowed);
+    }
     if (!(s.rolling_radius_m > 0.1 && s.rolling_radius_m < 1.0)) {
       throw InputError(t.where(i, r), format_value(s.rolling_radius_m) + " m is not allowed: must be in (0.1, 1) m");
     }
