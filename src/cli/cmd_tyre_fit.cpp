@@ -59,28 +59,6 @@ RrcPoint parse_point(const std::string& text, const TyreSize& size) {
           units::kmh_to_mps(number_in(f[2], where, "speed [km/h]")), number_in(f[3], where, "RRC"), where};
 }
 
-std::vector<RrcPoint> read_measured(const std::string& path) {
-  const CsvTable t = read_csv(path);
-  const char* kCols[] = {"pressure_kpa", "load_n", "speed_kmh", "rrc"};
-  std::size_t col[4];
-  for (int k = 0; k < 4; ++k) {
-    const auto c = t.column(kCols[k]);
-    if (!c) {
-      throw InputError(path, std::string("missing column '") + kCols[k] +
-                                 "'; expected pressure_kpa, load_n, speed_kmh, rrc; found " + t.columns_list());
-    }
-    col[k] = *c;
-  }
-  std::vector<RrcPoint> out;
-  for (std::size_t i = 0; i < t.rows.size(); ++i) {
-    double v[4];
-    for (int k = 0; k < 4; ++k) v[k] = number_in(t.rows[i][col[k]], t.where(i, col[k]), kCols[k]);
-    out.push_back({v[0] * 1e3, v[1], units::kmh_to_mps(v[2]), v[3], path + ": line " + std::to_string(t.row_line[i])});
-  }
-  if (out.empty()) throw InputError(path, "too few points for what is asked: the file has no data rows");
-  return out;
-}
-
 std::vector<HysteresisParam> parse_free(const std::string& text) {
   std::vector<HysteresisParam> out;
   if (text.empty()) return out;
@@ -275,7 +253,7 @@ void run_fit(const FitOptions& o) {
   }
   for (const auto& p : o.points) request.points.push_back(parse_point(p, size));
   if (!o.measured.empty()) {
-    for (auto& p : read_measured(o.measured)) request.points.push_back(p);
+    for (auto& p : load_measured_rrc_csv(o.measured)) request.points.push_back(p);
   }
   if (!o.j2452.empty()) {
     J2452Set set = parse_j2452_text(o.j2452, "--j2452 " + o.j2452);

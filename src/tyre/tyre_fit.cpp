@@ -7,6 +7,7 @@
 #include <set>
 #include <string>
 
+#include "rollsim/common/csv.hpp"
 #include "rollsim/common/error.hpp"
 #include "rollsim/common/units.hpp"
 #include "rollsim/tyre/hysteresis_model.hpp"
@@ -288,6 +289,32 @@ LabelBand eu_label_band_c1(const std::string& label_class, const std::string& wh
   }
   throw InputError(where, "'" + label_class + "' is not an EU tyre label fuel-efficiency class: allowed A, B, C, D, E "
                           "(Regulation (EU) 2020/740; its classes F and G of Regulation (EC) 1222/2009 no longer exist)");
+}
+
+std::vector<RrcPoint> load_measured_rrc_csv(const std::string& path) {
+  const CsvTable t = read_csv(path);
+  const char* kCols[] = {"pressure_kpa", "load_n", "speed_kmh", "rrc"};
+  std::size_t col[4];
+  for (int k = 0; k < 4; ++k) {
+    const auto c = t.column(kCols[k]);
+    if (!c) {
+      throw InputError(path, std::string("missing column '") + kCols[k] +
+                                 "'; expected pressure_kpa, load_n, speed_kmh, rrc; found " + t.columns_list());
+    }
+    col[k] = *c;
+  }
+  std::vector<RrcPoint> out;
+  for (std::size_t i = 0; i < t.rows.size(); ++i) {
+    double v[4];
+    for (int k = 0; k < 4; ++k) {
+      const auto x = parse_number(t.rows[i][col[k]]);
+      if (!x || !std::isfinite(*x)) throw InputError(t.where(i, col[k]), kCols[k] + std::string(" '") + t.rows[i][col[k]] + "' is not a number");
+      v[k] = *x;
+    }
+    out.push_back({v[0] * 1e3, v[1], units::kmh_to_mps(v[2]), v[3], path + ": line " + std::to_string(t.row_line[i])});
+  }
+  if (out.empty()) throw InputError(path, "too few points for what is asked: the file has no data rows");
+  return out;
 }
 
 RrcPoint iso28580_point(const TyreSize& size, double rrc, const std::string& where) {

@@ -95,6 +95,11 @@ LabelBand eu_label_band_c1(const std::string& label_class, const std::string& wh
 /// or 250 kPa (extra load). Throws InputError(where, ...) without a load index.
 RrcPoint iso28580_point(const TyreSize& size, double rrc, const std::string& where);
 
+/// Measured points from a CSV with columns pressure_kpa, load_n, speed_kmh, rrc (`rollsim tyre fit --measured`),
+/// each named by its file and line for the fit's errors. Throws InputError naming the file, line and column of a
+/// cell that is not a number, a missing column, or a file without data rows; ranges are the fit's to check.
+std::vector<RrcPoint> load_measured_rrc_csv(const std::string& path);
+
 }  // namespace rollsim
 
 namespace rollsim {
