@@ -157,7 +157,7 @@ constexpr double kTransientFuelTime_s = 0.15;
 // lifts before cutting (1.5 s at the idle rate here), and when fuelling resumes the three-way catalyst's oxygen
 // store, filled with air during the cut, is purged rich: ~1 g of O2 at 3.4 g of O2 per g of fuel, ~0.3 g of
 // fuel. Counted per entry into cut-off in the trace; the model enters it about as often as the Argonne Camry's
-// fuel flow drops to zero on the same traces (hot UDDS 68 against 63, two HWFETs 34 against 28, two US06s 43
+// fuel flow drops to zero on the same traces (hot UDDS 67 against 63, two HWFETs 34 against 28, two US06s 43
 // against 39; test CamryArgonne).
 constexpr double kCutOffDelay_s = 1.5;
 constexpr double kCatalystPurgeFuel_kg = 0.3e-3;
