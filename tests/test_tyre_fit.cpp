@@ -15,6 +15,7 @@
 #include "rollsim/tyre/j2452.hpp"
 #include "rollsim/tyre/j2452_evaluation.hpp"
 #include "rollsim/tyre/tyre_fit.hpp"
+#include "rollsim/tyre/tyre_fit_plan.hpp"
 #include "rollsim/tyre/tyre_model.hpp"
 #include "rollsim/tyre/tyre_spec.hpp"
 #include "test_support.hpp"
@@ -379,6 +380,82 @@ TEST(J2452, ShippedSharedConstantsAreTheFitToAllNineSets) {
     const double want = hysteresis_param_value(fitted, p);
     EXPECT_NEAR(hysteresis_param_value(shipped, p), want, 2e-3 * std::abs(want) + 1e-9) << hysteresis_param_key(p);
   }
+}
+
+// --- what a user has, turned into a fit (shared by the CLI and Python) ---
+
+TEST(TyreFitPlan, LabelAloneIsOneIsoPointWithTheBandAsItsUncertainty) {
+  TyreFitInputs in;
+  in.size = parse_tyre_size("205/55 R16 91V", "size");
+  in.label_class = "B";
+  const TyreFitPlan plan = plan_tyre_fit(in);
+  ASSERT_EQ(plan.request.points.size(), 1u);
+  // Regulation (EU) 2020/740, class B: 6.6-7.7 kg/t, declared to 0.1, so 6.55-7.75; load index 91 is 615 kg.
+  const RrcPoint& p = plan.request.points[0];
+  EXPECT_NEAR(p.rrc, 7.15e-3, 1e-12);
+  EXPECT_NEAR(p.pressure_pa, 210e3, 1e-9);
+  EXPECT_NEAR(p.load_n, 0.8 * 615.0 * 9.80665, 1e-9);
+  EXPECT_NEAR(p.speed_mps, 80.0 / 3.6, 1e-12);
+  EXPECT_NEAR(plan.request.assumed_relative_uncertainty, 0.6 / 7.15 / std::sqrt(3.0), 1e-12);
+  // With a measured point the label only checks the fit: the point is the data.
+  in.points.push_back({210e3, 4500.0, 80.0 / 3.6, 0.0085, "point"});
+  const TyreFitPlan with_point = plan_tyre_fit(in);
+  ASSERT_EQ(with_point.request.points.size(), 1u);
+  EXPECT_EQ(with_point.request.points[0].rrc, 0.0085);
+  EXPECT_TRUE(with_point.band.has_value());
+  EXPECT_NEAR(with_point.request.assumed_relative_uncertainty, FitRequest{}.assumed_relative_uncertainty, 0.0);
+}
+
+TEST(TyreFitPlan, ItsNumbersAreCheckedAndNamed) {
+  TyreFitInputs in;
+  in.size = parse_tyre_size("205/55 R16 91V", "size");
+  in.points.push_back({210e3, 4500.0, 80.0 / 3.6, 0.0085, "point"});
+  auto refused = [&](TyreFitInputs bad, const std::string& name) {
+    try {
+      plan_tyre_fit(bad);
+      ADD_FAILURE() << name;
+    } catch (const InputError& e) {
+      EXPECT_TRUE(has(e.what(), name)) << e.what();
+    }
+  };
+  TyreFitInputs drum = in;
+  drum.j2452 = parse_j2452_text("-0.4815,1.0051,0.0682,2.32E-04,1.20E-06", "j2452");
+  drum.drum_radius_m = 0.05;
+  drum.drum_where = "the drum";
+  refused(drum, "the drum");
+  TyreFitInputs scatter = in;
+  scatter.uncertainty_pct = 0.0;
+  scatter.uncertainty_where = "the scatter";
+  refused(scatter, "the scatter");
+  TyreFitInputs label = in;
+  label.label_class = "F";
+  label.label_where = "the label";
+  refused(label, "the label");
+  EXPECT_THROW(fitted_file_pressure_pa(in.size, 0.0, "pressure"), InputError);  // 0 bar
+  EXPECT_NEAR(fitted_file_pressure_pa(in.size, std::nullopt, "pressure"), 210e3, 0.0);
+  EXPECT_NEAR(fitted_file_pressure_pa(parse_tyre_size("215/45 R17 91W XL", "size"), std::nullopt, "pressure"), 250e3, 0.0);
+}
+
+TEST(CliTyreFit, JsonLinesCarryTheFitItsConstantsAndEveryResidual) {
+  const auto out = temp_dir() / "t.yaml";
+  const CmdResult r = fit("--size '205/55 R16 91V' --point 210,4500,80,0.0085 --point 250,4500,80,0.0079 "
+                          "--point 210,4500,40,0.0080 --label B --json --output '" + out.string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto ls = lines(r.out);
+  ASSERT_EQ(ls.size(), 1u + 6u + 3u) << r.out;  // the fit, six constants, three points
+  EXPECT_TRUE(has(ls[0], "\"kind\": \"fit\"") && has(ls[0], "\"label_class\": \"B\"")) << ls[0];
+  EXPECT_EQ(json_number(ls[0], "points"), 3);
+  int free = 0;
+  for (std::size_t i = 1; i <= 6; ++i) {
+    EXPECT_TRUE(has(ls[i], "\"kind\": \"param\"")) << ls[i];
+    free += has(ls[i], "\"free\": true");
+  }
+  EXPECT_EQ(free, 3);  // the level, the deflection exponent (2 pressures), the frequency slope (2 speeds)
+  for (std::size_t i = 7; i < ls.size(); ++i) {
+    EXPECT_TRUE(has(ls[i], "\"kind\": \"residual\"")) << ls[i];
+    EXPECT_NEAR(json_number(ls[i], "model_rrc") / json_number(ls[i], "rrc") - 1.0, json_number(ls[i], "error_pct") / 100.0, 1e-12);
+  }
+  EXPECT_TRUE(std::filesystem::exists(out));  // the tyre file is still written
 }
 
 // --- label and ISO conditions ---

@@ -23,6 +23,7 @@
 #include "rollsim/tyre/j2452.hpp"
 #include "rollsim/tyre/j2452_evaluation.hpp"
 #include "rollsim/tyre/tyre_fit.hpp"
+#include "rollsim/tyre/tyre_fit_plan.hpp"
 #include "rollsim/tyre/tyre_spec.hpp"
 
 namespace rollsim::cli {
@@ -32,6 +33,7 @@ struct FitOptions {
   std::string size, label, j2452, measured, output, name, pressure_bar, free, uncertainty_pct, drum_radius_m;
   std::vector<std::string> points;
   std::string evaluate_j2452, held_out_j2452;
+  bool json = false;
 };
 
 double number_in(const std::string& text, const std::string& where, const std::string& what) {
@@ -215,7 +217,9 @@ void print_shared_constants(const J2452Evaluation& ev, std::size_t sets, const s
 }
 
 void run_evaluate(const std::string& path, const std::string& held_out_path, const std::string& drum_text) {
-  const double drum = drum_text.empty() ? kJ2452DrumRadius_m : number_in(drum_text, "--drum-radius-m", "drum radius");
+  const double drum = drum_text.empty() ? kJ2452DrumRadius_m
+                                        : checked_number(number_in(drum_text, "--drum-radius-m", "drum radius"),
+                                                         "--drum-radius-m", {kDrumRadiusMin_m, kDrumRadiusMax_m, true, true});
   const auto sets = load_j2452_csv(path);
   if (sets.size() < 3) throw InputError(path, "too few sets for leave-one-tyre-out: need 3 or more");
   const bool held_out = !held_out_path.empty();
@@ -238,60 +242,48 @@ void run_fit(const FitOptions& o) {
   if (!o.evaluate_j2452.empty()) return run_evaluate(o.evaluate_j2452, o.held_out_j2452, o.drum_radius_m);
   if (o.size.empty()) throw InputError("--size", "missing: the tyre's size designation, e.g. \"205/55 R16 91V\"");
   if (o.output.empty()) throw InputError("--output", "missing: the tyre file to write, e.g. --output my-tyre.yaml");
-  const TyreSize size = parse_tyre_size(o.size, "--size");
-  TyreState start;
-  start.geometry.outer_radius_m = size.outer_radius_m;
-  start.geometry.section_width_m = size.section_width_m;
-  start.geometry.rim_radius_m = size.rim_diameter_m / 2.0;
-
-  FitRequest request;
-  std::optional<LabelBand> band;
-  std::optional<RrcPoint> iso;  // where the label's band applies
-  if (!o.label.empty()) {
-    band = eu_label_band_c1(o.label, "--label " + o.label);
-    iso = iso28580_point(size, band->rrc_mid(), "--label " + o.label);
-  }
-  for (const auto& p : o.points) request.points.push_back(parse_point(p, size));
+  TyreFitInputs in;
+  in.size = parse_tyre_size(o.size, "--size");
+  const TyreSize& size = in.size;
+  for (const auto& p : o.points) in.points.push_back(parse_point(p, size));
   if (!o.measured.empty()) {
-    for (auto& p : load_measured_rrc_csv(o.measured)) request.points.push_back(p);
+    for (auto& p : load_measured_rrc_csv(o.measured)) in.points.push_back(p);
+  }
+  if (!o.label.empty()) {
+    in.label_class = o.label;
+    in.label_where = "--label " + o.label;
   }
   if (!o.j2452.empty()) {
-    J2452Set set = parse_j2452_text(o.j2452, "--j2452 " + o.j2452);
-    set.rolling_radius_m = size.outer_radius_m;
-    const double drum = o.drum_radius_m.empty() ? kJ2452DrumRadius_m
-                                                : number_in(o.drum_radius_m, "--drum-radius-m", "drum radius");
-    if (!(drum > 0.1 && drum < 10.0)) throw InputError("--drum-radius-m", "must be in (0.1, 10) m");
-    for (auto& p : sample_j2452(set, j2452_grid(), drum, "--j2452 grid")) request.points.push_back(p);
+    in.j2452 = parse_j2452_text(o.j2452, "--j2452 " + o.j2452);
+    in.j2452_where = "--j2452";
   }
-  // A label alone is one point at ISO conditions, at the band's middle, with the band as its uncertainty
-  // (uniform over the band: half-width / sqrt(3)).
-  if (band && request.points.empty()) {
-    request.points.push_back(*iso);
-    request.assumed_relative_uncertainty = 0.5 * (band->rrc_max - band->rrc_min) / band->rrc_mid() / std::sqrt(3.0);
-  }
-  if (!o.uncertainty_pct.empty()) {
-    const double u = number_in(o.uncertainty_pct, "--rrc-uncertainty-pct", "uncertainty");
-    if (!(u > 0.0 && u <= 50.0)) throw InputError("--rrc-uncertainty-pct " + o.uncertainty_pct, "must be in (0, 50]");
-    request.assumed_relative_uncertainty = u / 100.0;
-  }
-  request.free = parse_free(o.free);
-  const TyreFit fit = fit_hysteresis(start, request);
+  if (!o.drum_radius_m.empty()) in.drum_radius_m = number_in(o.drum_radius_m, "--drum-radius-m", "drum radius");
+  in.drum_where = "--drum-radius-m";
+  if (!o.uncertainty_pct.empty()) in.uncertainty_pct = number_in(o.uncertainty_pct, "--rrc-uncertainty-pct", "uncertainty");
+  in.uncertainty_where = "--rrc-uncertainty-pct";
+  in.free = parse_free(o.free);
+  const TyreFitPlan plan = plan_tyre_fit(in);
+  const TyreFit fit = fit_hysteresis(plan.start, plan.request);
 
   FittedTyreFile file;
   file.name = o.name.empty() ? std::filesystem::path(o.output).stem().string() : o.name;
   file.size = o.size;
-  file.pressure_pa = o.pressure_bar.empty() ? (size.extra_load ? 250e3 : 210e3)
-                                            : units::bar_to_pa(number_in(o.pressure_bar, "--pressure-bar", "pressure"));
-  if (!(file.pressure_pa >= 0.5e5 && file.pressure_pa <= 6e5)) throw InputError("--pressure-bar", "must be in [0.5, 6] bar");
+  file.pressure_pa = fitted_file_pressure_pa(
+      size, o.pressure_bar.empty() ? std::nullopt : std::optional(number_in(o.pressure_bar, "--pressure-bar", "pressure")),
+      "--pressure-bar");
   std::string src = "rollsim tyre fit";
   if (!o.points.empty()) src += ", " + std::to_string(o.points.size()) + " --point";
   if (!o.measured.empty()) src += ", --measured " + o.measured;
   if (!o.j2452.empty()) src += ", --j2452 " + o.j2452;
   if (!o.label.empty()) src += ", --label " + o.label;
   file.source = src;
-  print_fit(fit, band, iso);
+  if (o.json) {
+    write_tyre_fit_json(std::cout, fit, plan);
+  } else {
+    print_fit(fit, plan.band, plan.iso);
+  }
   write_file_atomically(o.output, "--output", [&](std::ostream& out) { write_fitted_tyre_yaml(out, file, fit); });
-  std::cout << "wrote " << o.output << "\n";
+  if (!o.json) std::cout << "wrote " << o.output << "\n";
 }
 
 }  // namespace
@@ -324,6 +316,7 @@ void register_tyre_fit_command(CLI::App& tyre) {
   sub->add_option("--evaluate-j2452", o->evaluate_j2452,
                   "Instead of fitting: judge the model on a CSV of J2452 sets, leave-one-tyre-out, with baselines")
       ->type_name("FILE");
+  sub->add_flag("--json", o->json, "The fit as JSON lines (fit, each constant, each point's residual) instead of tables");
   sub->add_option("--held-out-j2452", o->held_out_j2452,
                   "With --evaluate-j2452: fit the shared constants once on its sets and judge them on these instead")
       ->type_name("FILE");

@@ -116,19 +116,19 @@ std::vector<MeasurementPlan> j2452_measurement_plans() {
   const OperatingPoint v115{kRefPressure_pa, kRefLoad_n, units::kmh_to_mps(115.0)};
   const OperatingPoint p180{180e3, kRefLoad_n, kRefSpeed_mps}, p300{300e3, kRefLoad_n, kRefSpeed_mps};
   const OperatingPoint z3{kRefPressure_pa, 3000.0, kRefSpeed_mps}, z6{kRefPressure_pa, 6000.0, kRefSpeed_mps};
-  std::vector<MeasurementPlan> plans{{"+15 km/h", {v15}},
-                                      {"+115 km/h", {v115}},
-                                      {"+180 kPa", {p180}},
-                                      {"+300 kPa", {p300}},
-                                      {"+3 kN", {z3}},
-                                      {"+6 kN", {z6}},
-                                      {"+15 km/h, +180 kPa", {v15, p180}},
-                                      {"+15 km/h, +300 kPa", {v15, p300}},
-                                      {"+115 km/h, +180 kPa", {v115, p180}},
-                                      {"+115 km/h, +300 kPa", {v115, p300}},
-                                      {"+15 km/h, +115 km/h", {v15, v115}},
-                                      {"+15 km/h, +115 km/h, +180 kPa", {v15, v115, p180}},
-                                      {"+15 km/h, +115 km/h, +300 kPa", {v15, v115, p300}}};
+  std::vector<MeasurementPlan> plans{{"+15 km/h", {v15}, {}},
+                                      {"+115 km/h", {v115}, {}},
+                                      {"+180 kPa", {p180}, {}},
+                                      {"+300 kPa", {p300}, {}},
+                                      {"+3 kN", {z3}, {}},
+                                      {"+6 kN", {z6}, {}},
+                                      {"+15 km/h, +180 kPa", {v15, p180}, {}},
+                                      {"+15 km/h, +300 kPa", {v15, p300}, {}},
+                                      {"+115 km/h, +180 kPa", {v115, p180}, {}},
+                                      {"+115 km/h, +300 kPa", {v115, p300}, {}},
+                                      {"+15 km/h, +115 km/h", {v15, v115}, {}},
+                                      {"+15 km/h, +115 km/h, +180 kPa", {v15, v115, p180}, {}},
+                                      {"+15 km/h, +115 km/h, +300 kPa", {v15, v115, p300}, {}}};
   for (auto& plan : plans) {  // what `rollsim tyre fit` frees for these points; their RRC does not matter here
     std::vector<RrcPoint> points{{kRefPressure_pa, kRefLoad_n, kRefSpeed_mps, 0.01, ""}};
     for (const auto& o : plan.extra) points.push_back({o.pressure_pa, o.load_n, o.speed_mps, 0.01, ""});

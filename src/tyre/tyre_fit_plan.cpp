@@ -1,0 +1,102 @@
+#include "rollsim/tyre/tyre_fit_plan.hpp"
+
+#include <cmath>
+
+#include "rollsim/common/json.hpp"
+#include "rollsim/common/units.hpp"
+#include "rollsim/common/yaml_reader.hpp"
+
+namespace rollsim {
+
+TyreFitPlan plan_tyre_fit(const TyreFitInputs& in) {
+  TyreFitPlan plan;
+  plan.start.geometry.outer_radius_m = in.size.outer_radius_m;
+  plan.start.geometry.section_width_m = in.size.section_width_m;
+  plan.start.geometry.rim_radius_m = in.size.rim_diameter_m / 2.0;
+  if (in.label_class) {
+    plan.band = eu_label_band_c1(*in.label_class, in.label_where);
+    plan.iso = iso28580_point(in.size, plan.band->rrc_mid(), in.label_where);
+  }
+  plan.request.points = in.points;
+  if (in.j2452) {
+    J2452Set set = *in.j2452;
+    set.rolling_radius_m = in.size.outer_radius_m;
+    const double drum = in.drum_radius_m ? checked_number(*in.drum_radius_m, in.drum_where, {kDrumRadiusMin_m, kDrumRadiusMax_m, true, true})
+                                         : kJ2452DrumRadius_m;
+    for (auto& p : sample_j2452(set, j2452_grid(), drum, in.j2452_where + " grid")) plan.request.points.push_back(p);
+  }
+  if (plan.band && plan.request.points.empty()) {
+    plan.request.points.push_back(*plan.iso);
+    plan.request.assumed_relative_uncertainty =
+        0.5 * (plan.band->rrc_max - plan.band->rrc_min) / plan.band->rrc_mid() / std::sqrt(3.0);
+  }
+  if (in.uncertainty_pct) {
+    plan.request.assumed_relative_uncertainty =
+        checked_number(*in.uncertainty_pct, in.uncertainty_where, Range::open_low(0.0, 50.0)) / 100.0;
+  }
+  plan.request.free = in.free;
+  return plan;
+}
+
+double fitted_file_pressure_pa(const TyreSize& size, std::optional<double> pressure_bar, const std::string& where) {
+  if (!pressure_bar) return size.extra_load ? 250e3 : 210e3;
+  return units::bar_to_pa(checked_number(*pressure_bar, where, Range::closed(0.5, 6.0)));
+}
+
+void write_tyre_fit_json(std::ostream& out, const TyreFit& fit, const TyreFitPlan& plan) {
+  JsonObject head;
+  head.add("kind", "fit")
+      .add("points", static_cast<int>(fit.residuals.size()))
+      .add("degrees_of_freedom", fit.degrees_of_freedom)
+      .add("rms_error_pct", 100.0 * fit.rms_relative_error)
+      .add("sigma_pct", 100.0 * fit.sigma_relative)
+      .add("sigma_from_residuals", fit.sigma_from_residuals);
+  if (plan.band && plan.iso) {
+    TyreState at = fit.tyre;
+    at.pressure_pa = plan.iso->pressure_pa;
+    const double rrc = evaluate_rolling_resistance(at, plan.iso->load_n, plan.iso->speed_mps).rrc;
+    head.add("label_class", std::string(1, plan.band->label_class))
+        .add("label_rrc_min_kg_per_t", 1e3 * plan.band->rrc_min)
+        .add("label_rrc_max_kg_per_t", 1e3 * plan.band->rrc_max)
+        .add("iso_rrc_kg_per_t", 1e3 * rrc)
+        .add("inside_label_band", rrc >= plan.band->rrc_min && rrc <= plan.band->rrc_max);
+  }
+  out << head.str() << '\n';
+  for (const auto& p : fit.params) {
+    out << JsonObject()
+               .add("kind", "param")
+               .add("key", hysteresis_param_key(p.param))
+               .add("free", true)
+               .add("value", p.value)
+               .add("std_error", p.std_error)
+               .add("low95", p.low95)
+               .add("high95", p.high95)
+               .add("at_bound", p.at_bound)
+               .str()
+        << '\n';
+  }
+  for (const auto p : fit.held) {
+    out << JsonObject()
+               .add("kind", "param")
+               .add("key", hysteresis_param_key(p))
+               .add("free", false)
+               .add("value", hysteresis_param_value(fit.tyre.hysteresis, p))
+               .str()
+        << '\n';
+  }
+  for (const auto& r : fit.residuals) {
+    out << JsonObject()
+               .add("kind", "residual")
+               .add("where", r.point.where)
+               .add("pressure_kpa", r.point.pressure_pa / 1e3)
+               .add("load_n", r.point.load_n)
+               .add("speed_kmh", units::mps_to_kmh(r.point.speed_mps))
+               .add("rrc", r.point.rrc)
+               .add("model_rrc", r.model_rrc)
+               .add("error_pct", 100.0 * r.relative_error)
+               .str()
+        << '\n';
+  }
+}
+
+}  // namespace rollsim
