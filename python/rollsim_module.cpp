@@ -5,9 +5,11 @@
 #include <pybind11/stl.h>
 
 #include <optional>
+#include <sstream>
 #include <string>
 #include <vector>
 
+#include "rollsim/common/atomic_file.hpp"
 #include "rollsim/common/csv.hpp"
 #include "rollsim/common/error.hpp"
 #include "rollsim/common/format.hpp"
@@ -20,6 +22,8 @@
 #include "rollsim/report/simulation_report.hpp"
 #include "rollsim/selection/front_end.hpp"
 #include "rollsim/sim/vehicle_run.hpp"
+#include "rollsim/tyre/j2452.hpp"
+#include "rollsim/tyre/tyre_fit_plan.hpp"
 #include "rollsim/tyre/tyre_model.hpp"
 #include "rollsim/tyre/tyre_request.hpp"
 #include "rollsim/vehicle/vehicle.hpp"
@@ -248,6 +252,72 @@ py::dict api_engine_map(py::dict engine, py::object speed_rpm, py::object torque
   return out;
 }
 
+// A measured point: (pressure_kpa, load_n, speed_kmh, rrc), or an RRC alone at the size's ISO 28580 conditions.
+RrcPoint fit_point(py::handle p, const TyreSize& size, const std::string& where) {
+  try {
+    if (py::isinstance<py::sequence>(p) && !py::isinstance<py::str>(p)) {
+      const auto v = p.cast<std::vector<double>>();
+      if (v.size() == 4) return {v[0] * 1e3, v[1], units::kmh_to_mps(v[2]), v[3], where};
+    } else if (!py::isinstance<py::str>(p)) {
+      return iso28580_point(size, p.cast<double>(), where);
+    }
+  } catch (const py::cast_error&) {
+  }
+  throw InputError(where, "expected (pressure_kpa, load_n, speed_kmh, rrc) or an RRC alone (ISO 28580 conditions)");
+}
+
+// `rollsim tyre fit --json` through the same library steps, and the tyre file it writes as a dict (for
+// simulate(tyre=...)); the file itself only when `output` is given.
+py::dict api_tyre_fit(const std::string& size, py::object points, py::object label, py::object j2452,
+                      py::object drum_radius_m, py::object free, py::object rrc_uncertainty_pct, py::object pressure_bar,
+                      const std::string& name, py::object output) {
+  TyreFitInputs in;
+  in.size = parse_tyre_size(size, "size");
+  if (!points.is_none()) {
+    std::size_t i = 0;
+    for (const auto p : points) {
+      in.points.push_back(fit_point(p, in.size, "points[" + std::to_string(i) + "]"));
+      ++i;
+    }
+  }
+  if (!label.is_none()) in.label_class = label.cast<std::string>();
+  if (!j2452.is_none()) {
+    std::string text;
+    for (const auto x : j2452) text += (text.empty() ? "" : ",") + number_text(x);
+    in.j2452 = parse_j2452_text(text, "j2452");
+  }
+  if (!drum_radius_m.is_none()) in.drum_radius_m = drum_radius_m.cast<double>();
+  if (!rrc_uncertainty_pct.is_none()) in.uncertainty_pct = rrc_uncertainty_pct.cast<double>();
+  if (!free.is_none()) in.free = free_params_from_keys(free.cast<std::vector<std::string>>(), "free");
+  const TyreFitPlan plan = plan_tyre_fit(in);
+  const TyreFit fit = fit_hysteresis(plan.start, plan.request);
+  FittedTyreFile file;
+  file.name = name;
+  file.size = size;
+  file.pressure_pa = fitted_file_pressure_pa(
+      in.size, pressure_bar.is_none() ? std::nullopt : std::optional(pressure_bar.cast<double>()), "pressure_bar");
+  file.source = "rollsim.tyre_fit (Python)";
+  std::ostringstream json, yaml;
+  write_tyre_fit_json(json, fit, plan);
+  write_fitted_tyre_yaml(yaml, file, fit);
+  py::dict out;
+  py::list params, residuals;
+  std::istringstream lines(json.str());
+  for (std::string line; std::getline(lines, line);) {
+    py::dict d = from_json(line).cast<py::dict>();
+    const std::string kind = d["kind"].cast<std::string>();
+    if (kind == "fit") out["fit"] = d;
+    else (kind == "param" ? params : residuals).append(d);
+  }
+  out["params"] = params;
+  out["residuals"] = residuals;
+  out["tyre"] = py::module_::import("yaml").attr("safe_load")(yaml.str());
+  if (!output.is_none()) {
+    write_file_atomically(output.cast<std::string>(), "output", [&](std::ostream& o) { o << yaml.str(); });
+  }
+  return out;
+}
+
 }  // namespace
 
 PYBIND11_MODULE(rollsim, m) {
@@ -302,6 +372,20 @@ load), speed_kmh [km/h]. With vehicle (and cycle) each point is a forward simula
 threads, default every core). Returns a list of dicts, one per point: the swept values (e.g. pressure_bar),
 load_n, speed_kmh, rrc, rr_force_n, rr_power_w, and the car's kwh_per_10km or l_per_100km. A range leaving the
 model's domain stops with a warning and returns the valid points.)");
+
+  m.def("tyre_fit", &api_tyre_fit, "size"_a, py::kw_only(), "points"_a = py::none(), "label"_a = py::none(),
+        "j2452"_a = py::none(), "drum_radius_m"_a = py::none(), "free"_a = py::none(),
+        "rrc_uncertainty_pct"_a = py::none(), "pressure_bar"_a = py::none(), "name"_a = "fitted", "output"_a = py::none(),
+        R"(The hysteresis model fitted to what you have for one tyre (`rollsim tyre fit --json`).
+
+size: designation, e.g. '205/55 R16 91V' (a load index is needed for ISO points and labels). points: a list of
+(pressure_kpa [kPa], load_n [N], speed_kmh [km/h], rrc [-]) or of RRCs alone (at ISO 28580 conditions); label: EU
+label class 'A'..'E' (alone: one ISO point at the band's middle); j2452: (alpha, beta, a, b, c) of a J2452 set,
+sampled and corrected from a drum of drum_radius_m [m, default 0.85]; free: constants to fit (default: what the
+points determine); rrc_uncertainty_pct [%]; pressure_bar [bar] and name of the tyre file; output: a path to write
+it to (then tyre(output) and every command take it). Returns {'fit': dict, 'params': [dict per constant],
+'residuals': [dict per point], 'tyre': the tyre file as a dict, which simulate(tyre=...) takes}. Same keys, values
+and errors as the command line.)");
 
   m.def("engine_map", &api_engine_map, "engine"_a, "speed_rpm"_a, "torque_nm"_a,
         R"(The library's fuel map (EngineMap) of an engine_map vehicle's `powertrain.engine` block.

@@ -62,21 +62,8 @@ RrcPoint parse_point(const std::string& text, const TyreSize& size) {
 }
 
 std::vector<HysteresisParam> parse_free(const std::string& text) {
-  std::vector<HysteresisParam> out;
-  if (text.empty()) return out;
-  for (const auto& key : split(text, ',')) {
-    const auto p = hysteresis_param_from_key(key);
-    if (!p) {
-      throw InputError("--free " + text, "'" + key + "' is not a constant of the hysteresis model; allowed: rrc_ref, "
-                                         "frequency_slope_per_hz, deflection_exponent, load_exponent, "
-                                         "speed_loss_rrc_per_hz2, speed_loss_load_exponent");
-    }
-    out.push_back(*p);
-  }
-  if (out.front() != HysteresisParam::RrcRef && std::find(out.begin(), out.end(), HysteresisParam::RrcRef) == out.end()) {
-    out.insert(out.begin(), HysteresisParam::RrcRef);  // the level is always the tyre's own
-  }
-  return out;
+  if (text.empty()) return {};
+  return free_params_from_keys(split(text, ','), "--free " + text);
 }
 
 std::string pct(double x, int d = 2) { return fixed(x * 100.0, d); }

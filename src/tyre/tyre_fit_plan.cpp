@@ -1,7 +1,9 @@
 #include "rollsim/tyre/tyre_fit_plan.hpp"
 
+#include <algorithm>
 #include <cmath>
 
+#include "rollsim/common/error.hpp"
 #include "rollsim/common/json.hpp"
 #include "rollsim/common/units.hpp"
 #include "rollsim/common/yaml_reader.hpp"
@@ -36,6 +38,25 @@ TyreFitPlan plan_tyre_fit(const TyreFitInputs& in) {
   }
   plan.request.free = in.free;
   return plan;
+}
+
+std::vector<HysteresisParam> free_params_from_keys(const std::vector<std::string>& keys, const std::string& where) {
+  std::vector<HysteresisParam> out;
+  for (const auto& key : keys) {
+    const auto p = hysteresis_param_from_key(key);
+    if (!p) {
+      std::string allowed;
+      for (int k = 0; k < kHysteresisParamCount; ++k) {
+        allowed += (k ? ", " : "") + std::string(hysteresis_param_key(static_cast<HysteresisParam>(k)));
+      }
+      throw InputError(where, "'" + key + "' is not a constant of the hysteresis model; allowed: " + allowed);
+    }
+    out.push_back(*p);
+  }
+  if (!out.empty() && std::find(out.begin(), out.end(), HysteresisParam::RrcRef) == out.end()) {
+    out.insert(out.begin(), HysteresisParam::RrcRef);  // the level is always the tyre's own
+  }
+  return out;
 }
 
 double fitted_file_pressure_pa(const TyreSize& size, std::optional<double> pressure_bar, const std::string& where) {

@@ -40,6 +40,10 @@ struct TyreFitPlan {
 /// uncertainty outside (0, 50] %.
 TyreFitPlan plan_tyre_fit(const TyreFitInputs& in);
 
+/// The constants named by `keys` (hysteresis_param_key), with the level always among them (the tyre's own).
+/// Throws InputError(where, ...) naming a key that is not a constant and the allowed ones.
+std::vector<HysteresisParam> free_params_from_keys(const std::vector<std::string>& keys, const std::string& where);
+
 /// The inflation pressure a fitted tyre file is written at [Pa]: `pressure_bar` (0.5-6 bar) or, without it, ISO
 /// 28580's for the size (210 kPa, 250 kPa for extra load). Throws InputError(where, ...) outside the range.
 double fitted_file_pressure_pa(const TyreSize& size, std::optional<double> pressure_bar, const std::string& where);
