@@ -252,6 +252,16 @@ py::dict api_engine_map(py::dict engine, py::object speed_rpm, py::object torque
   return out;
 }
 
+// A keyword argument as T, or the named error a command-line user would get for a malformed option.
+template <class T>
+T arg_as(py::handle x, const std::string& where, const std::string& expected) {
+  try {
+    return x.cast<T>();
+  } catch (const py::cast_error&) {
+    throw InputError(where, "expected " + expected);
+  }
+}
+
 // A measured point: (pressure_kpa, load_n, speed_kmh, rrc), or an RRC alone at the size's ISO 28580 conditions.
 RrcPoint fit_point(py::handle p, const TyreSize& size, const std::string& where) {
   try {
@@ -280,22 +290,29 @@ py::dict api_tyre_fit(const std::string& size, py::object points, py::object lab
       ++i;
     }
   }
-  if (!label.is_none()) in.label_class = label.cast<std::string>();
+  if (!label.is_none()) in.label_class = arg_as<std::string>(label, "label", "a class 'A'..'E'");
   if (!j2452.is_none()) {
     std::string text;
-    for (const auto x : j2452) text += (text.empty() ? "" : ",") + number_text(x);
+    for (const double x : arg_as<std::vector<double>>(j2452, "j2452", "(alpha, beta, a, b, c)")) {
+      text += (text.empty() ? "" : ",") + format_value(x);
+    }
     in.j2452 = parse_j2452_text(text, "j2452");
   }
-  if (!drum_radius_m.is_none()) in.drum_radius_m = drum_radius_m.cast<double>();
-  if (!rrc_uncertainty_pct.is_none()) in.uncertainty_pct = rrc_uncertainty_pct.cast<double>();
-  if (!free.is_none()) in.free = free_params_from_keys(free.cast<std::vector<std::string>>(), "free");
+  if (!drum_radius_m.is_none()) in.drum_radius_m = arg_as<double>(drum_radius_m, "drum_radius_m", "a number [m]");
+  if (!rrc_uncertainty_pct.is_none()) {
+    in.uncertainty_pct = arg_as<double>(rrc_uncertainty_pct, "rrc_uncertainty_pct", "a number [%]");
+  }
+  if (!free.is_none()) {
+    in.free = free_params_from_keys(arg_as<std::vector<std::string>>(free, "free", "a list of constant names"), "free");
+  }
   const TyreFitPlan plan = plan_tyre_fit(in);
   const TyreFit fit = fit_hysteresis(plan.start, plan.request);
   FittedTyreFile file;
   file.name = name;
   file.size = size;
   file.pressure_pa = fitted_file_pressure_pa(
-      in.size, pressure_bar.is_none() ? std::nullopt : std::optional(pressure_bar.cast<double>()), "pressure_bar");
+      in.size, pressure_bar.is_none() ? std::nullopt : std::optional(arg_as<double>(pressure_bar, "pressure_bar", "a number [bar]")),
+      "pressure_bar");
   file.source = "rollsim.tyre_fit (Python)";
   std::ostringstream json, yaml;
   write_tyre_fit_json(json, fit, plan);

@@ -61,7 +61,9 @@ class TyreFit(unittest.TestCase):
             cases = [(dict(points=["x"]), "points[0]"), (dict(points=[(0, 4000, 80, 0.009)]), "pressure 0 kPa"),
                      (dict(points=[0.5]), "RRC 0.5"), (dict(label="F"), "label"),
                      (dict(points=[0.009], free=["bogus"]), "bogus"), (dict(points=[0.009], pressure_bar=0), "pressure_bar"),
-                     (dict(j2452=(-0.4, 0.9, 0.1)), "ALPHA,BETA,A,B,C"), (dict(), "too few points")]
+                     (dict(j2452=(-0.4, 0.9, 0.1)), "ALPHA,BETA,A,B,C"), (dict(), "too few points"),
+                     (dict(label=2), "label"), (dict(j2452="x"), "j2452"), (dict(points=[0.009], free="rrc_ref"), "free"),
+                     (dict(points=[0.009], pressure_bar="2"), "pressure_bar")]
             for kwargs, named in cases:
                 with self.assertRaises(rollsim.InputError, msg=str(kwargs)) as e:
                     rollsim.tyre_fit("205/55 R16 91V", output=out, **kwargs)
