@@ -107,7 +107,8 @@ py::dict stack(const std::vector<py::dict>& points) {
 py::object api_tyre(py::object file, py::object size, py::object outer_radius_m, py::object width_m, py::object pressure_bar,
                 py::object load_n, py::object load_pct, py::object speed_kmh) {
   TyreRequest req;
-  if (!file.is_none()) req.file = file.cast<std::string>();
+  if (py::isinstance<py::dict>(file)) req.file_text = to_json(file);
+  else if (!file.is_none()) req.file = file.cast<std::string>();
   if (!size.is_none()) req.size = size.cast<std::string>();
   req.outer_radius_m = number_text(outer_radius_m);
   req.width_m = number_text(width_m);
@@ -351,7 +352,8 @@ carrying the command line's message (options are named as on the command line, e
         "speed_kmh"_a = 80.0,
         R"(Rolling resistance of one tyre at one load and one or more speeds (`rollsim tyre --json`).
 
-tyre: a tyre file or shipped name ('175-70R14'); or size='175/70 R14 84T'; or outer_radius_m [m] and width_m [m].
+tyre: a tyre file or shipped name ('175-70R14') or a dict of its keys (as tyre_fit returns); or
+size='175/70 R14 84T'; or outer_radius_m [m] and width_m [m].
 pressure_bar [bar] (required without a file; overrides a file's), load_n [N] or load_pct [% of the maximum load,
 default 80], speed_kmh [km/h]: a number gives one dict of numbers, an array gives a dict of arrays (one per speed).
 Keys: rrc [-], rr_force_n [N], rr_power_w [W], stiffness_n_per_m, deflection_m, contact_length_m, offset_e_m,
@@ -400,9 +402,9 @@ size: designation, e.g. '205/55 R16 91V' (a load index is needed for ISO points 
 label class 'A'..'E' (alone: one ISO point at the band's middle); j2452: (alpha, beta, a, b, c) of a J2452 set,
 sampled and corrected from a drum of drum_radius_m [m, default 0.85]; free: constants to fit (default: what the
 points determine); rrc_uncertainty_pct [%]; pressure_bar [bar] and name of the tyre file; output: a path to write
-it to (then tyre(output) and every command take it). Returns {'fit': dict, 'params': [dict per constant],
-'residuals': [dict per point], 'tyre': the tyre file as a dict, which simulate(tyre=...) takes}. Same keys, values
-and errors as the command line.)");
+it to (every command takes it). Returns {'fit': dict, 'params': [dict per constant], 'residuals': [dict per
+point], 'tyre': the tyre file as a dict, which tyre(...) and simulate(tyre=...) take}. Same keys, values and errors
+as the command line.)");
 
   m.def("engine_map", &api_engine_map, "engine"_a, "speed_rpm"_a, "torque_nm"_a,
         R"(The library's fuel map (EngineMap) of an engine_map vehicle's `powertrain.engine` block.

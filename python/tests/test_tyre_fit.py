@@ -27,6 +27,8 @@ class TyreFit(unittest.TestCase):
                 self.assertAlmostEqual(got / rrc, 1.0, places=8)  # the file keeps 9 significant digits
             # The returned dict is that file: a car on it uses the same energy as a car on the file.
             on_file = rollsim.simulate("ev", tyre=path, cycle="nedc", replay=True, trace=False)["summary"]
+            at_file = rollsim.tyre(path, load_n=4500, speed_kmh=[40, 80, 120])["rrc"]
+        self.assertEqual(list(rollsim.tyre(r["tyre"], load_n=4500, speed_kmh=[40, 80, 120])["rrc"]), list(at_file))
         on_dict = rollsim.simulate("ev", tyre=r["tyre"], cycle="nedc", replay=True, trace=False)["summary"]
         self.assertEqual(on_dict["aec_kwh_per_10km"], on_file["aec_kwh_per_10km"])
         self.assertEqual(len(r["residuals"]), 3)

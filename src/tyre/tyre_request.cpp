@@ -8,13 +8,14 @@ namespace rollsim {
 TyreSpec build_requested_tyre(const TyreRequest& o) {
   TyreSpec spec;
   const bool has_geometry = !o.outer_radius_m.empty() || !o.width_m.empty();
-  if (!o.file.empty()) {
+  if (!o.file.empty() || !o.file_text.empty()) {
     if (!o.size.empty()) throw InputError("--size '" + o.size + "'", "not allowed together with a tyre file");
     if (has_geometry) {
       throw InputError(o.outer_radius_m.empty() ? "--width-m" : "--outer-radius-m",
                        "not allowed together with a tyre file (the file gives the geometry)");
     }
-    spec = load_tyre_file(resolve_data_file(o.file, "tyres", ".yaml", "tyre file"));
+    spec = o.file_text.empty() ? load_tyre_file(resolve_data_file(o.file, "tyres", ".yaml", "tyre file"))
+                               : load_tyre_text(o.file_text, "tyre dict");
   } else if (!o.size.empty()) {
     if (has_geometry) {
       throw InputError(o.outer_radius_m.empty() ? "--width-m" : "--outer-radius-m",
@@ -42,7 +43,7 @@ TyreSpec build_requested_tyre(const TyreRequest& o) {
   }
   if (!o.pressure_bar.empty()) {
     spec.state.pressure_pa = units::bar_to_pa(parse_option_number(o.pressure_bar, "--pressure-bar", Range::open_low(0.0, 20.0)));
-  } else if (o.file.empty()) {
+  } else if (o.file.empty() && o.file_text.empty()) {
     throw InputError("--pressure-bar", "missing: the inflation pressure in bar is needed (e.g. --pressure-bar 2.1)");
   }
   return spec;

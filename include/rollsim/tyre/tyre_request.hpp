@@ -15,6 +15,7 @@ namespace rollsim {
 /// both front ends name a bad value alike (by its option, e.g. "--pressure-bar"). Empty means not given.
 struct TyreRequest {
   std::string file;  ///< tyre file or shipped name
+  std::string file_text;  ///< or a tyre file's YAML (or JSON) text, e.g. a Python dict of its keys
   std::string size;  ///< designation, e.g. "175/70 R14 84T"
   std::string outer_radius_m, width_m, pressure_bar, load_n, load_pct;
 };
