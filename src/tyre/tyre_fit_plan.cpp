@@ -23,8 +23,8 @@ TyreFitPlan plan_tyre_fit(const TyreFitInputs& in) {
   if (in.j2452) {
     J2452Set set = *in.j2452;
     set.rolling_radius_m = in.size.outer_radius_m;
-    const double drum = in.drum_radius_m ? checked_number(*in.drum_radius_m, in.drum_where, {kDrumRadiusMin_m, kDrumRadiusMax_m, true, true})
-                                         : kJ2452DrumRadius_m;
+    const Range drum_range{kDrumRadiusMin_m, kDrumRadiusMax_m, true, true};
+    const double drum = in.drum_radius_m ? checked_number(*in.drum_radius_m, in.drum_where, drum_range) : kJ2452DrumRadius_m;
     for (auto& p : sample_j2452(set, j2452_grid(), drum, in.j2452_where + " grid")) plan.request.points.push_back(p);
   }
   if (plan.band && plan.request.points.empty()) {
