@@ -571,6 +571,26 @@ TEST(CliTyreFit, EvaluationTablePrintsEveryTyreAndTheSharedConstants) {
   for (const auto& plan : evaluation().plans) EXPECT_TRUE(has(r.out, plan.name)) << plan.name;
 }
 
+TEST(CliTyreFit, EvaluationAsJsonLinesHoldsEveryTableRow) {
+  const CmdResult r = fit("--evaluate-j2452 '" + kJ2452Csv + "' --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto& ev = evaluation();
+  const auto ls = lines(r.out);
+  // A line per tyre, per plan, the bound, the all-sets constants and each tyre's leave-one-out constants.
+  ASSERT_EQ(ls.size(), ev.tyres.size() + ev.plans.size() + 1 + 1 + ev.tyres.size()) << r.out;
+  for (std::size_t i = 0; i < ev.tyres.size(); ++i) {
+    EXPECT_TRUE(has(ls[i], "\"name\": \"" + ev.tyres[i].name + "\"")) << ls[i];
+    EXPECT_NEAR(json_number(ls[i], "one_point_rms_pct"), 100.0 * ev.tyres[i].one_point_rms, 1e-9);
+  }
+  const std::string& plan = ls[ev.tyres.size() + 7];  // the eighth plan: +15 km/h, +300 kPa
+  EXPECT_TRUE(has(plan, "\"measured_besides\": \"+15 km/h, +300 kPa\"")) << plan;
+  EXPECT_LE(json_number(plan, "worst_rms_pct"), 5.0);
+  EXPECT_TRUE(has(ls[ev.tyres.size() + ev.plans.size()], "common_shape"));
+  const CmdResult held = fit("--evaluate-j2452 '" + kJ2452Csv + "' --held-out-j2452 '" + kHeldOutCsv + "' --json");
+  ASSERT_EQ(held.exit_code, 0) << held.err;
+  EXPECT_EQ(lines(held.out).size(), 8u + ev.plans.size() + 1 + 1);  // one set of shared constants: the nine's
+}
+
 TEST(CliTyreFit, HeldOutEvaluationJudgesTheOtherFileAndNeedsTheFirst) {
   const CmdResult r = fit("--evaluate-j2452 '" + kJ2452Csv + "' --held-out-j2452 '" + kHeldOutCsv + "'");
   ASSERT_EQ(r.exit_code, 0) << r.err;

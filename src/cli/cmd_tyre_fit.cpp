@@ -203,7 +203,7 @@ void print_shared_constants(const J2452Evaluation& ev, std::size_t sets, const s
   std::cout << s.render();
 }
 
-void run_evaluate(const std::string& path, const std::string& held_out_path, const std::string& drum_text) {
+void run_evaluate(const std::string& path, const std::string& held_out_path, const std::string& drum_text, bool json) {
   const double drum = drum_text.empty() ? kJ2452DrumRadius_m
                                         : checked_number(number_in(drum_text, "--drum-radius-m", "drum radius"),
                                                          "--drum-radius-m", {kDrumRadiusMin_m, kDrumRadiusMax_m, true, true});
@@ -212,6 +212,7 @@ void run_evaluate(const std::string& path, const std::string& held_out_path, con
   const bool held_out = !held_out_path.empty();
   const J2452Evaluation ev = held_out ? evaluate_j2452_held_out(sets, load_j2452_csv(held_out_path), drum)
                                       : evaluate_j2452(sets, drum);
+  if (json) return write_j2452_evaluation_json(std::cout, ev);
   std::cout << "RMS relative RRC error over 180-300 kPa x 3-6 kN x 15-115 km/h (150 points), %; one point = 210 kPa, "
                "4000 N, 80 km/h; "
             << (held_out ? "shared constants and median J2452 shape fitted once on the " + std::to_string(sets.size()) +
@@ -226,7 +227,7 @@ void run_fit(const FitOptions& o) {
   if (!o.held_out_j2452.empty() && o.evaluate_j2452.empty()) {
     throw InputError("--held-out-j2452", "needs --evaluate-j2452 FILE: the sets the shared constants are fitted on");
   }
-  if (!o.evaluate_j2452.empty()) return run_evaluate(o.evaluate_j2452, o.held_out_j2452, o.drum_radius_m);
+  if (!o.evaluate_j2452.empty()) return run_evaluate(o.evaluate_j2452, o.held_out_j2452, o.drum_radius_m, o.json);
   if (o.size.empty()) throw InputError("--size", "missing: the tyre's size designation, e.g. \"205/55 R16 91V\"");
   if (o.output.empty()) throw InputError("--output", "missing: the tyre file to write, e.g. --output my-tyre.yaml");
   TyreFitInputs in;
@@ -303,7 +304,9 @@ void register_tyre_fit_command(CLI::App& tyre) {
   sub->add_option("--evaluate-j2452", o->evaluate_j2452,
                   "Instead of fitting: judge the model on a CSV of J2452 sets, leave-one-tyre-out, with baselines")
       ->type_name("FILE");
-  sub->add_flag("--json", o->json, "The fit as JSON lines (fit, each constant, each point's residual) instead of tables");
+  sub->add_flag("--json", o->json,
+                "JSON lines instead of tables: the fit, each constant, each point's residual (with --evaluate-j2452: "
+                "each tyre, each measurement plan, the common-shape bound, the shared constants)");
   sub->add_option("--held-out-j2452", o->held_out_j2452,
                   "With --evaluate-j2452: fit the shared constants once on its sets and judge them on these instead")
       ->type_name("FILE");

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <functional>
 
+#include "rollsim/common/json.hpp"
 #include "rollsim/common/statistics.hpp"
 #include "rollsim/common/units.hpp"
 #include "rollsim/tyre/hysteresis_model.hpp"
@@ -295,6 +296,7 @@ J2452Evaluation evaluate_j2452(const std::vector<J2452Set>& sets, double drum_ra
 J2452Evaluation evaluate_j2452_held_out(const std::vector<J2452Set>& training, const std::vector<J2452Set>& test,
                                         double drum_radius_m) {
   J2452Evaluation out;
+  out.leave_one_out = false;
   out.shared_all = fit_shared_constants(training, drum_radius_m);
   out.common_shape = common_shape_bound(test, drum_radius_m);
   out.plans = j2452_measurement_plans();
@@ -302,6 +304,71 @@ J2452Evaluation evaluate_j2452_held_out(const std::vector<J2452Set>& training, c
     out.tyres.push_back(evaluate_tyre(set, out.shared_all, training, out.shared_all, out.plans, drum_radius_m));
   }
   return out;
+}
+
+namespace {
+
+JsonObject scaling_json(const SurfaceScaling& s) {
+  return JsonObject()
+      .add("pressure_exponent", s.pressure_exponent)
+      .add("load_exponent", s.load_exponent)
+      .add("speed_rise_pct", 100.0 * s.speed_rise);
+}
+
+JsonObject shared_json(const std::string& without, const HysteresisConstants& c) {
+  JsonObject j;
+  j.add("kind", "shared").add("fitted_without", without);
+  for (const auto p : kShared) j.add(hysteresis_param_key(p), hysteresis_param_value(c, p));
+  return j;
+}
+
+}  // namespace
+
+void write_j2452_evaluation_json(std::ostream& out, const J2452Evaluation& ev) {
+  for (const auto& e : ev.tyres) {
+    out << JsonObject()
+               .add("kind", "tyre")
+               .add("name", e.name)
+               .add("flagged", e.flagged)
+               .add("rrc_kg_per_t", 1e3 * e.reference_rrc)
+               .add("one_point_rms_pct", 100.0 * e.one_point_rms)
+               .add("one_point_max_pct", 100.0 * e.one_point_max)
+               .add("full_fit_rms_pct", 100.0 * e.full_fit_rms)
+               .add("thesis_rms_pct", 100.0 * e.thesis_rms)
+               .add("constant_rms_pct", 100.0 * e.constant_rms)
+               .add("median_shape_rms_pct", 100.0 * e.median_shape_rms)
+               .add("measured", scaling_json(e.measured))
+               .add("one_point", scaling_json(e.one_point))
+               .add("full_fit", scaling_json(e.full_fit))
+               .add("thesis", scaling_json(e.thesis))
+               .str()
+        << '\n';
+  }
+  for (std::size_t k = 0; k < ev.plans.size(); ++k) {
+    std::string fitted;
+    for (const auto p : ev.plans[k].fitted) fitted += (fitted.empty() ? "" : ", ") + std::string(hysteresis_param_key(p));
+    JsonObject per_tyre;
+    std::vector<double> rms;
+    for (const auto& e : ev.tyres) {
+      per_tyre.add(e.name, 100.0 * e.plan_rms.at(k));
+      rms.push_back(e.plan_rms.at(k));
+    }
+    out << JsonObject()
+               .add("kind", "plan")
+               .add("measured_besides", ev.plans[k].name)
+               .add("fitted", fitted)
+               .add("median_rms_pct", 100.0 * median(rms))
+               .add("worst_rms_pct", 100.0 * *std::max_element(rms.begin(), rms.end()))
+               .add("rms_pct", per_tyre)
+               .str()
+        << '\n';
+  }
+  out << JsonObject().add("kind", "common_shape").add("worst_log_rms_pct", 100.0 * ev.common_shape.worst_log_rms).str()
+      << '\n';
+  out << shared_json("", ev.shared_all).str() << '\n';
+  if (ev.leave_one_out) {
+    for (const auto& e : ev.tyres) out << shared_json(e.name, e.shared).str() << '\n';
+  }
 }
 
 }  // namespace rollsim

@@ -1,6 +1,7 @@
 // Judging tyre models on measured J2452 surfaces: one-point and full fits, baselines, leave-one-tyre-out.
 #pragma once
 
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -66,6 +67,7 @@ struct CommonShapeBound {
 struct J2452Evaluation {
   std::vector<TyreEvaluation> tyres;
   HysteresisConstants shared_all;  ///< shared constants fitted on every set (the shipped defaults)
+  bool leave_one_out = true;       ///< false: every tyre judged with shared_all, fitted on other tyres
   std::vector<MeasurementPlan> plans;
   CommonShapeBound common_shape;
 };
@@ -93,5 +95,11 @@ J2452Evaluation evaluate_j2452(const std::vector<J2452Set>& sets, double drum_ra
 /// tyres'.
 J2452Evaluation evaluate_j2452_held_out(const std::vector<J2452Set>& training, const std::vector<J2452Set>& test,
                                         double drum_radius_m);
+
+/// The evaluation as JSON lines, the command's tables in files' units (percent): one "tyre" object per tyre (its
+/// errors and the exponents measured and modelled), one "plan" per measurement plan (median, worst and each tyre's
+/// RMS by name), the "common_shape" bound, and one "shared" object per set of shared constants (`fitted_without`
+/// a tyre's name, or "" for the fit on every training set).
+void write_j2452_evaluation_json(std::ostream& out, const J2452Evaluation& ev);
 
 }  // namespace rollsim
