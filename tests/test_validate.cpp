@@ -591,6 +591,19 @@ TEST(CliValidate, JsonRowsAndANamedErrorForAFileWithoutTheColumns) {
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.err.find("not_epa.csv"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("Test Number"), std::string::npos) << r.err;
+  // The list's header alone: a named error, not an empty summary.
+  const auto header_only = dir / "header_only.csv";
+  {
+    std::ifstream in(kList);
+    std::string line;
+    std::getline(in, line);
+    std::ofstream(header_only) << line << "\n";
+  }
+  const auto e = test::run_rollsim("validate --epa-test-car-list " + header_only.string());
+  EXPECT_NE(e.exit_code, 0);
+  EXPECT_NE(e.err.find("header_only.csv"), std::string::npos) << e.err;
+  EXPECT_NE(e.err.find("no test rows"), std::string::npos) << e.err;
+  EXPECT_TRUE(e.out.empty()) << e.out;
   // The list's first 40 rows: one JSON object per row, simulated or skipped.
   const auto part = dir / "first_rows.csv";
   {

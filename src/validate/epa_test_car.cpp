@@ -118,6 +118,7 @@ std::vector<EpaTestRow> read_epa_test_car_list(const std::string& path) {
                     c_a = col("Target Coef A (lbf)"), c_b = col("Target Coef B (lbf/mph)"),
                     c_c = col("Target Coef C (lbf/mph**2)"), c_fe = col("RND_ADJ_FE");
   const std::size_t c_bag[3] = {col("FE Bag 1"), col("FE Bag 2"), col("FE Bag 3")};
+  if (t.rows.empty()) throw InputError(path, "no test rows: the file has the list's columns but no data line");
   std::vector<EpaTestRow> rows;
   rows.reserve(t.rows.size());
   for (std::size_t i = 0; i < t.rows.size(); ++i) {

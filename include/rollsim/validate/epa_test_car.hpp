@@ -53,8 +53,9 @@ struct EpaTestRow {
   std::optional<double> bag_mpg[3];       ///< FE Bag 1..3 (FTP rows)
 };
 
-/// Reads the list (CSV with the EPA's column names). Throws InputError naming the file for a missing file or a
-/// missing column; a bad cell does not throw, it leaves the field empty so the row is skipped by name.
+/// Reads the list (CSV with the EPA's column names). Throws InputError naming the file for a missing file, a
+/// missing column or no data line; a bad cell does not throw, it leaves the field empty so the row is skipped by
+/// name.
 std::vector<EpaTestRow> read_epa_test_car_list(const std::string& path);
 
 }  // namespace rollsim::validate
