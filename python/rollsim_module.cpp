@@ -268,7 +268,7 @@ RrcPoint fit_point(py::handle p, const TyreSize& size, const std::string& where)
   try {
     if (py::isinstance<py::sequence>(p) && !py::isinstance<py::str>(p)) {
       const auto v = p.cast<std::vector<double>>();
-      if (v.size() == 4) return {v[0] * 1e3, v[1], units::kmh_to_mps(v[2]), v[3], where};
+      if (v.size() == 4) return rrc_point_from_file_units(v[0], v[1], v[2], v[3], where);
     } else if (!py::isinstance<py::str>(p)) {
       return iso28580_point(size, p.cast<double>(), where);
     }

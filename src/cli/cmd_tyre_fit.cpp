@@ -57,8 +57,8 @@ RrcPoint parse_point(const std::string& text, const TyreSize& size) {
   if (f.size() != 4) {
     throw InputError(where, "expected KPA,LOAD_N,KMH,RRC (e.g. 210,4000,80,0.0085) or RRC alone (ISO 28580 conditions)");
   }
-  return {number_in(f[0], where, "pressure [kPa]") * 1e3, number_in(f[1], where, "load [N]"),
-          units::kmh_to_mps(number_in(f[2], where, "speed [km/h]")), number_in(f[3], where, "RRC"), where};
+  return rrc_point_from_file_units(number_in(f[0], where, "pressure [kPa]"), number_in(f[1], where, "load [N]"),
+                                   number_in(f[2], where, "speed [km/h]"), number_in(f[3], where, "RRC"), where);
 }
 
 std::vector<HysteresisParam> parse_free(const std::string& text) {
@@ -170,11 +170,9 @@ void print_plans_table(const J2452Evaluation& ev) {
   m.set_left_aligned(0);
   m.set_left_aligned(1);
   for (std::size_t k = 0; k < ev.plans.size(); ++k) {
-    std::string fitted;
-    for (const auto p : ev.plans[k].fitted) fitted += (fitted.empty() ? "" : ", ") + std::string(hysteresis_param_key(p));
-    std::vector<double> rms;
-    for (const auto& e : ev.tyres) rms.push_back(e.plan_rms[k]);
-    std::vector<std::string> cells{ev.plans[k].name, fitted, pct(median(rms)), pct(worst_of(rms))};
+    const std::vector<double> rms = plan_rms_column(ev, k);
+    std::vector<std::string> cells{ev.plans[k].name, hysteresis_param_keys(ev.plans[k].fitted), pct(median(rms)),
+                                   pct(worst_of(rms))};
     for (const double x : rms) cells.push_back(pct(x));
     m.add_row(cells);
   }
@@ -205,8 +203,8 @@ void print_shared_constants(const J2452Evaluation& ev, std::size_t sets, const s
 
 void run_evaluate(const std::string& path, const std::string& held_out_path, const std::string& drum_text, bool json) {
   const double drum = drum_text.empty() ? kJ2452DrumRadius_m
-                                        : checked_number(number_in(drum_text, "--drum-radius-m", "drum radius"),
-                                                         "--drum-radius-m", {kDrumRadiusMin_m, kDrumRadiusMax_m, true, true});
+                                        : checked_drum_radius_m(number_in(drum_text, "--drum-radius-m", "drum radius"),
+                                                                "--drum-radius-m");
   const auto sets = load_j2452_csv(path);
   if (sets.size() < 3) throw InputError(path, "too few sets for leave-one-tyre-out: need 3 or more");
   const bool held_out = !held_out_path.empty();

@@ -7,6 +7,7 @@
 #include "rollsim/common/csv.hpp"
 #include "rollsim/common/error.hpp"
 #include "rollsim/common/units.hpp"
+#include "rollsim/common/yaml_reader.hpp"
 
 namespace rollsim {
 
@@ -38,6 +39,10 @@ std::optional<FieldError> coefficient_error(const J2452Set& s) {
 }
 
 }  // namespace
+
+double checked_drum_radius_m(double radius_m, const std::string& where) {
+  return checked_number(radius_m, where, {0.1, 10.0, true, true});
+}
 
 J2452Set parse_j2452_text(const std::string& text, const std::string& where) {
   static const char* kNames[] = {"ALPHA", "BETA", "A", "B", "C"};

@@ -324,6 +324,12 @@ JsonObject shared_json(const std::string& without, const HysteresisConstants& c)
 
 }  // namespace
 
+std::vector<double> plan_rms_column(const J2452Evaluation& ev, std::size_t k) {
+  std::vector<double> rms;
+  for (const auto& e : ev.tyres) rms.push_back(e.plan_rms.at(k));
+  return rms;
+}
+
 void write_j2452_evaluation_json(std::ostream& out, const J2452Evaluation& ev) {
   for (const auto& e : ev.tyres) {
     out << JsonObject()
@@ -345,18 +351,13 @@ void write_j2452_evaluation_json(std::ostream& out, const J2452Evaluation& ev) {
         << '\n';
   }
   for (std::size_t k = 0; k < ev.plans.size(); ++k) {
-    std::string fitted;
-    for (const auto p : ev.plans[k].fitted) fitted += (fitted.empty() ? "" : ", ") + std::string(hysteresis_param_key(p));
+    const std::vector<double> rms = plan_rms_column(ev, k);
     JsonObject per_tyre;
-    std::vector<double> rms;
-    for (const auto& e : ev.tyres) {
-      per_tyre.add(e.name, 100.0 * e.plan_rms.at(k));
-      rms.push_back(e.plan_rms.at(k));
-    }
+    for (std::size_t i = 0; i < ev.tyres.size(); ++i) per_tyre.add(ev.tyres[i].name, 100.0 * rms[i]);
     out << JsonObject()
                .add("kind", "plan")
                .add("measured_besides", ev.plans[k].name)
-               .add("fitted", fitted)
+               .add("fitted", hysteresis_param_keys(ev.plans[k].fitted))
                .add("median_rms_pct", 100.0 * median(rms))
                .add("worst_rms_pct", 100.0 * *std::max_element(rms.begin(), rms.end()))
                .add("rms_pct", per_tyre)

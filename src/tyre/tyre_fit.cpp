@@ -4,8 +4,10 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <iterator>
 #include <set>
 #include <string>
+#include <utility>
 
 #include "rollsim/common/csv.hpp"
 #include "rollsim/common/error.hpp"
@@ -69,12 +71,6 @@ std::string missing_for(HysteresisParam p, const Spread& s) {
   return "";
 }
 
-std::string list_keys(const std::vector<HysteresisParam>& ps) {
-  std::string s;
-  for (auto p : ps) s += (s.empty() ? "" : ", ") + std::string(hysteresis_param_key(p));
-  return s;
-}
-
 void check_request(const FitRequest& r, const std::vector<HysteresisParam>& free) {
   if (r.points.empty()) {
     throw InputError("--point", "too few points for what is asked: no measured point given (give --point, "
@@ -95,7 +91,7 @@ void check_request(const FitRequest& r, const std::vector<HysteresisParam>& free
   if (free.size() > r.points.size()) {
     throw InputError("--free", "too few points for what is asked: " + std::to_string(r.points.size()) +
                                    " point(s) cannot determine " + std::to_string(free.size()) + " parameters (" +
-                                   list_keys(free) + ")");
+                                   hysteresis_param_keys(free) + ")");
   }
   if (!(r.assumed_relative_uncertainty > 0.0)) {
     throw InputError("--rrc-uncertainty-pct", "must be > 0");
@@ -158,6 +154,14 @@ TyreFit fit_once(const TyreState& start, const FitRequest& r, const std::vector<
 }
 
 }  // namespace
+
+std::string hysteresis_param_keys(const std::vector<HysteresisParam>& ps) {
+  std::string s;
+  for (auto p : ps) s += (s.empty() ? "" : ", ") + std::string(hysteresis_param_key(p));
+  return s;
+}
+
+std::vector<HysteresisParam> all_hysteresis_params() { return {std::begin(kAllParams), std::end(kAllParams)}; }
 
 const char* hysteresis_param_key(HysteresisParam p) {
   switch (p) {
@@ -291,6 +295,10 @@ LabelBand eu_label_band_c1(const std::string& label_class, const std::string& wh
                           "(Regulation (EU) 2020/740; its classes F and G of Regulation (EC) 1222/2009 no longer exist)");
 }
 
+RrcPoint rrc_point_from_file_units(double pressure_kpa, double load_n, double speed_kmh, double rrc, std::string where) {
+  return {pressure_kpa * 1e3, load_n, units::kmh_to_mps(speed_kmh), rrc, std::move(where)};
+}
+
 std::vector<RrcPoint> load_measured_rrc_csv(const std::string& path) {
   const CsvTable t = read_csv(path);
   const char* kCols[] = {"pressure_kpa", "load_n", "speed_kmh", "rrc"};
@@ -311,7 +319,7 @@ std::vector<RrcPoint> load_measured_rrc_csv(const std::string& path) {
       if (!x || !std::isfinite(*x)) throw InputError(t.where(i, col[k]), kCols[k] + std::string(" '") + t.rows[i][col[k]] + "' is not a number");
       v[k] = *x;
     }
-    out.push_back({v[0] * 1e3, v[1], units::kmh_to_mps(v[2]), v[3], path + ": line " + std::to_string(t.row_line[i])});
+    out.push_back(rrc_point_from_file_units(v[0], v[1], v[2], v[3], path + ": line " + std::to_string(t.row_line[i])));
   }
   if (out.empty()) throw InputError(path, "too few points for what is asked: the file has no data rows");
   return out;

@@ -23,8 +23,7 @@ TyreFitPlan plan_tyre_fit(const TyreFitInputs& in) {
   if (in.j2452) {
     J2452Set set = *in.j2452;
     set.rolling_radius_m = in.size.outer_radius_m;
-    const Range drum_range{kDrumRadiusMin_m, kDrumRadiusMax_m, true, true};
-    const double drum = in.drum_radius_m ? checked_number(*in.drum_radius_m, in.drum_where, drum_range) : kJ2452DrumRadius_m;
+    const double drum = in.drum_radius_m ? checked_drum_radius_m(*in.drum_radius_m, in.drum_where) : kJ2452DrumRadius_m;
     for (auto& p : sample_j2452(set, j2452_grid(), drum, in.j2452_where + " grid")) plan.request.points.push_back(p);
   }
   if (plan.band && plan.request.points.empty()) {
@@ -45,11 +44,8 @@ std::vector<HysteresisParam> free_params_from_keys(const std::vector<std::string
   for (const auto& key : keys) {
     const auto p = hysteresis_param_from_key(key);
     if (!p) {
-      std::string allowed;
-      for (int k = 0; k < kHysteresisParamCount; ++k) {
-        allowed += (k ? ", " : "") + std::string(hysteresis_param_key(static_cast<HysteresisParam>(k)));
-      }
-      throw InputError(where, "'" + key + "' is not a constant of the hysteresis model; allowed: " + allowed);
+      throw InputError(where, "'" + key + "' is not a constant of the hysteresis model; allowed: " +
+                                  hysteresis_param_keys(all_hysteresis_params()));
     }
     out.push_back(*p);
   }

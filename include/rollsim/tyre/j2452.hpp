@@ -19,8 +19,8 @@ struct J2452Set {
 
 /// The drum radius of the shipped Michelin sets (data/tyres/SOURCES.md) [m].
 inline constexpr double kJ2452DrumRadius_m = 0.85;
-/// Drum radii a user may give [m], open at both ends.
-inline constexpr double kDrumRadiusMin_m = 0.1, kDrumRadiusMax_m = 10.0;
+/// A drum radius a user gave [m], if in (0.1, 10) m; otherwise InputError(where, ...) naming it and the range.
+double checked_drum_radius_m(double radius_m, const std::string& where);
 
 /// Flat-road over drum force, sqrt(r_drum / (r_drum + r_tyre)) (SAE J2452 Eq. 22 as quoted by the ADVISOR
 /// files, data/tyres/SOURCES.md; ISO 28580 uses the same relation). A curved drum deflects the tyre more than

@@ -96,6 +96,9 @@ J2452Evaluation evaluate_j2452(const std::vector<J2452Set>& sets, double drum_ra
 J2452Evaluation evaluate_j2452_held_out(const std::vector<J2452Set>& training, const std::vector<J2452Set>& test,
                                         double drum_radius_m);
 
+/// Each tyre's RMS error under plan `k` (ev.plans[k]), in the tyres' order.
+std::vector<double> plan_rms_column(const J2452Evaluation& ev, std::size_t k);
+
 /// The evaluation as JSON lines, the command's tables in files' units (percent): one "tyre" object per tyre (its
 /// errors and the exponents measured and modelled), one "plan" per measurement plan (median, worst and each tyre's
 /// RMS by name), the "common_shape" bound, and one "shared" object per set of shared constants (`fitted_without`

@@ -26,6 +26,10 @@ inline constexpr int kHysteresisParamCount = 6;
 
 /// The tyre-file key of a parameter (model.<key>), also its name in --free.
 const char* hysteresis_param_key(HysteresisParam p);
+/// The keys of `ps`, comma-separated, for messages and tables ("rrc_ref, frequency_slope_per_hz").
+std::string hysteresis_param_keys(const std::vector<HysteresisParam>& ps);
+/// Every constant a fit can free, in the enum's order.
+std::vector<HysteresisParam> all_hysteresis_params();
 std::optional<HysteresisParam> hysteresis_param_from_key(const std::string& key);
 double hysteresis_param_value(const HysteresisConstants& c, HysteresisParam p);
 void set_hysteresis_param(HysteresisConstants& c, HysteresisParam p, double value);
@@ -94,6 +98,9 @@ LabelBand eu_label_band_c1(const std::string& label_class, const std::string& wh
 /// The ISO 28580 test point of a C1 tyre: 80 km/h, 80 % of the load index's load, 210 kPa (standard load)
 /// or 250 kPa (extra load). Throws InputError(where, ...) without a load index.
 RrcPoint iso28580_point(const TyreSize& size, double rrc, const std::string& where);
+
+/// A point given in files' units (kPa, N, km/h, RRC) as the fit takes it (SI), named `where`.
+RrcPoint rrc_point_from_file_units(double pressure_kpa, double load_n, double speed_kmh, double rrc, std::string where);
 
 /// Measured points from a CSV with columns pressure_kpa, load_n, speed_kmh, rrc (`rollsim tyre fit --measured`),
 /// each named by its file and line for the fit's errors. Throws InputError naming the file, line and column of a
