@@ -29,6 +29,7 @@ JsonObject row_json(const validate::RowOutcome& o) {
   j.add("test_number", r.test_number).add("make", r.make).add("model", r.model).add("fuel", o.powertrain);
   j.add("cycle", validate::to_string(r.cycle)).add("procedure", r.procedure).add("line", static_cast<int>(r.line));
   j.add("half", o.fitting_half ? "fitting" : "held-out");
+  if (r.derived) j.add("analytically_derived", true).add("adfe_base_test", r.derived->base_test);
   if (o.skip != validate::SkipReason::none) {
     j.add("skipped", validate::to_string(o.skip) + (o.skip_detail.empty() ? "" : ": " + o.skip_detail));
     return j;
@@ -57,6 +58,15 @@ void print_summary(const validate::Validation& v) {
               << fixed(c.eligible ? 100.0 * static_cast<double>(c.simulated) / static_cast<double>(c.eligible) : 0.0, 1)
               << " %)\n";
   }
+  std::size_t derived = 0, derived_simulated = 0;
+  for (const auto& o : v.rows) {
+    if (!o.row->derived) continue;
+    ++derived;
+    if (o.skip == validate::SkipReason::none) ++derived_simulated;
+  }
+  std::cout << "analytically derived results (ADFE): " << derived << " rows, " << derived_simulated
+            << " simulated as the configuration the result is for (the ADFE columns' weight, N/V and road-load power), "
+               "not the tested vehicle the row describes\n";
   report::TextTable t({"powertrain", "cycle", "half", "count", "median err %", "median |err| %", "p90 |err| %"});
   t.set_left_aligned(0);
   t.set_left_aligned(1);

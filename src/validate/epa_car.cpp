@@ -241,20 +241,9 @@ std::shared_ptr<const Powertrain> electric_of(const EpaTestRow& row) {
   return std::make_shared<ElectricPowertrain>(p);
 }
 
-}  // namespace
-
-FuelParams test_fuel(EpaFuel fuel) {
-  // Certification fuels (40 CFR 1065.710 ranges): Tier 2 gasoline (indolene, no ethanol) specific gravity
-  // ~0.743, net heating value ~18,450 BTU/lb = 42.9 MJ/kg; ultra-low-sulphur certification diesel ~0.852 and
-  // 42.8 MJ/kg; E85 ~0.781 and ~29.5 MJ/kg. CO2 from carbon mass fractions 0.866, 0.870, 0.584 (x 44/12).
-  switch (fuel) {
-    case EpaFuel::diesel: return {852.0, 42.8e6, 0.870 * 44.0 / 12.0};
-    case EpaFuel::e85: return {781.0, 29.5e6, 0.584 * 44.0 / 12.0};
-    default: return {743.0, 42.9e6, 0.866 * 44.0 / 12.0};
-  }
-}
-
-SkipReason check_car_fields(const EpaTestRow& r, std::string& detail) {
+// The fields of the car a result belongs to, in their physical ranges (50 mph too: a derived configuration's
+// road load is scaled to its power there).
+SkipReason check_configuration(const EpaTestRow& r, std::string& detail) {
   if (!r.test_mass_kg) return missing(detail, "Equivalent Test Weight (lbs.)");
   if (*r.test_mass_kg < 450.0 || *r.test_mass_kg > 9000.0) return absurd(detail, "test mass [kg]", *r.test_mass_kg, "450-9000 kg");
   if (!r.road_a_n) return missing(detail, "Target Coef A (lbf)");
@@ -262,7 +251,7 @@ SkipReason check_car_fields(const EpaTestRow& r, std::string& detail) {
   if (!r.road_c_n_s2_per_m2) return missing(detail, "Target Coef C (lbf/mph**2)");
   if (*r.road_c_n_s2_per_m2 <= 0.0 || *r.road_c_n_s2_per_m2 > 4.0)
     return absurd(detail, "target C [N s^2/m^2]", *r.road_c_n_s2_per_m2, "0-4");
-  for (double v_mps : {2.0, 10.0, 20.0, 30.0, 40.0}) {
+  for (double v_mps : {2.0, 10.0, 20.0, 50.0 * units::kMpsPerMph, 30.0, 40.0}) {
     const double f_n = *r.road_a_n + v_mps * (*r.road_b_n_s_per_m + v_mps * *r.road_c_n_s2_per_m2);
     if (f_n <= 0.0 || f_n > 5000.0) return absurd(detail, "target road load at " + format_value(units::mps_to_kmh(v_mps)) + " km/h [N]", f_n, "0-5000 N");
   }
@@ -285,7 +274,28 @@ SkipReason check_car_fields(const EpaTestRow& r, std::string& detail) {
   return SkipReason::none;
 }
 
-VehicleModel car_from_row(const EpaTestRow& row, const EpaDefaults& d) {
+}  // namespace
+
+FuelParams test_fuel(EpaFuel fuel) {
+  // Certification fuels (40 CFR 1065.710 ranges): Tier 2 gasoline (indolene, no ethanol) specific gravity
+  // ~0.743, net heating value ~18,450 BTU/lb = 42.9 MJ/kg; ultra-low-sulphur certification diesel ~0.852 and
+  // 42.8 MJ/kg; E85 ~0.781 and ~29.5 MJ/kg. CO2 from carbon mass fractions 0.866, 0.870, 0.584 (x 44/12).
+  switch (fuel) {
+    case EpaFuel::diesel: return {852.0, 42.8e6, 0.870 * 44.0 / 12.0};
+    case EpaFuel::e85: return {781.0, 29.5e6, 0.584 * 44.0 / 12.0};
+    default: return {743.0, 42.9e6, 0.866 * 44.0 / 12.0};
+  }
+}
+
+SkipReason check_car_fields(const EpaTestRow& row, std::string& detail) {
+  if (const char* field = missing_derived_field(row)) return missing(detail, field);
+  const SkipReason why = check_configuration(result_configuration(row), detail);
+  if (why != SkipReason::none && row.derived) detail = "the analytically derived configuration (ADFE columns): " + detail;
+  return why;
+}
+
+VehicleModel car_from_row(const EpaTestRow& listed, const EpaDefaults& d) {
+  const EpaTestRow row = result_configuration(listed);
   Vehicle v;
   v.name = row.make + " " + row.model;
   v.body.test_mass_kg = *row.test_mass_kg;
@@ -314,7 +324,7 @@ std::shared_ptr<const Effect> cold_start_effect(const EpaTestRow& row, double co
                      {"heat_per_wheel_work", 0.6},
                      {"heat_loss_w_per_k", 40.0},
                      {"warm_excess_k", 60.0}};
-  return make_effect(EffectId::engine_warmup, p, EffectContext{*row.test_mass_kg, 0.0});
+  return make_effect(EffectId::engine_warmup, p, EffectContext{*result_configuration(row).test_mass_kg, 0.0});
 }
 
 }  // namespace rollsim::validate

@@ -54,7 +54,36 @@ EpaTransmission transmission_of(const std::string& text) {
   return EpaTransmission::other;
 }
 
+constexpr const char* kAdfeWeight = "ADFE Equiv. Test Weight (lbs.)";
+constexpr const char* kAdfeNv = "ADFE N/V Ratio";
+constexpr const char* kAdfePower = "ADFE Total Road Load HP";
+// EPA's road-load horsepower is the target road load's power at 50 mph.
+constexpr double kRoadLoadPowerSpeed_mps = 50.0 * kMpsPerMph;
+
 }  // namespace
+
+const char* missing_derived_field(const EpaTestRow& row) {
+  if (!row.derived) return nullptr;
+  if (!row.derived->test_mass_kg) return kAdfeWeight;
+  if (!row.derived->engine_radps_per_mps) return kAdfeNv;
+  if (!row.derived->road_load_power_w) return kAdfePower;
+  return nullptr;
+}
+
+EpaTestRow result_configuration(const EpaTestRow& row) {
+  if (!row.derived || missing_derived_field(row) || !row.road_a_n || !row.road_b_n_s_per_m || !row.road_c_n_s2_per_m2) return row;
+  const double v = kRoadLoadPowerSpeed_mps;
+  const double tested_power_w = (*row.road_a_n + v * (*row.road_b_n_s_per_m + v * *row.road_c_n_s2_per_m2)) * v;
+  if (!(tested_power_w > 0.0)) return row;
+  EpaTestRow r = row;
+  r.test_mass_kg = row.derived->test_mass_kg;
+  r.engine_radps_per_mps = row.derived->engine_radps_per_mps;
+  const double scale = *row.derived->road_load_power_w / tested_power_w;
+  *r.road_a_n *= scale;
+  *r.road_b_n_s_per_m *= scale;
+  *r.road_c_n_s2_per_m2 *= scale;
+  return r;
+}
 
 std::string to_string(EpaCycle c) {
   switch (c) {
@@ -116,7 +145,9 @@ std::vector<EpaTestRow> read_epa_test_car_list(const std::string& path) {
                     c_etw = col("Equivalent Test Weight (lbs.)"), c_disp = col("Test Veh Displacement (L)"),
                     c_hp = col("Rated Horsepower"), c_gears = col("# of Gears"), c_nv = col("N/V Ratio"),
                     c_a = col("Target Coef A (lbf)"), c_b = col("Target Coef B (lbf/mph)"),
-                    c_c = col("Target Coef C (lbf/mph**2)"), c_fe = col("RND_ADJ_FE");
+                    c_c = col("Target Coef C (lbf/mph**2)"), c_fe = col("RND_ADJ_FE"),
+                    c_adfe = col("Analytically Derived FE?"), c_adfe_test = col("ADFE Test Number"),
+                    c_adfe_power = col(kAdfePower), c_adfe_etw = col(kAdfeWeight), c_adfe_nv = col(kAdfeNv);
   const std::size_t c_bag[3] = {col("FE Bag 1"), col("FE Bag 2"), col("FE Bag 3")};
   if (t.rows.empty()) throw InputError(path, "no test rows: the file has the list's columns but no data line");
   std::vector<EpaTestRow> rows;
@@ -152,6 +183,14 @@ std::vector<EpaTestRow> read_epa_test_car_list(const std::string& path) {
     if (const auto v = number(c_c)) r.road_c_n_s2_per_m2 = *v * kNPerLbf / (kMpsPerMph * kMpsPerMph);
     r.measured = number(c_fe);
     for (int b = 0; b < 3; ++b) r.bag_mpg[b] = number(c_bag[b]);
+    if (lower(trim(cells[c_adfe])) == "yes") {
+      EpaTestRow::DerivedConfiguration d;
+      d.base_test = trim(cells[c_adfe_test]);
+      if (const auto v = number(c_adfe_etw)) d.test_mass_kg = *v * kKgPerLb;
+      if (const auto v = number(c_adfe_nv)) d.engine_radps_per_mps = *v * units::kRadpsPerRpm / kMpsPerMph;
+      if (const auto v = number(c_adfe_power)) d.road_load_power_w = *v * units::kWPerHp;
+      r.derived = std::move(d);
+    }
     rows.push_back(std::move(r));
   }
   return rows;

@@ -23,12 +23,14 @@ struct EpaDefaults {
   double cold_fuel_excess = 0.3;
 };
 
-/// Checks that the row holds what a car needs, within physical ranges. Returns the reason a row cannot be built
-/// (`none` when it can) and fills `detail` with the field and value.
+/// Checks that the row holds what a car needs, within physical ranges, for the configuration its result belongs
+/// to (result_configuration: an analytically derived row's ADFE columns). Returns the reason a row cannot be
+/// built (`none` when it can) and fills `detail` with the field and value.
 SkipReason check_car_fields(const EpaTestRow& row, std::string& detail);
 
-/// The car of a checked row: inertial mass, target road load and the powertrain of its kind (engine with fuel
-/// map and the row's transmission, or electric drive). The fuel-converter or charge constants come from `d`.
+/// The car of a checked row, in the configuration its result belongs to (result_configuration): inertial mass,
+/// target road load and the powertrain of its kind (engine with fuel map and the row's transmission, or electric
+/// drive). The fuel-converter or charge constants come from `d`.
 VehicleModel car_from_row(const EpaTestRow& row, const EpaDefaults& d);
 
 /// The engine warm-up effect's parameters for the row's engine with a given cold fuel excess (FTP bag 1).

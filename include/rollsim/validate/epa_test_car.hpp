@@ -51,7 +51,27 @@ struct EpaTestRow {
   std::optional<double> road_a_n, road_b_n_s_per_m, road_c_n_s2_per_m2;  ///< target coefficients
   std::optional<double> measured;         ///< RND_ADJ_FE as published (mpg or mpge)
   std::optional<double> bag_mpg[3];       ///< FE Bag 1..3 (FTP rows)
+  /// "Analytically Derived FE?" Yes: the result was not measured on the vehicle the row describes. EPA derived it
+  /// from that vehicle's test (`base_test`) for another configuration, and the ADFE columns hold that
+  /// configuration's test weight, N/V ratio and road-load power at 50 mph; the row's own weight, N/V and target
+  /// coefficients stay the tested vehicle's (README, validate: the list's 305 derived rows whose base test it also
+  /// holds). Empty for a measured row.
+  struct DerivedConfiguration {
+    std::string base_test;
+    std::optional<double> test_mass_kg, engine_radps_per_mps, road_load_power_w;
+  };
+  std::optional<DerivedConfiguration> derived;
 };
+
+/// The row as the car its result belongs to: a measured row as it is; an analytically derived one with the ADFE
+/// test mass and N/V ratio, and its target coefficients scaled together so the road load at 50 mph takes the
+/// ADFE road-load power (the list gives the derived configuration that one figure, not a curve). A derived row
+/// needs its three ADFE fields and a tested road load that is positive at 50 mph (check_car_fields checks both);
+/// without them the row is returned as it is.
+EpaTestRow result_configuration(const EpaTestRow& row);
+
+/// The first ADFE column a derived row lacks (empty or not a number), or nullptr when it has all three.
+const char* missing_derived_field(const EpaTestRow& row);
 
 /// Reads the list (CSV with the EPA's column names). Throws InputError naming the file for a missing file, a
 /// missing column or no data line; a bad cell does not throw, it leaves the field empty so the row is skipped by
