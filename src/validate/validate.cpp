@@ -87,13 +87,20 @@ bool name_says_hybrid(const EpaTestRow& r) {
 struct VehicleFacts {
   bool charge_depleting_on_fuel = false;
   double ftp_mpg = 0.0, hwfet_mpg = 0.0;
+  bool electric_result_in_mpge = false;  ///< a charge-depleting result at 60 MPG or more: MPGe, as the unit says
 };
+
+// An electric row's "MPG" of 8-60 is read as kWh per 100 miles (SOURCES.md: no electric car reaches 8-60 MPGe).
+constexpr double kKwhPer100MiBelow = 60.0, kKwhPer100MiFrom = 8.0;
+bool reads_as_kwh_per_100mi(double value) { return value >= kKwhPer100MiFrom && value < kKwhPer100MiBelow; }
 
 std::map<std::string, VehicleFacts> vehicle_facts(const std::vector<EpaTestRow>& rows) {
   std::map<std::string, VehicleFacts> f;
   for (const auto& r : rows) {
     auto& v = f[vehicle_key(r)];
     if (charge_depleting(r.cycle) && liquid(r.fuel)) v.charge_depleting_on_fuel = true;
+    if (charge_depleting(r.cycle) && r.fuel == EpaFuel::electricity && r.measured && *r.measured >= kKwhPer100MiBelow)
+      v.electric_result_in_mpge = true;
     if (!r.measured || *r.measured <= 0.0 || *r.measured > 150.0 || !liquid(r.fuel)) continue;
     if (r.cycle == EpaCycle::ftp75) v.ftp_mpg = *r.measured;
     if (r.cycle == EpaCycle::hwfet) v.hwfet_mpg = *r.measured;
@@ -133,8 +140,13 @@ void classify(const EpaTestRow& r, const std::map<std::string, VehicleFacts>& fa
   }
   if (!r.measured) return skip(SkipReason::no_measured_result);
   o.measured = *r.measured;
-  if (r.fuel == EpaFuel::electricity && o.measured >= 8.0 && o.measured < 60.0) {
-    // See the data's SOURCES.md: some electric rows give 17-35 "MPG"; read as kWh per 100 miles.
+  if (r.fuel == EpaFuel::electricity && reads_as_kwh_per_100mi(o.measured)) {
+    // See the data's SOURCES.md: some electric rows give 17-35 "MPG"; read as kWh per 100 miles, unless the
+    // vehicle's other charge-depleting results are in MPGe (the list's EQS 450+: 138 on the UDDS, 38.1 on the
+    // highway, which would be 88.5 MPGe): then neither reading can be trusted.
+    if (facts.at(vehicle_key(r)).electric_result_in_mpge)
+      return skip(SkipReason::absurd_measured_result,
+                  format_value(o.measured) + " \"MPG\" where this vehicle's other charge-depleting results are in MPGe: the unit is unclear");
     o.measured = 100.0 * kKwhPerGallonEquivalent / o.measured;
     o.measured_from_kwh_per_100mi = true;
   }
