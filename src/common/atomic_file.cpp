@@ -30,7 +30,11 @@ bool writable_dir(const fs::path& dir) {
 // The temporary sits in the target's folder so that the rename cannot cross file systems.
 fs::path temporary_for(const std::string& path) {
   const fs::path target(path);
-  return folder_of(path) / ("." + target.filename().string() + ".tmp" + std::to_string(::getpid()));
+  // Appended, not "." + string&&: GCC 12 warns falsely on the latter once it is inlined (-Wrestrict, GCC bug 105651).
+  std::string name = ".";
+  name += target.filename().string();
+  name += ".tmp" + std::to_string(::getpid());
+  return folder_of(path) / name;
 }
 
 }  // namespace

@@ -24,7 +24,11 @@ std::string resolve_tyre_path(const std::string& name, const std::string& vehicl
 
 std::string portable_vehicle_yaml(const std::string& text, const std::string& vehicle_path, const std::string& tyre_override) {
   namespace fs = std::filesystem;
-  auto quoted = [](const std::string& path) { return "\"" + fs::absolute(path).lexically_normal().string() + "\""; };
+  auto quoted = [](const std::string& path) {
+    std::string q = "\"";  // appended: GCC 12 warns falsely on "\"" + string&& once inlined (GCC bug 105651)
+    q += fs::absolute(path).lexically_normal().string();
+    return q + "\"";
+  };
   // The tyres the file names, resolved as load_vehicle_file resolves them.
   std::vector<std::pair<std::string, std::string>> tyres;  // key, absolute path
   if (!tyre_override.empty()) {
