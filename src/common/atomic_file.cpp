@@ -30,7 +30,7 @@ bool writable_dir(const fs::path& dir) {
 // The temporary sits in the target's folder so that the rename cannot cross file systems.
 fs::path temporary_for(const std::string& path) {
   const fs::path target(path);
-  // Appended, not "." + string&&: GCC 12 warns falsely on the latter once it is inlined (-Wrestrict, GCC bug 105651).
+  // Appended, not "." + string&&: GCC 12 warns falsely (-Wrestrict) on the latter once it is inlined.
   std::string name = ".";
   name += target.filename().string();
   name += ".tmp" + std::to_string(::getpid());

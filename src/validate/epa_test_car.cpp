@@ -57,8 +57,6 @@ EpaTransmission transmission_of(const std::string& text) {
 constexpr const char* kAdfeWeight = "ADFE Equiv. Test Weight (lbs.)";
 constexpr const char* kAdfeNv = "ADFE N/V Ratio";
 constexpr const char* kAdfePower = "ADFE Total Road Load HP";
-// EPA's road-load horsepower is the target road load's power at 50 mph.
-constexpr double kRoadLoadPowerSpeed_mps = 50.0 * kMpsPerMph;
 
 }  // namespace
 

@@ -25,7 +25,7 @@ std::string resolve_tyre_path(const std::string& name, const std::string& vehicl
 std::string portable_vehicle_yaml(const std::string& text, const std::string& vehicle_path, const std::string& tyre_override) {
   namespace fs = std::filesystem;
   auto quoted = [](const std::string& path) {
-    std::string q = "\"";  // appended: GCC 12 warns falsely on "\"" + string&& once inlined (GCC bug 105651)
+    std::string q = "\"";  // appended: GCC 12 warns falsely (-Wrestrict) on "\"" + string&& once inlined
     q += fs::absolute(path).lexically_normal().string();
     return q + "\"";
   };

@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "rollsim/common/units.hpp"
+
 namespace rollsim::validate {
 
 enum class EpaCycle { ftp75, hwfet, us06, cd_udds, cd_highway, cd_us06, sc03, cold, other };
@@ -62,6 +64,9 @@ struct EpaTestRow {
   };
   std::optional<DerivedConfiguration> derived;
 };
+
+/// EPA's road-load horsepower is the target road load's power at this speed, 50 mph.
+inline constexpr double kRoadLoadPowerSpeed_mps = 50.0 * units::kMpsPerMph;
 
 /// The row as the car its result belongs to: a measured row as it is; an analytically derived one with the ADFE
 /// test mass and N/V ratio, and its target coefficients scaled together so the road load at 50 mph takes the
