@@ -59,10 +59,7 @@ const J2452Evaluation& held_out_evaluation() {
 
 std::vector<double> plan_rms(const J2452Evaluation& ev, const std::string& plan) {
   for (std::size_t k = 0; k < ev.plans.size(); ++k) {
-    if (ev.plans[k].name != plan) continue;
-    std::vector<double> rms;
-    for (const auto& e : ev.tyres) rms.push_back(e.plan_rms.at(k));
-    return rms;
+    if (ev.plans[k].name == plan) return plan_rms_column(ev, k);
   }
   ADD_FAILURE() << "no plan " << plan;
   return {};
@@ -223,8 +220,7 @@ TEST(J2452, AThirdPointAtLowSpeedAndAnotherPressureMeetsBothTargets) {
     if (ev.plans[k].name != "+15 km/h, +180 kPa" && ev.plans[k].name != "+15 km/h, +300 kPa") continue;
     ++judged;
     ASSERT_EQ(ev.plans[k].extra.size(), 2u);
-    std::vector<double> rms;
-    for (const auto& e : ev.tyres) rms.push_back(e.plan_rms.at(k));
+    const std::vector<double> rms = plan_rms_column(ev, k);
     EXPECT_LE(median(rms), 0.025) << ev.plans[k].name;
     EXPECT_LE(*std::max_element(rms.begin(), rms.end()), 0.05) << ev.plans[k].name;
   }

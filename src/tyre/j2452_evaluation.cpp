@@ -96,16 +96,22 @@ constexpr HysteresisParam kShared[] = {HysteresisParam::FrequencySlope, Hysteres
                                        HysteresisParam::LoadExponent, HysteresisParam::SpeedLoss,
                                        HysteresisParam::SpeedLossLoadExponent};
 
-// The plan's points on the tyre's surface, its reference point first, fitted from the shared constants.
+// The plan's points, the reference point first, each with the RRC `rrc_at` gives it.
+std::vector<RrcPoint> plan_points(const MeasurementPlan& plan, const std::function<double(const OperatingPoint&)>& rrc_at) {
+  std::vector<RrcPoint> points;
+  const OperatingPoint reference{kRefPressure_pa, kRefLoad_n, kRefSpeed_mps};
+  points.push_back({reference.pressure_pa, reference.load_n, reference.speed_mps, rrc_at(reference), "reference point"});
+  for (const auto& o : plan.extra) points.push_back({o.pressure_pa, o.load_n, o.speed_mps, rrc_at(o), plan.name});
+  return points;
+}
+
+// The plan's points on the tyre's surface, fitted from the shared constants.
 double plan_rms(const MeasurementPlan& plan, const J2452Set& set, const HysteresisConstants& shared,
                 const std::vector<RrcPoint>& truth, double drum_radius_m) {
   FitRequest request;  // free: what the points determine
-  const auto measure = [&](const OperatingPoint& o, const std::string& where) {
-    request.points.push_back({o.pressure_pa, o.load_n, o.speed_mps,
-                              j2452_flat_rrc(set, o.pressure_pa, o.load_n, o.speed_mps, drum_radius_m), where});
-  };
-  measure({kRefPressure_pa, kRefLoad_n, kRefSpeed_mps}, "reference point");
-  for (const auto& o : plan.extra) measure(o, plan.name);
+  request.points = plan_points(plan, [&](const OperatingPoint& o) {
+    return j2452_flat_rrc(set, o.pressure_pa, o.load_n, o.speed_mps, drum_radius_m);
+  });
   const TyreFit fit = fit_hysteresis(one_point_tyre(set, shared, drum_radius_m), request);
   return grid_error(hysteresis_surface(fit.tyre), truth).rms;
 }
@@ -131,9 +137,7 @@ std::vector<MeasurementPlan> j2452_measurement_plans() {
                                       {"+15 km/h, +115 km/h, +180 kPa", {v15, v115, p180}, {}},
                                       {"+15 km/h, +115 km/h, +300 kPa", {v15, v115, p300}, {}}};
   for (auto& plan : plans) {  // what `rollsim tyre fit` frees for these points; their RRC does not matter here
-    std::vector<RrcPoint> points{{kRefPressure_pa, kRefLoad_n, kRefSpeed_mps, 0.01, ""}};
-    for (const auto& o : plan.extra) points.push_back({o.pressure_pa, o.load_n, o.speed_mps, 0.01, ""});
-    plan.fitted = identifiable_params(points);
+    plan.fitted = identifiable_params(plan_points(plan, [](const OperatingPoint&) { return 0.01; }));
   }
   return plans;
 }
@@ -250,8 +254,7 @@ TyreEvaluation evaluate_tyre(const J2452Set& set, const HysteresisConstants& sha
 
   FitRequest request;
   request.points = truth;
-  request.free = {HysteresisParam::RrcRef,   HysteresisParam::FrequencySlope, HysteresisParam::DeflectionExponent,
-                  HysteresisParam::LoadExponent, HysteresisParam::SpeedLoss, HysteresisParam::SpeedLossLoadExponent};
+  request.free = all_hysteresis_params();
   const TyreFit full = fit_hysteresis(one_point_tyre(set, full_fit_start, drum_radius_m), request);
   const Surface full_surface = hysteresis_surface(full.tyre);
   e.full_fit_rms = grid_error(full_surface, truth).rms;

@@ -313,7 +313,7 @@ VehicleModel car_from_row(const EpaTestRow& listed, const EpaDefaults& d) {
   return m;
 }
 
-std::shared_ptr<const Effect> cold_start_effect(const EpaTestRow& row, double cold_fuel_excess) {
+std::shared_ptr<const Effect> cold_start_effect(const EpaTestRow& row, const VehicleModel& car, double cold_fuel_excess) {
   // The catalogue's engine warm-up (effects/catalogue.cpp): oil and block heated from the test's 20-30 degC to
   // 60 K above it. Heat capacity ~40 kJ/K per litre of displacement (block, head and fluids of a 2 l engine weigh
   // ~120 kg at ~0.6 kJ/(kg K)); heat reaching them at idle ~1 kW per litre plus 60 % of the wheel work.
@@ -324,7 +324,7 @@ std::shared_ptr<const Effect> cold_start_effect(const EpaTestRow& row, double co
                      {"heat_per_wheel_work", 0.6},
                      {"heat_loss_w_per_k", 40.0},
                      {"warm_excess_k", 60.0}};
-  return make_effect(EffectId::engine_warmup, p, EffectContext{*result_configuration(row).test_mass_kg, 0.0});
+  return make_effect(EffectId::engine_warmup, p, EffectContext{car.mass_kg, 0.0});
 }
 
 }  // namespace rollsim::validate

@@ -267,7 +267,7 @@ Raw simulate_row(const EpaTestRow& r, const Cycles& c, const EpaDefaults& d) {
     const SimulationResult hot = simulate_replay(car, c.bag1, traced);
     const SimulationResult stabilised = simulate_replay(car, c.bag2, traced);
     VehicleModel cold_car = car;
-    cold_car.effects.push_back(cold_start_effect(r, 1.0));
+    cold_car.effects.push_back(cold_start_effect(r, car, 1.0));
     const SimulationResult cold = simulate_replay(cold_car, c.bag1, traced);
     w.bag1_hot_m3 = fuel_m3(hot);
     w.bag2_m3 = fuel_m3(stabilised);

@@ -33,8 +33,9 @@ SkipReason check_car_fields(const EpaTestRow& row, std::string& detail);
 /// drive). The fuel-converter or charge constants come from `d`.
 VehicleModel car_from_row(const EpaTestRow& row, const EpaDefaults& d);
 
-/// The engine warm-up effect's parameters for the row's engine with a given cold fuel excess (FTP bag 1).
-std::shared_ptr<const Effect> cold_start_effect(const EpaTestRow& row, double cold_fuel_excess);
+/// The engine warm-up effect's parameters for the row's engine with a given cold fuel excess (FTP bag 1), built
+/// against `car`, the row's car (car_from_row).
+std::shared_ptr<const Effect> cold_start_effect(const EpaTestRow& row, const VehicleModel& car, double cold_fuel_excess);
 
 /// Fuel properties of the row's test fuel.
 FuelParams test_fuel(EpaFuel fuel);
