@@ -4,8 +4,12 @@
 
 #include <cmath>
 #include <filesystem>
+#include <algorithm>
 #include <fstream>
+#include <set>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "rollsim/common/error.hpp"
 #include "rollsim/common/units.hpp"
@@ -69,6 +73,37 @@ TEST(SelectionSweep, StopsBeforeTheDeflectionReachesTheRim) {
   EXPECT_LT(r.points.back().rr.deflection_m, sidewall_m);
   EXPECT_TRUE(has(*r.stopped, "rim")) << *r.stopped;
   EXPECT_TRUE(has(*r.stopped, "last valid point")) << *r.stopped;
+}
+
+// A CSV or JSON line with one name twice is read as the last value by most readers; sweeping load or speed made
+// "speed_kmh" twice (and "load_N" beside "load_n") until session 13.
+TEST(SelectionSweep, EveryColumnNameIsUniqueWhateverIsSwept) {
+  const std::vector<SweepParam> all{SweepParam::Pressure, SweepParam::Diameter, SweepParam::Width,
+                                    SweepParam::Load,     SweepParam::LoadPct,  SweepParam::Speed};
+  const std::vector<std::pair<double, double>> range{{2, 3}, {600, 700}, {150, 200}, {3000, 4000}, {60, 80}, {40, 80}};
+  for (std::size_t a = 0; a < all.size(); ++a) {
+    for (std::size_t b = 0; b <= all.size(); ++b) {
+      if (b == a || (b < all.size() && (all[a] == SweepParam::Load || all[a] == SweepParam::LoadPct) &&
+                     (all[b] == SweepParam::Load || all[b] == SweepParam::LoadPct))) {
+        continue;
+      }
+      SweepOptions o = one_axis(all[a], range[a].first, range[a].second, 2);
+      if (b < all.size()) o.axes.push_back({all[b], range[b].first, range[b].second, 2});
+      const SweepResult r = sweep_tyre(tyre("175-70R14"), o);
+      ASSERT_EQ(r.points.size(), b < all.size() ? 4u : 2u);
+      const auto columns = sweep_point_columns(r, r.points.back());
+      std::set<std::string> names;
+      for (const auto& [name, value] : columns) EXPECT_TRUE(names.insert(name).second) << name << " twice";
+      for (const char* must : {"load_n", "speed_kmh"}) EXPECT_TRUE(names.count(must)) << must;
+      // The evaluated load and speed are what the columns say.
+      for (const auto& [name, value] : columns) {
+        if (name == "load_n") EXPECT_DOUBLE_EQ(value, r.points.back().load_n);
+        if (name == "speed_kmh") EXPECT_DOUBLE_EQ(value, r.points.back().speed_kmh);
+      }
+      const std::string header = sweep_csv(r).substr(0, sweep_csv(r).find('\n'));
+      EXPECT_EQ(std::count(header.begin(), header.end(), ',') + 1, static_cast<long>(columns.size() + 4)) << header;
+    }
+  }
 }
 
 TEST(SelectionSweep, BadRangesAreRejected) {

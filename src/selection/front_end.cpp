@@ -107,11 +107,9 @@ std::vector<JsonObject> sweep_json(const SweepResult& r) {
   std::vector<JsonObject> out;
   for (const auto& p : r.points) {
     JsonObject j;
-    for (std::size_t i = 0; i < r.axes.size(); ++i) {
-      j.add(sweep_param_key(r.axes[i].param) + "_" + sweep_param_unit(r.axes[i].param), p.values[i]);
-    }
-    j.add("load_n", p.load_n).add("speed_kmh", p.speed_kmh).add("rrc", p.rr.rrc).add("rr_force_n", p.rr.rr_force_n)
-        .add("rr_power_w", p.rr.rr_power_w);
+    for (const auto& [name, value] : sweep_point_columns(r, p)) j.add(name, value);
+    j.add("rrc", p.rr.rrc).add("rr_force_n", p.rr.rr_force_n).add("rr_power_w", p.rr.rr_power_w)
+        .add("deflection_m", p.rr.deflection_m);
     if (r.vehicle) j.add(r.energy_unit, p.energy);
     out.push_back(j);
   }

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <exception>
 #include <sstream>
+#include <utility>
 
 #include "rollsim/common/error.hpp"
 #include "rollsim/common/parallel.hpp"
@@ -263,16 +264,35 @@ SweepResult sweep_vehicle(const Vehicle& vehicle, const TyreSpec& tyre, const Dr
   return r;
 }
 
+std::vector<std::pair<std::string, double>> sweep_point_columns(const SweepResult& r, const SweepPoint& p) {
+  // A load or speed axis is the evaluated load or speed itself (load-pct is not: its column is the share).
+  auto column = [](SweepParam a) {
+    return a == SweepParam::Load ? std::string("load_n") : a == SweepParam::LoadPct ? std::string("load_pct")
+                                                                                     : sweep_param_key(a) + "_" + sweep_param_unit(a);
+  };
+  std::vector<std::pair<std::string, double>> out;
+  bool load_axis = false, speed_axis = false;
+  for (std::size_t i = 0; i < r.axes.size(); ++i) {
+    out.emplace_back(column(r.axes[i].param), p.values[i]);
+    load_axis = load_axis || r.axes[i].param == SweepParam::Load;
+    speed_axis = speed_axis || r.axes[i].param == SweepParam::Speed;
+  }
+  if (!load_axis) out.emplace_back("load_n", p.load_n);
+  if (!speed_axis) out.emplace_back("speed_kmh", p.speed_kmh);
+  return out;
+}
+
 std::string sweep_csv(const SweepResult& r) {
   std::ostringstream out;
-  for (const auto& a : r.axes) out << sweep_param_key(a.param) << "_" << sweep_param_unit(a.param) << ",";
-  out << "load_n,speed_kmh,rrc,rr_force_n,rr_power_w,deflection_m";
+  SweepPoint names_only;  // the header needs no point: a sweep that stopped at its first still has one
+  names_only.values.resize(r.axes.size());
+  for (const auto& [name, value] : sweep_point_columns(r, names_only)) out << name << ",";
+  out << "rrc,rr_force_n,rr_power_w,deflection_m";
   if (r.vehicle) out << "," << r.energy_unit;
   out << "\n";
   for (const auto& p : r.points) {
-    for (double v : p.values) out << format_value(v) << ",";
-    out << format_value(p.load_n) << "," << format_value(p.speed_kmh) << "," << fixed(p.rr.rrc, 7) << ","
-        << fixed(p.rr.rr_force_n, 4) << "," << fixed(p.rr.rr_power_w, 3) << ","
+    for (const auto& [name, value] : sweep_point_columns(r, p)) out << format_value(value) << ",";
+    out << fixed(p.rr.rrc, 7) << "," << fixed(p.rr.rr_force_n, 4) << "," << fixed(p.rr.rr_power_w, 3) << ","
         << fixed(p.rr.deflection_m, 6);
     if (r.vehicle) out << "," << fixed(p.energy, 5);
     out << "\n";

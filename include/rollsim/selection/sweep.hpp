@@ -5,6 +5,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "rollsim/common/distribute.hpp"
@@ -81,6 +82,11 @@ SweepResult sweep_tyre(const TyreSpec& tyre, const SweepOptions& options);
 /// Stops like sweep_tyre.
 SweepResult sweep_vehicle(const Vehicle& vehicle, const TyreSpec& tyre, const DriveCycle& cycle,
                           const SweepOptions& options);
+
+/// Where a point is, as (column, value) pairs: each axis (pressure_bar, diameter_mm, width_mm, load_n, load_pct,
+/// speed_kmh), then the load and speed the tyre was evaluated at unless an axis already is that column, so every
+/// column name is unique.
+std::vector<std::pair<std::string, double>> sweep_point_columns(const SweepResult& result, const SweepPoint& point);
 
 /// The sweep as CSV (header + one line per point).
 std::string sweep_csv(const SweepResult& result);
