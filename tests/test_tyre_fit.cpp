@@ -119,6 +119,38 @@ TEST(HysteresisModel, RrcFallsWithPressureAndRisesWithSpeed) {
   EXPECT_GT(evaluate_rolling_resistance(t, 4000.0, 30.0).rrc, evaluate_rolling_resistance(t, 4000.0, 22.0).rrc);
 }
 
+// A what-if on the size keeps the measured tyre's reference deflection, so the size acts through the deflection as
+// the model's law says: RRC ~ dz^n_d at a fixed load and pressure. Before session 13 the reference deflection was
+// re-derived from the resized tyre and cancelled it: a sweep over width was flat and its elasticity 0.
+TEST(HysteresisModel, AWhatIfOnTheSizeActsThroughTheDeflection) {
+  const TyreState t = hysteresis_tyre();
+  const double z = 4000.0, v = 22.0;
+  // The tyre at its own size is unchanged by the pinning.
+  EXPECT_DOUBLE_EQ(evaluate_rolling_resistance(with_geometry(t, t.geometry), z, v).rrc,
+                   evaluate_rolling_resistance(t, z, v).rrc);
+  // Width changes neither the frequency nor the speed-squared term: the whole hysteresis part scales as dz^n_d.
+  TyreState no_speed = t;
+  no_speed.hysteresis.frequency_slope_per_hz = no_speed.hysteresis.speed_loss_rrc_per_hz2 = 0.0;
+  for (double scale : {0.7, 1.3}) {
+    TyreGeometry g = t.geometry;
+    g.section_width_m *= scale;
+    const TyreState wide = with_geometry(no_speed, g);
+    const double dz_ratio = vertical_stiffness_n_per_m(no_speed) / vertical_stiffness_n_per_m(wide);
+    EXPECT_NEAR(evaluate_rolling_resistance(wide, z, v).rrc / evaluate_rolling_resistance(no_speed, z, v).rrc,
+                std::pow(dz_ratio, t.hysteresis.deflection_exponent), 1e-12);
+    EXPECT_NE(dz_ratio, 1.0);
+  }
+  // A wider or taller tyre deflects less and loses less; the thesis model is untouched by the pinning.
+  TyreGeometry wider = t.geometry, taller = t.geometry;
+  wider.section_width_m *= 1.2;
+  taller.outer_radius_m *= 1.1;
+  EXPECT_LT(evaluate_rolling_resistance(with_geometry(t, wider), z, v).rrc, evaluate_rolling_resistance(t, z, v).rrc);
+  EXPECT_LT(evaluate_rolling_resistance(with_geometry(t, taller), z, v).rrc, evaluate_rolling_resistance(t, z, v).rrc);
+  TyreState thesis = t;
+  thesis.model = TyreModelKind::Thesis;
+  EXPECT_EQ(with_geometry(thesis, wider).hysteresis.reference_deflection_m, 0.0);
+}
+
 // --- fitting: known truths ---
 
 TEST(TyreFit, RecoversEveryConstantFromASurfaceItGenerated) {

@@ -54,8 +54,13 @@ Sensitivity vehicle_sensitivity(const Vehicle& vehicle, const TyreSpec& tyre, co
       Vehicle v = vehicle;
       TyreSpec t = tyre;
       switch (row.parameter) {
-        case TyreParameter::OuterDiameter: t.state.geometry.outer_radius_m *= f[k]; break;
-        case TyreParameter::SectionWidth: t.state.geometry.section_width_m *= f[k]; break;
+        case TyreParameter::OuterDiameter:
+        case TyreParameter::SectionWidth: {
+          TyreGeometry g = t.state.geometry;
+          (row.parameter == TyreParameter::OuterDiameter ? g.outer_radius_m : g.section_width_m) *= f[k];
+          t.state = with_geometry(t.state, g);
+          break;
+        }
         case TyreParameter::Pressure: t.state.pressure_pa *= f[k]; break;
         case TyreParameter::Load: v.body.test_mass_kg *= f[k]; break;  // every wheel load scales with mass
         case TyreParameter::Speed: break;

@@ -142,14 +142,14 @@ TyreExplanation explain_tyre(const TyreState& tyre, double load_n, double speed_
   // Diameter is scaled with the rim kept: a bigger tyre on the same rim has a taller sidewall.
   add(TyreParameter::OuterDiameter, "outer diameter", "outer_diameter", 2.0 * tyre.geometry.outer_radius_m,
       [&](double s) {
-        TyreState t = tyre;
-        t.geometry.outer_radius_m *= s;
-        return evaluate_rolling_resistance(t, load_n, speed_mps);
+        TyreGeometry g = tyre.geometry;
+        g.outer_radius_m *= s;
+        return evaluate_rolling_resistance(with_geometry(tyre, g), load_n, speed_mps);
       });
   add(TyreParameter::SectionWidth, "section width", "section_width", tyre.geometry.section_width_m, [&](double s) {
-    TyreState t = tyre;
-    t.geometry.section_width_m *= s;
-    return evaluate_rolling_resistance(t, load_n, speed_mps);
+    TyreGeometry g = tyre.geometry;
+    g.section_width_m *= s;
+    return evaluate_rolling_resistance(with_geometry(tyre, g), load_n, speed_mps);
   });
   add(TyreParameter::Pressure, "inflation pressure", "pressure", tyre.pressure_pa, [&](double s) {
     TyreState t = tyre;

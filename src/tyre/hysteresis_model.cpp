@@ -8,12 +8,18 @@
 
 namespace rollsim {
 
-SpeedPolynomial hysteresis_polynomial(const TyreState& tyre, double load_n) {
+double hysteresis_reference_deflection_m(const TyreState& tyre) {
   const HysteresisConstants& c = tyre.hysteresis;
+  if (c.reference_deflection_m > 0.0) return c.reference_deflection_m;
   TyreState at_ref = tyre;
   at_ref.pressure_pa = c.reference_pressure_pa;
+  return c.reference_load_n / vertical_stiffness_n_per_m(at_ref);
+}
+
+SpeedPolynomial hysteresis_polynomial(const TyreState& tyre, double load_n) {
+  const HysteresisConstants& c = tyre.hysteresis;
   const double deflection_m = load_n / vertical_stiffness_n_per_m(tyre);
-  const double deflection_ref_m = c.reference_load_n / vertical_stiffness_n_per_m(at_ref);
+  const double deflection_ref_m = hysteresis_reference_deflection_m(tyre);
   const double load_ratio = load_n / c.reference_load_n;
   const double hysteresis = c.rrc_ref * std::pow(deflection_m / deflection_ref_m, c.deflection_exponent) *
                             std::pow(load_ratio, c.load_exponent);
@@ -34,6 +40,8 @@ void check_hysteresis_constants(const HysteresisConstants& c) {
     fail("reference pressure [Pa]", c.reference_pressure_pa, "must be > 0");
   if (!(c.reference_load_n > 0.0) || !std::isfinite(c.reference_load_n))
     fail("reference load [N]", c.reference_load_n, "must be > 0");
+  if (!(c.reference_deflection_m >= 0.0) || !std::isfinite(c.reference_deflection_m))
+    fail("reference deflection [m]", c.reference_deflection_m, "must be >= 0 (0: the tyre's own)");
   if (!(c.rrc_ref > 0.0 && c.rrc_ref <= 0.1)) fail("rrc_ref", c.rrc_ref, "must be in (0, 0.1]");
   for (const auto& [name, v] : {std::pair{"deflection_exponent", c.deflection_exponent},
                                 std::pair{"load_exponent", c.load_exponent},

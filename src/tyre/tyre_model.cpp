@@ -66,6 +66,13 @@ double vertical_stiffness_n_per_m(const TyreState& tyre) {
   return 1.0e4 * (c.stiffness_pressure_coeff * p_bar * std::sqrt(0.7 * w_mm * d_mm) + c.stiffness_offset_kgf_per_mm);
 }
 
+TyreState with_geometry(const TyreState& tyre, const TyreGeometry& geometry) {
+  TyreState t = tyre;
+  if (t.model == TyreModelKind::Hysteresis) t.hysteresis.reference_deflection_m = hysteresis_reference_deflection_m(tyre);
+  t.geometry = geometry;
+  return t;
+}
+
 void check_operating_point(const TyreState& tyre, double load_n, double speed_mps) {
   const auto& g = tyre.geometry;
   if (!(g.outer_radius_m > 0.0) || !std::isfinite(g.outer_radius_m))

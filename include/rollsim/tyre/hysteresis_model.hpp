@@ -12,6 +12,9 @@ struct SpeedPolynomial {
   double k2_s2_per_m2 = 0.0;  ///< speed-squared loss [1/(m/s)^2]
 };
 
+/// dz_ref: the pinned reference deflection, or the tyre's own at P_ref and N_ref.
+double hysteresis_reference_deflection_m(const TyreState& tyre);
+
 /// The hysteresis model's polynomial (HysteresisConstants). Assumes check_operating_point passed.
 SpeedPolynomial hysteresis_polynomial(const TyreState& tyre, double load_n);
 

@@ -45,6 +45,9 @@ struct HysteresisConstants {
   double frequency_slope_per_hz = 0.017138;   ///< s_f: relative rise of the loss modulus per Hz
   double speed_loss_rrc_per_hz2 = 4.2285e-6;  ///< c_w: speed-squared loss [RRC / Hz^2]
   double speed_loss_load_exponent = 0.086928;  ///< n_w
+  /// dz_ref [m] held fixed by a what-if on the tyre's size (with_geometry); 0: the tyre's own deflection at
+  /// P_ref and N_ref, which is what a tyre file and a fit use.
+  double reference_deflection_m = 0.0;
 };
 
 /// Undeformed tyre geometry.
@@ -84,6 +87,11 @@ struct RollingResistance {
 
 /// Vertical stiffness of the constant-belt model [N/m].
 double vertical_stiffness_n_per_m(const TyreState& tyre);
+
+/// The tyre resized to `geometry`, for a what-if on its size (sweeps, sensitivities). A hysteresis tyre keeps the
+/// reference deflection of the size it was measured at: its loss follows (dz / dz_ref)^n_d, and re-deriving dz_ref
+/// from the new size would cancel the size's effect on the deflection (a wider tyre would lose exactly as much).
+TyreState with_geometry(const TyreState& tyre, const TyreGeometry& geometry);
 
 /// Checks that `tyre` and the operating point are in the model's domain; throws ModelDomainError saying
 /// which quantity is out and what is allowed (deflection reaching the rim, non-positive pressure, ...).
