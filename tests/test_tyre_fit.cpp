@@ -12,6 +12,7 @@
 
 #include "rollsim/common/error.hpp"
 #include "rollsim/common/units.hpp"
+#include "rollsim/tyre/hysteresis_model.hpp"
 #include "rollsim/tyre/j2452.hpp"
 #include "rollsim/tyre/j2452_evaluation.hpp"
 #include "rollsim/tyre/tyre_fit.hpp"
@@ -204,6 +205,32 @@ TEST(TyreFit, ChoosesOnlyWhatThePointsDetermine) {
   EXPECT_EQ(two_speeds[1], HysteresisParam::FrequencySlope);
   const auto pressures = identifiable_params({pt(180, 4000, 80), pt(240, 4000, 80), pt(300, 4000, 80)});
   EXPECT_EQ(pressures.size(), 2u);  // level and deflection exponent; no speed or load information
+}
+
+// Points that have RRC rise with pressure contradict the model's law (loss grows with deflection) and every measured
+// set: the deflection exponent is held at its bound 0 and the contradiction stays in the residuals, as a negative
+// frequency slope does. Before session 13 two such points wrote a tyre with a deflection exponent of -2.9.
+TEST(TyreFit, RrcRisingWithPressureHoldsTheDeflectionExponentAtZero) {
+  TyreState start;
+  start.geometry = {0.3159, 0.205, 0.2032};
+  start.pressure_pa = 2.1e5;
+  FitRequest r;
+  r.points = {{210e3, 4000.0, 80 / 3.6, 0.008, "a"}, {250e3, 4000.0, 80 / 3.6, 0.012, "b"}};
+  const TyreFit f = fit_hysteresis(start, r);
+  bool held = false;
+  for (const auto& e : f.params) {
+    if (e.param != HysteresisParam::DeflectionExponent) continue;
+    held = e.at_bound;
+    EXPECT_EQ(e.value, 0.0);
+  }
+  EXPECT_TRUE(held);
+  EXPECT_EQ(f.tyre.hysteresis.deflection_exponent, 0.0);
+  // With no pressure dependence left the two points get one RRC: the residuals carry the +-20 % the data disagree.
+  EXPECT_NEAR(f.residuals[0].model_rrc, f.residuals[1].model_rrc, 1e-12);
+  TyreState bad = start;
+  bad.model = TyreModelKind::Hysteresis;
+  bad.hysteresis.deflection_exponent = -0.5;
+  EXPECT_THROW(check_hysteresis_constants(bad.hysteresis), ModelDomainError);
 }
 
 // --- measured data: the nine J2452 sets, each held out ---

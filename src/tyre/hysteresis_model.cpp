@@ -43,8 +43,10 @@ void check_hysteresis_constants(const HysteresisConstants& c) {
   if (!(c.reference_deflection_m >= 0.0) || !std::isfinite(c.reference_deflection_m))
     fail("reference deflection [m]", c.reference_deflection_m, "must be >= 0 (0: the tyre's own)");
   if (!(c.rrc_ref > 0.0 && c.rrc_ref <= 0.1)) fail("rrc_ref", c.rrc_ref, "must be in (0, 0.1]");
-  for (const auto& [name, v] : {std::pair{"deflection_exponent", c.deflection_exponent},
-                                std::pair{"load_exponent", c.load_exponent},
+  // Loss grows with deflection (strain amplitude): a negative exponent would have RRC rise with pressure.
+  if (!(c.deflection_exponent >= 0.0 && c.deflection_exponent <= 5.0))
+    fail("deflection_exponent", c.deflection_exponent, "must be in [0, 5]");
+  for (const auto& [name, v] : {std::pair{"load_exponent", c.load_exponent},
                                 std::pair{"speed_loss_load_exponent", c.speed_loss_load_exponent}}) {
     if (!(std::abs(v) <= 5.0)) fail(name, v, "must be in [-5, 5]");
   }

@@ -249,14 +249,16 @@ TyreFit fit_hysteresis(const TyreState& start_in, const FitRequest& r) {
   start.hysteresis.rrc_ref = 0.01;
   start.hysteresis.rrc_ref *= r.points.front().rrc / model_rrc(start, r.points.front());
 
-  // A slope or speed loss cannot be negative (RRC would reach 0 at some speed): one that fits below 0 is held
-  // at 0 and the rest refitted.
+  // A slope or speed loss cannot be negative (RRC would reach 0 at some speed), nor the deflection exponent (a
+  // tyre losing less the more it deflects would lose more when pumped up; every measured set loses less, J2452
+  // pressure exponents -0.26 to -0.59): one that fits below 0 is held at 0 and the rest refitted.
   std::vector<HysteresisParam> at_bound;
   while (true) {
     TyreFit fit = fit_once(start, r, free);
     bool changed = false;
     for (const auto& e : fit.params) {
-      const bool nonneg = e.param == HysteresisParam::FrequencySlope || e.param == HysteresisParam::SpeedLoss;
+      const bool nonneg = e.param == HysteresisParam::FrequencySlope || e.param == HysteresisParam::SpeedLoss ||
+                          e.param == HysteresisParam::DeflectionExponent;
       if (nonneg && e.value < 0.0) {
         set_hysteresis_param(start.hysteresis, e.param, 0.0);
         free.erase(std::find(free.begin(), free.end(), e.param));

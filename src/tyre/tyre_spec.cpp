@@ -180,7 +180,7 @@ void read_model_map(YamlMap& m, TyreState& state) {
     h.reference_pressure_pa =
         units::bar_to_pa(opt_number(m, "reference_pressure_bar", Range::closed(0.5, 6.0)).value_or(units::pa_to_bar(h.reference_pressure_pa)));
     h.reference_load_n = opt_number(m, "reference_load_n", Range::open_low(0.0, 1e5)).value_or(h.reference_load_n);
-    h.deflection_exponent = opt_number(m, "deflection_exponent", Range::closed(-5, 5)).value_or(h.deflection_exponent);
+    h.deflection_exponent = opt_number(m, "deflection_exponent", Range::closed(0, 5)).value_or(h.deflection_exponent);
     h.load_exponent = opt_number(m, "load_exponent", Range::closed(-5, 5)).value_or(h.load_exponent);
     h.frequency_slope_per_hz = opt_number(m, "frequency_slope_per_hz", Range::closed(0, 1)).value_or(h.frequency_slope_per_hz);
     h.speed_loss_rrc_per_hz2 =
