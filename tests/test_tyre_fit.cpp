@@ -233,6 +233,24 @@ TEST(TyreFit, RrcRisingWithPressureHoldsTheDeflectionExponentAtZero) {
   EXPECT_THROW(check_hysteresis_constants(bad.hysteresis), ModelDomainError);
 }
 
+// The same point given twice is fitted exactly: residuals of 0 are no estimate of the scatter, and the interval
+// falls back to the assumed uncertainty instead of a zero width (before session 13: [x, x], "0.00 % from the
+// residuals").
+TEST(TyreFit, RepeatedIdenticalPointsDoNotClaimAZeroWidthInterval) {
+  TyreState start;
+  start.geometry = {0.3159, 0.205, 0.2032};
+  start.pressure_pa = 2.1e5;
+  FitRequest r;
+  r.points = {{210e3, 4000.0, 80 / 3.6, 0.008, "a"}, {210e3, 4000.0, 80 / 3.6, 0.008, "b"}};
+  const TyreFit f = fit_hysteresis(start, r);
+  EXPECT_EQ(f.degrees_of_freedom, 1);
+  EXPECT_FALSE(f.sigma_from_residuals);
+  EXPECT_EQ(f.sigma_relative, r.assumed_relative_uncertainty);
+  EXPECT_EQ(sigma_source(f), "assumed: the residuals are all 0");
+  ASSERT_EQ(f.params.size(), 1u);
+  EXPECT_LT(f.params[0].low95, 0.99 * f.params[0].value);
+}
+
 // --- measured data: the nine J2452 sets, each held out ---
 
 TEST(J2452, DrumToFlatFactorIsTheStatedRelation) {

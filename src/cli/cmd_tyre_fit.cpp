@@ -86,7 +86,7 @@ void print_fit(const TyreFit& fit, const std::optional<LabelBand>& band, const s
   }
   std::cout << "Hysteresis model fitted to " << fit.residuals.size() << " point(s), " << fit.params.size()
             << " constant(s) free; intervals from the Jacobian with " << pct(fit.sigma_relative) << " % relative scatter ("
-            << (fit.sigma_from_residuals ? "from the residuals" : "assumed: no degrees of freedom left") << ")\n"
+            << sigma_source(fit) << ")\n"
             << t.render();
   std::cout << "residuals: RMS " << pct(fit.rms_relative_error) << " %";
   double worst = 0.0;

@@ -127,7 +127,9 @@ TyreFit fit_once(const TyreState& start, const FitRequest& r, const std::vector<
   fit.degrees_of_freedom = m - n;
   const double ssr = ls.residuals.squaredNorm();
   fit.rms_relative_error = std::sqrt(ssr / m);
-  fit.sigma_from_residuals = fit.degrees_of_freedom > 0;
+  // Residuals that are all zero (repeated identical points fitted exactly) say nothing of the scatter: an interval
+  // of zero width would claim certainty no measurement has.
+  fit.sigma_from_residuals = fit.degrees_of_freedom > 0 && fit.rms_relative_error > 1e-9;
   fit.sigma_relative = fit.sigma_from_residuals ? std::sqrt(ssr / fit.degrees_of_freedom) : r.assumed_relative_uncertainty;
   // Covariance of the scaled parameters; a pseudo-inverse keeps a degenerate direction from producing NaN.
   const Eigen::MatrixXd jtj = ls.jacobian.transpose() * ls.jacobian;
@@ -359,12 +361,17 @@ std::string yaml_quoted(const std::string& s) {
 
 }  // namespace
 
+std::string sigma_source(const TyreFit& fit) {
+  if (fit.sigma_from_residuals) return "from the residuals";
+  return fit.degrees_of_freedom > 0 ? "assumed: the residuals are all 0" : "assumed: no degrees of freedom left";
+}
+
 void write_fitted_tyre_yaml(std::ostream& out, const FittedTyreFile& file, const TyreFit& fit) {
   const HysteresisConstants& h = fit.tyre.hysteresis;
   out << "# Written by 'rollsim tyre fit': hysteresis model fitted to " << fit.residuals.size()
       << " point(s), RMS relative error " << num(fit.rms_relative_error * 100.0) << " %.\n";
   out << "# 95 % intervals (Jacobian covariance, relative scatter " << num(fit.sigma_relative * 100.0) << " % "
-      << (fit.sigma_from_residuals ? "from the residuals" : "assumed: no degrees of freedom left") << "):\n";
+      << sigma_source(fit) << "):\n";
   for (const auto& e : fit.params) {
     out << "#   " << hysteresis_param_key(e.param) << " " << num(e.value);
     if (e.at_bound) out << " (held at its bound 0)\n";

@@ -67,8 +67,11 @@ struct TyreFit {
   double rms_relative_error = 0.0;
   int degrees_of_freedom = 0;                 ///< points - free parameters
   double sigma_relative = 0.0;                ///< relative measurement scatter used for the intervals
-  bool sigma_from_residuals = false;          ///< false: the assumed uncertainty (no degrees of freedom left)
+  bool sigma_from_residuals = false;          ///< false: the assumed uncertainty (see sigma_source)
 };
+
+/// Where the fit's scatter comes from, for its reports: "from the residuals", or why it is the assumed one.
+std::string sigma_source(const TyreFit& fit);
 
 struct FitRequest {
   std::vector<RrcPoint> points;
