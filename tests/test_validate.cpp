@@ -704,6 +704,16 @@ TEST(CliValidate, JsonRowsAndANamedErrorForAFileWithoutTheColumns) {
     EXPECT_NE(rows.front().find(key), std::string::npos) << rows.front();
     EXPECT_EQ(rows[1].find(key), std::string::npos) << rows[1];
   }
+  // Its summary: the first 40 rows hold petrol cars only, so the diesel and charge efficiencies are not fitted and
+  // the summary says they are nominal instead of printing them as fitted on 0 rows.
+  const auto s = test::run_rollsim("validate --threads 2 --epa-test-car-list " + part.string());
+  ASSERT_EQ(s.exit_code, 0) << s.err;
+  for (const char* constant : {"diesel ", "charge efficiency "}) {
+    const auto at = s.out.find(constant);
+    ASSERT_NE(at, std::string::npos) << s.out;
+    EXPECT_EQ(s.out.find(" (nominal: no rows to fit it)", at), at + std::string(constant).size() + 5) << s.out;
+  }
+  EXPECT_EQ(s.out.find("(0 rows)"), std::string::npos) << s.out;
 }
 
 }  // namespace

@@ -46,11 +46,18 @@ void print_summary(const validate::Validation& v) {
   const auto& f = v.fitted;
   std::cout << "EPA Test Car List: " << v.rows.size() << " rows; split by the hash of make|model: fitting half sets "
             << "the constants, held-out half judges them\n";
-  std::cout << "fitted on the fitting half: petrol indicated efficiency " << fixed(f.defaults.petrol_indicated_efficiency, 3)
-            << " (" << f.petrol_rows << " rows), diesel " << fixed(f.defaults.diesel_indicated_efficiency, 3) << " ("
-            << f.diesel_rows << " rows), charge efficiency " << fixed(f.defaults.charge_efficiency, 3) << " ("
-            << f.electric_rows << " rows), cold-start fuel excess " << fixed(f.defaults.cold_fuel_excess, 3) << " ("
-            << f.cold_start_rows << " FTPs' bag 1 vs bag 3)\n";
+  // A constant with no row to fit it keeps its nominal value; say so rather than print it as fitted.
+  auto constant = [](const std::string& name, double value, std::size_t rows, const std::string& what) {
+    return name + " " + fixed(value, 3) + " (" +
+           (rows ? std::to_string(rows) + " " + what : "nominal: no " + what + " to fit it") + ")";
+  };
+  std::cout << "fitted on the fitting half: "
+            << constant("petrol indicated efficiency", f.defaults.petrol_indicated_efficiency, f.petrol_rows, "rows")
+            << ", " << constant("diesel", f.defaults.diesel_indicated_efficiency, f.diesel_rows, "rows") << ", "
+            << constant("charge efficiency", f.defaults.charge_efficiency, f.electric_rows, "rows") << ", "
+            << constant("cold-start fuel excess", f.defaults.cold_fuel_excess, f.cold_start_rows,
+                        "FTPs' bag 1 vs bag 3")
+            << "\n";
   for (const bool fitting : {false, true}) {
     const auto c = validate::coverage(v, fitting);
     std::cout << (fitting ? "fitting" : "held-out") << ": simulated " << c.simulated << " of " << c.eligible
