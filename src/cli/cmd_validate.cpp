@@ -62,8 +62,9 @@ void print_summary(const validate::Validation& v) {
     const auto c = validate::coverage(v, fitting);
     std::cout << (fitting ? "fitting" : "held-out") << ": simulated " << c.simulated << " of " << c.eligible
               << " FTP-75, HWFET, US06 and charge-depleting rows ("
-              << fixed(c.eligible ? 100.0 * static_cast<double>(c.simulated) / static_cast<double>(c.eligible) : 0.0, 1)
-              << " %)\n";
+              << (c.eligible ? fixed(100.0 * static_cast<double>(c.simulated) / static_cast<double>(c.eligible), 1) + " %"
+                             : std::string("none in this half"))
+              << ")\n";
   }
   std::size_t derived = 0, derived_simulated = 0;
   for (const auto& o : v.rows) {
