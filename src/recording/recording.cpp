@@ -14,6 +14,9 @@ namespace rollsim {
 
 namespace {
 
+// The same mapping in a fleet manifest is a row's columns or preset, not an option: a hint must name both.
+constexpr const char* kFleetMapping = " (in a fleet manifest: its columns or preset column)";
+
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kSecondsPerDay = 86400.0;
 // A clock falling by more than half a day between two samples is read as passing midnight; a smaller fall
@@ -222,14 +225,14 @@ Recording load_recording(const std::string& path, const ColumnMapping& mapping) 
     if (source_of(canonical).empty()) continue;  // dropped: its scale has nothing to scale
     if (!find(canonical)) {
       throw InputError(path, "a scale is given for " + canonical + " but the file has no column '" + source_of(canonical) +
-                                 "'; " + found + "; map one with --column " + canonical + "=SOURCE");
+                                 "'; " + found + "; map one with --column " + canonical + "=SOURCE" + kFleetMapping);
     }
   }
   auto require = [&](const std::string& canonical) {
     const auto col = find(canonical);
     if (!col) {
       throw InputError(path, "missing required column '" + canonical + "'; " + found + "; map one with --column " +
-                                 canonical + "=SOURCE");
+                                 canonical + "=SOURCE" + kFleetMapping);
     }
     return *col;
   };
@@ -491,7 +494,7 @@ Recording load_recording(const std::string& path, const ColumnMapping& mapping) 
   if (!rec.battery_power_w && !rec.battery_voltage_v && !rec.soc_fraction && !rec.fuel_rate_m3ps) {
     throw InputError(path, "has no energy channel: need one of battery_power_kw, battery_voltage_v with "
                            "battery_current_a, soc_pct or fuel_rate_lph; " + found +
-                               "; map one with --column CANONICAL=SOURCE (e.g. --column soc_pct=Soc)");
+                               "; map one with --column CANONICAL=SOURCE (e.g. --column soc_pct=Soc)" + kFleetMapping);
   }
   return rec;
 }
