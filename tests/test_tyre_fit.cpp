@@ -41,6 +41,13 @@ TyreState hysteresis_tyre() {
   return t;
 }
 
+// The hysteresis tyre fitted to two points with the fit's own choice of what to free.
+TyreFit fit_two_points(const RrcPoint& a, const RrcPoint& b) {
+  FitRequest r;
+  r.points = {a, b};
+  return fit_hysteresis(hysteresis_tyre(), r);
+}
+
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
@@ -211,12 +218,7 @@ TEST(TyreFit, ChoosesOnlyWhatThePointsDetermine) {
 // set: the deflection exponent is held at its bound 0 and the contradiction stays in the residuals, as a negative
 // frequency slope does. Before session 13 two such points wrote a tyre with a deflection exponent of -2.9.
 TEST(TyreFit, RrcRisingWithPressureHoldsTheDeflectionExponentAtZero) {
-  TyreState start;
-  start.geometry = {0.3159, 0.205, 0.2032};
-  start.pressure_pa = 2.1e5;
-  FitRequest r;
-  r.points = {{210e3, 4000.0, 80 / 3.6, 0.008, "a"}, {250e3, 4000.0, 80 / 3.6, 0.012, "b"}};
-  const TyreFit f = fit_hysteresis(start, r);
+  const TyreFit f = fit_two_points({210e3, 4000.0, 80 / 3.6, 0.008, "a"}, {250e3, 4000.0, 80 / 3.6, 0.012, "b"});
   bool held = false;
   for (const auto& e : f.params) {
     if (e.param != HysteresisParam::DeflectionExponent) continue;
@@ -227,8 +229,7 @@ TEST(TyreFit, RrcRisingWithPressureHoldsTheDeflectionExponentAtZero) {
   EXPECT_EQ(f.tyre.hysteresis.deflection_exponent, 0.0);
   // With no pressure dependence left the two points get one RRC: the residuals carry the +-20 % the data disagree.
   EXPECT_NEAR(f.residuals[0].model_rrc, f.residuals[1].model_rrc, 1e-12);
-  TyreState bad = start;
-  bad.model = TyreModelKind::Hysteresis;
+  TyreState bad = hysteresis_tyre();
   bad.hysteresis.deflection_exponent = -0.5;
   EXPECT_THROW(check_hysteresis_constants(bad.hysteresis), ModelDomainError);
 }
@@ -237,15 +238,10 @@ TEST(TyreFit, RrcRisingWithPressureHoldsTheDeflectionExponentAtZero) {
 // falls back to the assumed uncertainty instead of a zero width (before session 13: [x, x], "0.00 % from the
 // residuals").
 TEST(TyreFit, RepeatedIdenticalPointsDoNotClaimAZeroWidthInterval) {
-  TyreState start;
-  start.geometry = {0.3159, 0.205, 0.2032};
-  start.pressure_pa = 2.1e5;
-  FitRequest r;
-  r.points = {{210e3, 4000.0, 80 / 3.6, 0.008, "a"}, {210e3, 4000.0, 80 / 3.6, 0.008, "b"}};
-  const TyreFit f = fit_hysteresis(start, r);
+  const TyreFit f = fit_two_points({210e3, 4000.0, 80 / 3.6, 0.008, "a"}, {210e3, 4000.0, 80 / 3.6, 0.008, "b"});
   EXPECT_EQ(f.degrees_of_freedom, 1);
   EXPECT_FALSE(f.sigma_from_residuals);
-  EXPECT_EQ(f.sigma_relative, r.assumed_relative_uncertainty);
+  EXPECT_EQ(f.sigma_relative, FitRequest{}.assumed_relative_uncertainty);
   EXPECT_EQ(sigma_source(f), "assumed: the residuals are all 0");
   ASSERT_EQ(f.params.size(), 1u);
   EXPECT_LT(f.params[0].low95, 0.99 * f.params[0].value);
