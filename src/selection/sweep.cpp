@@ -78,11 +78,15 @@ TyreSpec with_parameter(const TyreSpec& tyre, SweepParam p, double value) {
   TyreSpec t = tyre;
   switch (p) {
     case SweepParam::Pressure: t.state.pressure_pa = units::bar_to_pa(value); break;
-    case SweepParam::Diameter:
+    case SweepParam::Diameter: {
+      TyreGeometry g = t.state.geometry;
+      g.outer_radius_m = value * units::kMPerMm / 2.0;
+      t.state = with_geometry(t.state, g);
+      break;
+    }
     case SweepParam::Width: {
       TyreGeometry g = t.state.geometry;
-      (p == SweepParam::Diameter ? g.outer_radius_m : g.section_width_m) =
-          p == SweepParam::Diameter ? value * units::kMPerMm / 2.0 : value * units::kMPerMm;
+      g.section_width_m = value * units::kMPerMm;
       t.state = with_geometry(t.state, g);
       break;
     }
