@@ -388,8 +388,9 @@ files are skipped with a warning.)");
 tyre: file, shipped name or dict. axes: [(param, from, to[, steps])], param one of pressure [bar], diameter [mm],
 width [mm], load [N], load-pct [%], speed [km/h]; steps default 11. load_n [N] (default 80 % of the maximum
 load), speed_kmh [km/h]. With vehicle (and cycle) each point is a forward simulation of the car (on `threads`
-threads, default every core). Returns a list of dicts, one per point: the swept values (e.g. pressure_bar),
-load_n, speed_kmh, rrc, rr_force_n, rr_power_w, and the car's kwh_per_10km or l_per_100km. A range leaving the
+threads, default every core). Returns a list of dicts, one per point: the swept values (pressure_bar,
+diameter_mm, width_mm, load_n, load_pct, speed_kmh), the load_n and speed_kmh evaluated at when not swept, rrc,
+rr_force_n, rr_power_w, deflection_m, and the car's kwh_per_10km or l_per_100km. A range leaving the
 model's domain stops with a warning and returns the valid points.)");
 
   m.def("tyre_fit", &api_tyre_fit, "size"_a, py::kw_only(), "points"_a = py::none(), "label"_a = py::none(),

@@ -170,6 +170,29 @@ TEST_F(Hardening, UnreadableFileSaysSo) {
   EXPECT_TRUE(has(r.err, tyre + ": cannot be read: Permission denied")) << r.err;
 }
 
+// A name longer than the system allows (NAME_MAX, 255 bytes on Linux) made std::filesystem's status query throw:
+// the run ended with "filesystem error: status: File name too long" and exit 1, and the fuzzer found it through a
+// vehicle file's tyre name (session 13). Each place a name is looked up now reports it as not found, exit 2.
+TEST_F(Hardening, ANameTooLongForTheSystemIsNotFoundNotASystemError) {
+  const std::string long_name(300, 'a');
+  const std::string vehicle = write("v.yaml", slurp(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/ev.yaml"));
+  std::string text = slurp(vehicle);
+  const auto at = text.find("tyres:");
+  ASSERT_NE(at, std::string::npos);
+  text = text.substr(0, at) + "tyres:\n  all: " + long_name + "\n" + text.substr(text.find("powertrain:"));
+  const std::string with_long_tyre = write("long_tyre.yaml", text);
+  const fs::path manifest = dir_ / "fleet.csv";
+  std::ofstream(manifest) << "vehicle,recording\nev," << long_name << "\n";
+  for (const std::string& args : {"simulate --vehicle " + long_name, "simulate --vehicle ev --tyre " + long_name,
+                                  "simulate --vehicle ev --cycle " + long_name, "simulate --vehicle '" + with_long_tyre + "'",
+                                  "compare --vehicle ev --catalogue " + long_name, "diagnose --fleet '" + manifest.string() + "'"}) {
+    const CmdResult r = run_rollsim(args);
+    EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.err;
+    EXPECT_FALSE(has(r.err, "filesystem error")) << args << "\n" << r.err;
+    EXPECT_TRUE(has(r.err, "not found") || has(r.err, "no such file") || has(r.err, "not a folder")) << args << "\n" << r.err;
+  }
+}
+
 // A recording is bounded before it is loaded: by its size in bytes and by its number of samples.
 TEST_F(Hardening, OversizedRecordingIsRejectedEarly) {
   const std::string big = write("big.csv", "time_s,speed_kmh,battery_power_kw\n");

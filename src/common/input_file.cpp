@@ -10,6 +10,16 @@
 
 namespace rollsim {
 
+bool is_regular_file_path(const std::filesystem::path& path) {
+  std::error_code ec;
+  return std::filesystem::is_regular_file(path, ec);
+}
+
+bool is_folder_path(const std::filesystem::path& path) {
+  std::error_code ec;
+  return std::filesystem::is_directory(path, ec);
+}
+
 std::string read_input_file(const std::string& path, std::uintmax_t max_bytes) {
   namespace fs = std::filesystem;
   std::error_code ec;

@@ -239,11 +239,10 @@ std::string resolve_data_file(const std::string& name, const std::string& shippe
     if (!extension.empty()) candidates.push_back(shipped / (name + extension));
   }
   for (const auto& c : candidates) {
-    if (fs::is_regular_file(c)) return c.string();
+    if (is_regular_file_path(c)) return c.string();
   }
   // A folder given by name: say so rather than "not found".
-  std::error_code ec;
-  if (fs::is_directory(fs::path(name), ec)) throw InputError(option + " '" + name + "'", "is a folder; a file is expected here");
+  if (is_folder_path(fs::path(name))) throw InputError(option + " '" + name + "'", "is a folder; a file is expected here");
   throw InputError(option + " '" + name + "'",
                    "file not found (looked in the current folder and in " + shipped.string() + ")");
 }

@@ -8,6 +8,7 @@
 
 #include "rollsim/common/csv.hpp"
 #include "rollsim/common/error.hpp"
+#include "rollsim/common/input_file.hpp"
 #include "rollsim/common/units.hpp"
 #include "rollsim/common/yaml_reader.hpp"
 
@@ -117,8 +118,8 @@ DriveCycle load_cycle(const std::string& name_or_path, const std::string& option
     return read_cycle_csv(resolve_data_file(key, "cycles", ".csv", option), key);
   }
   namespace fs = std::filesystem;
-  if (fs::is_directory(name_or_path)) throw InputError(option + " '" + name_or_path + "'", "is a folder; a file is expected here");
-  if (!fs::is_regular_file(name_or_path)) {
+  if (is_folder_path(name_or_path)) throw InputError(option + " '" + name_or_path + "'", "is a folder; a file is expected here");
+  if (!is_regular_file_path(name_or_path)) {
     std::string list;
     for (std::size_t i = 0; i < names.size(); ++i) list += (i ? ", " : "") + names[i];
     throw InputError(option + " '" + name_or_path + "'",

@@ -11,6 +11,7 @@
 #include "rollsim/common/csv.hpp"
 #include "rollsim/common/error.hpp"
 #include "rollsim/common/format.hpp"
+#include "rollsim/common/input_file.hpp"
 #include "rollsim/common/statistics.hpp"
 #include "rollsim/common/yaml_reader.hpp"
 #include "rollsim/report/table.hpp"
@@ -30,7 +31,7 @@ std::vector<std::string> split_list(const std::string& cell) {
 std::string resolve(const std::string& cell, const std::filesystem::path& dir, const char* shipped, const char* ext,
                     const std::string& where) {
   const std::filesystem::path beside = dir / cell;
-  if (std::filesystem::is_regular_file(beside)) return beside.string();
+  if (is_regular_file_path(beside)) return beside.string();
   try {
     return resolve_data_file(cell, shipped, ext, where);
   } catch (const InputError& e) {
@@ -64,7 +65,7 @@ FleetManifest read_fleet_manifest(const std::string& path) {
     const std::string vehicle_path = resolve(cell(vehicle), dir, "vehicles", ".yaml", where(vehicle));
     const std::string tyre_path = cell(tyre).empty() ? "" : resolve(cell(tyre), dir, "tyres", ".yaml", where(tyre));
     const std::filesystem::path rec = dir / cell(recording);
-    if (!std::filesystem::is_regular_file(rec))
+    if (!is_regular_file_path(rec))
       throw InputError(where(recording), "file '" + rec.string() + "' not found");
     FleetRecording fr{rec.string(), {}, t.row_line[r]};
     try {

@@ -20,9 +20,11 @@ CandidateList load_candidates(const std::vector<std::string>& tyres, bool use_ca
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) throw InputError("--catalogue " + dir, "not a folder");
   std::vector<std::string> files;
-  for (const auto& e : fs::directory_iterator(dir)) {
-    if (e.path().extension() == ".yaml" || e.path().extension() == ".yml") files.push_back(e.path().string());
+  // Non-throwing iteration: a folder that cannot be listed is a named input error, not a system exception.
+  for (fs::directory_iterator it(dir, ec), end; it != end; it.increment(ec)) {
+    if (it->path().extension() == ".yaml" || it->path().extension() == ".yml") files.push_back(it->path().string());
   }
+  if (ec) throw InputError("--catalogue " + dir, "cannot be listed: " + ec.message());
   std::sort(files.begin(), files.end());
   if (files.empty()) throw InputError("--catalogue " + dir, "holds no *.yaml tyre files");
   for (const auto& f : files) {

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "rollsim/common/error.hpp"
+#include "rollsim/common/input_file.hpp"
 #include "rollsim/common/yaml_reader.hpp"
 
 namespace rollsim {
@@ -14,7 +15,7 @@ std::string resolve_tyre_path(const std::string& name, const std::string& vehicl
   namespace fs = std::filesystem;
   const fs::path beside = fs::path(vehicle_file).parent_path() / name;
   for (const fs::path& p : {beside, fs::path(beside.string() + ".yaml")})
-    if (fs::is_regular_file(p)) return p.string();
+    if (is_regular_file_path(p)) return p.string();
   try {
     return resolve_data_file(name, "tyres", ".yaml", where);
   } catch (const InputError&) {

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <filesystem>
 #include <string>
 
 namespace rollsim {
@@ -16,5 +17,11 @@ inline constexpr std::uintmax_t kMaxCsvFileBytes = 256u << 20;
 /// The whole content of `path`. Throws InputError naming the path for each way it cannot be input: not
 /// found, a folder, not a regular file, not readable (with the system's reason), larger than `max_bytes`.
 std::string read_input_file(const std::string& path, std::uintmax_t max_bytes);
+
+/// Whether `path` is a regular file, or a folder. False for every way it cannot be one, including a name the system
+/// refuses (longer than NAME_MAX, say), where std::filesystem's throwing queries would end the run with a system
+/// error instead of the caller's named "not found".
+bool is_regular_file_path(const std::filesystem::path& path);
+bool is_folder_path(const std::filesystem::path& path);
 
 }  // namespace rollsim
