@@ -159,6 +159,24 @@ TEST(HysteresisModel, AWhatIfOnTheSizeActsThroughTheDeflection) {
   EXPECT_EQ(with_geometry(thesis, wider).hysteresis.reference_deflection_m, 0.0);
 }
 
+// A file's exponents extrapolate without limit: deflection and load exponents of 5 give RRC 0.46 at 1.5 times the
+// reference load, which the model returned as a number (and simulate and sweep used) before session 13. Beyond 0.1
+// it is a domain error naming the level and the exponents; at the reference load the same file is fine.
+TEST(HysteresisModel, ALevelNoTyreReachesIsADomainErrorNotANumber) {
+  TyreState t = hysteresis_tyre();
+  t.hysteresis.deflection_exponent = t.hysteresis.load_exponent = 5.0;
+  check_hysteresis_constants(t.hysteresis);
+  EXPECT_NO_THROW(evaluate_rolling_resistance(t, t.hysteresis.reference_load_n, 20.0));
+  try {
+    evaluate_rolling_resistance(t, 1.5 * t.hysteresis.reference_load_n, 20.0);
+    ADD_FAILURE() << "no domain error";
+  } catch (const ModelDomainError& e) {
+    EXPECT_NE(std::string(e.what()).find("beyond 0.1"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("deflection 5, load 5"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(TyreAtLoad::prepare(t, 1.5 * t.hysteresis.reference_load_n), ModelDomainError);
+}
+
 // --- fitting: known truths ---
 
 TEST(TyreFit, RecoversEveryConstantFromASurfaceItGenerated) {

@@ -120,7 +120,7 @@ RollingResistance patch_result(const Patch& p, double outer_radius_m) {
 
 RollingResistance evaluate_hysteresis(const TyreState& tyre, double load_n, double speed_mps) {
   const Patch p = loaded_patch(tyre, load_n);
-  const SpeedPolynomial k = hysteresis_polynomial(tyre, load_n);
+  const SpeedPolynomial k = checked_hysteresis_polynomial(tyre, load_n);
   const double r = tyre.geometry.outer_radius_m;
   RollingResistance out = patch_result(p, r);
   if (speed_mps > 0.0) {  // standstill: no rolling loss, as in the thesis model
@@ -180,7 +180,7 @@ RollingResistance evaluate_rolling_resistance(const TyreState& tyre, double load
 TyreAtLoad TyreAtLoad::prepare(const TyreState& tyre, double load_n) {
   check_operating_point(tyre, load_n, 0.0);
   if (tyre.model == TyreModelKind::Hysteresis) {
-    const SpeedPolynomial k = hysteresis_polynomial(tyre, load_n);
+    const SpeedPolynomial k = checked_hysteresis_polynomial(tyre, load_n);
     TyreAtLoad t;
     t.k0_ = k.k0;
     t.k1_s_per_m_ = k.k1_s_per_m;
