@@ -193,6 +193,18 @@ TEST_F(Hardening, ANameTooLongForTheSystemIsNotFoundNotASystemError) {
   }
 }
 
+// A tyre file whose constants give a level no tyre has (a Coulomb damping of 10 MN: RRC 423) kept the car standing
+// while the driver demanded full power, and simulate ground on for minutes (over 100 s before session 13). It is now
+// a domain error at once, naming the axle, the tyre's file and the constants.
+TEST_F(Hardening, ATyreNoCarCouldMoveOnIsRefusedAtOnce) {
+  const std::string tyre = write("sticky.yaml", "name: sticky\nsize: \"205/55 R16 91V\"\npressure_bar: 2.1\n"
+                                                "model:\n  coulomb_damping_n: 1e7\n");
+  const CmdResult r = run_rollsim("simulate --vehicle ev --tyre '" + tyre + "'");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_TRUE(has(r.err, "front tyre 'sticky' (" + tyre + ")")) << r.err;
+  EXPECT_TRUE(has(r.err, "coulomb_damping_n 10000000")) << r.err;
+}
+
 // A recording is bounded before it is loaded: by its size in bytes and by its number of samples.
 TEST_F(Hardening, OversizedRecordingIsRejectedEarly) {
   const std::string big = write("big.csv", "time_s,speed_kmh,battery_power_kw\n");

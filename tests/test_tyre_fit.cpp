@@ -159,10 +159,10 @@ TEST(HysteresisModel, AWhatIfOnTheSizeActsThroughTheDeflection) {
   EXPECT_EQ(with_geometry(thesis, wider).hysteresis.reference_deflection_m, 0.0);
 }
 
-// A file's exponents extrapolate without limit: deflection and load exponents of 5 give RRC 0.46 at 1.5 times the
+// A file's constants extrapolate without limit: deflection and load exponents of 5 give RRC 0.46 at 1.5 times the
 // reference load, which the model returned as a number (and simulate and sweep used) before session 13. Beyond 0.1
 // it is a domain error naming the level and the exponents; at the reference load the same file is fine.
-TEST(HysteresisModel, ALevelNoTyreReachesIsADomainErrorNotANumber) {
+TEST(TyreModels, ALevelNoTyreReachesIsADomainErrorNotANumber) {
   TyreState t = hysteresis_tyre();
   t.hysteresis.deflection_exponent = t.hysteresis.load_exponent = 5.0;
   check_hysteresis_constants(t.hysteresis);
@@ -175,6 +175,13 @@ TEST(HysteresisModel, ALevelNoTyreReachesIsADomainErrorNotANumber) {
     EXPECT_NE(std::string(e.what()).find("deflection 5, load 5"), std::string::npos) << e.what();
   }
   EXPECT_THROW(TyreAtLoad::prepare(t, 1.5 * t.hysteresis.reference_load_n), ModelDomainError);
+  // The same bound holds for the thesis model's constants: a Coulomb damping of 10 MN gave RRC 423.
+  TyreState thesis = hysteresis_tyre();
+  thesis.model = TyreModelKind::Thesis;
+  EXPECT_NO_THROW(TyreAtLoad::prepare(thesis, 4000.0));
+  thesis.constants.coulomb_damping_n = 1e7;
+  EXPECT_THROW(TyreAtLoad::prepare(thesis, 4000.0), ModelDomainError);
+  EXPECT_THROW(evaluate_rolling_resistance(thesis, 4000.0, 20.0), ModelDomainError);
 }
 
 // --- fitting: known truths ---

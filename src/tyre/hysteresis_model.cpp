@@ -9,9 +9,6 @@
 
 namespace rollsim {
 
-namespace {
-constexpr double kMaxHysteresisRrc = 0.1;  // as rrc_ref's own bound in check_hysteresis_constants
-}  // namespace
 
 double hysteresis_reference_deflection_m(const TyreState& tyre) {
   const HysteresisConstants& c = tyre.hysteresis;
@@ -37,22 +34,6 @@ SpeedPolynomial hysteresis_polynomial(const TyreState& tyre, double load_n) {
   return p;
 }
 
-SpeedPolynomial checked_hysteresis_polynomial(const TyreState& tyre, double load_n) {
-  const SpeedPolynomial p = hysteresis_polynomial(tyre, load_n);
-  const HysteresisConstants& c = tyre.hysteresis;
-  const double hysteresis = p.k0;
-  // The exponents extrapolate: a file's constants at a load or pressure far from their data can give any level.
-  // Beyond 0.1 (100 kg/t, ten times a production tyre's) it is the constants, not a tyre, that speak.
-  if (!(hysteresis <= kMaxHysteresisRrc)) {
-    throw ModelDomainError("the hysteresis model's RRC " + format_value(hysteresis) + " at " + format_value(load_n) +
-                           " N and " + format_value(units::pa_to_bar(tyre.pressure_pa)) + " bar is beyond " +
-                           format_value(kMaxHysteresisRrc) + " (no pneumatic tyre loses that much): its exponents " +
-                           "(deflection " + format_value(c.deflection_exponent) + ", load " + format_value(c.load_exponent) +
-                           ") extrapolate too far from the reference point");
-  }
-  return p;
-}
-
 void check_hysteresis_constants(const HysteresisConstants& c) {
   auto fail = [](const std::string& name, double v, const std::string& allowed) {
     throw ModelDomainError("hysteresis constant " + name + " = " + format_value(v) + ": " + allowed);
@@ -63,7 +44,7 @@ void check_hysteresis_constants(const HysteresisConstants& c) {
     fail("reference load [N]", c.reference_load_n, "must be > 0");
   if (!(c.reference_deflection_m >= 0.0) || !std::isfinite(c.reference_deflection_m))
     fail("reference deflection [m]", c.reference_deflection_m, "must be >= 0 (0: the tyre's own)");
-  if (!(c.rrc_ref > 0.0 && c.rrc_ref <= kMaxHysteresisRrc)) fail("rrc_ref", c.rrc_ref, "must be in (0, 0.1]");
+  if (!(c.rrc_ref > 0.0 && c.rrc_ref <= kMaxRrc)) fail("rrc_ref", c.rrc_ref, "must be in (0, 0.1]");
   // Loss grows with deflection (strain amplitude): a negative exponent would have RRC rise with pressure.
   if (!(c.deflection_exponent >= 0.0 && c.deflection_exponent <= 5.0))
     fail("deflection_exponent", c.deflection_exponent, "must be in [0, 5]");

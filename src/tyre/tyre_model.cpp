@@ -107,6 +107,23 @@ void check_operating_point(const TyreState& tyre, double load_n, double speed_mp
 
 namespace {
 
+// Past kMaxRrc it is the constants that extrapolate: name them, so the user sees which to mend.
+void check_rrc_level(double rrc, const TyreState& tyre, double load_n, const std::string& what) {
+  if (rrc <= kMaxRrc) return;
+  std::string constants;
+  if (tyre.model == TyreModelKind::Hysteresis) {
+    constants = "exponents (deflection " + v(tyre.hysteresis.deflection_exponent) + ", load " +
+                v(tyre.hysteresis.load_exponent) + ")";
+  } else {
+    const auto& c = tyre.constants;
+    constants = "damping constants (coulomb_damping_n " + v(c.coulomb_damping_n) + ", viscous_damping_ns_per_m " +
+                v(c.viscous_damping_ns_per_m) + ", rotational_drag_kg_per_m2 " + v(c.rotational_drag_kg_per_m2) + ")";
+  }
+  throw ModelDomainError(what + " " + v(rrc) + " at " + v(load_n) + " N and " + v(units::pa_to_bar(tyre.pressure_pa)) +
+                         " bar is beyond " + v(kMaxRrc) + " (no pneumatic tyre loses that much): the model's " +
+                         constants + " are outside any tyre's");
+}
+
 // The loaded-patch figures both models report.
 RollingResistance patch_result(const Patch& p, double outer_radius_m) {
   RollingResistance out;
@@ -120,7 +137,7 @@ RollingResistance patch_result(const Patch& p, double outer_radius_m) {
 
 RollingResistance evaluate_hysteresis(const TyreState& tyre, double load_n, double speed_mps) {
   const Patch p = loaded_patch(tyre, load_n);
-  const SpeedPolynomial k = checked_hysteresis_polynomial(tyre, load_n);
+  const SpeedPolynomial k = hysteresis_polynomial(tyre, load_n);
   const double r = tyre.geometry.outer_radius_m;
   RollingResistance out = patch_result(p, r);
   if (speed_mps > 0.0) {  // standstill: no rolling loss, as in the thesis model
@@ -129,6 +146,7 @@ RollingResistance evaluate_hysteresis(const TyreState& tyre, double load_n, doub
     out.rrc_rotational_drag = k.k2_s2_per_m2 * speed_mps * speed_mps;
   }
   out.rrc = out.rrc_coulomb + out.rrc_viscous + out.rrc_rotational_drag;
+  check_rrc_level(std::max(out.rrc, k.k0), tyre, load_n, "RRC");
   out.offset_e_m = out.rrc * r;
   out.rr_force_n = out.rrc * load_n;
   out.rr_power_w = out.rr_force_n * speed_mps;
@@ -174,13 +192,15 @@ RollingResistance evaluate_rolling_resistance(const TyreState& tyre, double load
   out.rrc_rotational_drag = m_drag / f_total / r;
   out.rr_force_n = out.rrc * load_n;
   out.rr_power_w = out.rr_force_n * speed_mps;
+  check_rrc_level(out.rrc, tyre, load_n, "RRC");
   return out;
 }
 
 TyreAtLoad TyreAtLoad::prepare(const TyreState& tyre, double load_n) {
   check_operating_point(tyre, load_n, 0.0);
   if (tyre.model == TyreModelKind::Hysteresis) {
-    const SpeedPolynomial k = checked_hysteresis_polynomial(tyre, load_n);
+    const SpeedPolynomial k = hysteresis_polynomial(tyre, load_n);
+    check_rrc_level(k.k0, tyre, load_n, "RRC level (as the speed goes to 0)");
     TyreAtLoad t;
     t.k0_ = k.k0;
     t.k1_s_per_m_ = k.k1_s_per_m;
@@ -197,6 +217,7 @@ TyreAtLoad TyreAtLoad::prepare(const TyreState& tyre, double load_n) {
   t.k0_ = c.coulomb_damping_n / c.elements * s.coulomb_m * per_nr;
   t.k1_s_per_m_ = c.viscous_damping_ns_per_m / c.elements * s.viscous_m * per_nr;
   t.k2_s2_per_m2_ = 2.0 * std::numbers::pi * r * tyre.geometry.section_width_m * c.rotational_drag_kg_per_m2 * per_nr;
+  check_rrc_level(t.k0_, tyre, load_n, "RRC level (as the speed goes to 0)");
   t.load_n_ = load_n;
   return t;
 }

@@ -274,8 +274,8 @@ class TyreRoadLoad final : public RoadLoadModel {
   TyreRoadLoad(const Vehicle& v) : body_(v.body), front_(*v.front_tyre), rear_(*v.rear_tyre) {}
   RoadLoadCoeffs at_grade(double grade) const override {
     const auto loads = wheel_loads(body_, grade);
-    const auto f = TyreAtLoad::prepare(front_.state, loads.front_n);
-    const auto r = TyreAtLoad::prepare(rear_.state, loads.rear_n);
+    const auto f = prepare(front_, loads.front_n, "front");
+    const auto r = prepare(rear_, loads.rear_n, "rear");
     RoadLoadCoeffs c;
     c.rolling_f0_n = 2.0 * (f.k0() * loads.front_n + r.k0() * loads.rear_n);
     c.rolling_f1_n_s_per_m = 2.0 * (f.k1_s_per_m() * loads.front_n + r.k1_s_per_m() * loads.rear_n);
@@ -289,6 +289,15 @@ class TyreRoadLoad final : public RoadLoadModel {
   }
 
  private:
+  // A tyre outside its model's domain at this car's load is named with its axle and file.
+  static TyreAtLoad prepare(const TyreSpec& tyre, double load_n, const char* axle) {
+    try {
+      return TyreAtLoad::prepare(tyre.state, load_n);
+    } catch (const ModelDomainError& e) {
+      throw ModelDomainError(std::string(axle) + " tyre '" + tyre.name + "' (" + tyre.source + "): " + e.what());
+    }
+  }
+
   BodyParams body_;
   TyreSpec front_, rear_;
 };

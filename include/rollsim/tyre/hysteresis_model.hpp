@@ -18,11 +18,6 @@ double hysteresis_reference_deflection_m(const TyreState& tyre);
 /// The hysteresis model's polynomial (HysteresisConstants). Assumes check_operating_point passed.
 SpeedPolynomial hysteresis_polynomial(const TyreState& tyre, double load_n);
 
-/// hysteresis_polynomial for a tyre in use (evaluations, simulations): throws ModelDomainError when the level at
-/// this load and pressure is beyond any tyre's (0.1), where the constants extrapolate too far. Fits call the
-/// unchecked one, whose trial steps may pass through such levels.
-SpeedPolynomial checked_hysteresis_polynomial(const TyreState& tyre, double load_n);
-
 /// Checks the hysteresis constants (positive level and reference point, finite exponents, RRC > 0 at all
 /// speeds); throws ModelDomainError naming the constant and what is allowed.
 void check_hysteresis_constants(const HysteresisConstants& c);

@@ -85,6 +85,11 @@ struct RollingResistance {
   double rr_power_w = 0.0;         ///< rr_force_n * V
 };
 
+/// The largest RRC either model may give (100 kg/t, ten times a production tyre's). A file's constants can
+/// extrapolate past it (a damping or an exponent far from any tyre's); beyond it they, not a tyre, speak, so an
+/// evaluation or a prepared tyre there is a ModelDomainError naming them.
+inline constexpr double kMaxRrc = 0.1;
+
 /// Vertical stiffness of the constant-belt model [N/m].
 double vertical_stiffness_n_per_m(const TyreState& tyre);
 
