@@ -80,6 +80,13 @@ TEST(Fleet, ABadColumnMappingNamesTheManifestAndTheGroupsLine) {
   EXPECT_NE(r.err.find("badcol.csv: group 'bad' (line 3)"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("No Such Column"), std::string::npos) << r.err;
   EXPECT_TRUE(r.out.empty()) << r.out;
+  // A recording read without its preset lacks the canonical columns: the hint names the manifest's way to map them,
+  // not only --column, which --fleet does not take (session 13).
+  const std::string twizy = kRecordings + "rsk_renault_twizy/T2_04_26_2021.csv";
+  const auto n = test::run_rollsim("diagnose --fleet '" + write_manifest("nopreset.csv", "vehicle,recording\ntwizy," + twizy + "\n") + "'");
+  EXPECT_NE(n.exit_code, 0);
+  EXPECT_NE(n.err.find("missing required column 'time_s'"), std::string::npos) << n.err;
+  EXPECT_NE(n.err.find("in a fleet manifest: its columns or preset column"), std::string::npos) << n.err;
 }
 
 TEST(Fleet, PerRecordingOptionsAreRefusedNotIgnored) {
