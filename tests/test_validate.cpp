@@ -664,6 +664,15 @@ TEST(CamryArgonne, CutOffEntriesMatchTheMeasuredFuelFlow) {
   }
 }
 
+// The list's first `lines` lines (its header and lines - 1 rows) written to `to`.
+std::filesystem::path first_lines_of_list(const std::filesystem::path& to, int lines) {
+  std::ifstream in(kList);
+  std::ofstream out(to);
+  std::string line;
+  for (int i = 0; i < lines && std::getline(in, line); ++i) out << line << "\n";
+  return to;
+}
+
 TEST(CliValidate, JsonRowsAndANamedErrorForAFileWithoutTheColumns) {
   const auto dir = test::temp_dir();
   const auto bad = dir / "not_epa.csv";
@@ -686,13 +695,7 @@ TEST(CliValidate, JsonRowsAndANamedErrorForAFileWithoutTheColumns) {
   EXPECT_NE(e.err.find("no test rows"), std::string::npos) << e.err;
   EXPECT_TRUE(e.out.empty()) << e.out;
   // The list's first 40 rows: one JSON object per row, simulated or skipped.
-  const auto part = dir / "first_rows.csv";
-  {
-    std::ifstream in(kList);
-    std::ofstream out(part);
-    std::string line;
-    for (int i = 0; i < 41 && std::getline(in, line); ++i) out << line << "\n";
-  }
+  const auto part = first_lines_of_list(dir / "first_rows.csv", 41);
   const auto j = test::run_rollsim("validate --json --threads 2 --epa-test-car-list " + part.string());
   ASSERT_EQ(j.exit_code, 0) << j.err;
   const auto rows = test::lines(j.out);
@@ -716,13 +719,7 @@ TEST(CliValidate, JsonRowsAndANamedErrorForAFileWithoutTheColumns) {
   EXPECT_EQ(s.out.find("(0 rows)"), std::string::npos) << s.out;
   // The list's first two rows are one model's, so one half has nothing to judge: it says so instead of "0 of 0
   // (0.0 %)" (session 13).
-  const auto two = dir / "first_two.csv";
-  {
-    std::ifstream in(kList);
-    std::ofstream out(two);
-    std::string line;
-    for (int i = 0; i < 3 && std::getline(in, line); ++i) out << line << "\n";
-  }
+  const auto two = first_lines_of_list(dir / "first_two.csv", 3);
   const auto t = test::run_rollsim("validate --epa-test-car-list " + two.string());
   ASSERT_EQ(t.exit_code, 0) << t.err;
   EXPECT_NE(t.out.find("simulated 0 of 0 FTP-75, HWFET, US06 and charge-depleting rows (none in this half)"),

@@ -5,10 +5,8 @@
 #include <string>
 
 #include "rollsim/common/error.hpp"
-#include "rollsim/common/units.hpp"
 
 namespace rollsim {
-
 
 double hysteresis_reference_deflection_m(const TyreState& tyre) {
   const HysteresisConstants& c = tyre.hysteresis;
