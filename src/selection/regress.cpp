@@ -79,6 +79,8 @@ std::vector<RegressOutcome> run_baseline(const Baseline& b) {
   return out;
 }
 
+std::string baseline_value_text(double value) { return significant(value, 6); }
+
 std::string baseline_yaml(const Baseline& b, const std::vector<RegressOutcome>& outcomes) {
   std::ostringstream y;
   y << "# Energy regression baseline for `rollsim regress` (forward simulation). Each case: the car, the tyre fitted\n"
@@ -93,7 +95,7 @@ std::string baseline_yaml(const Baseline& b, const std::vector<RegressOutcome>& 
       << "    tyre: " << c.tyre << "\n"
       << "    cycle: " << c.cycle << "\n"
       << "    unit: " << c.unit << "\n"
-      << "    expected: " << significant(value, 6) << "\n"
+      << "    expected: " << baseline_value_text(value) << "\n"
       << "    tolerance_pct: " << significant(c.tolerance_pct, 6) << "\n";
   }
   return y.str();

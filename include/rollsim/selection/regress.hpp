@@ -38,4 +38,7 @@ std::vector<RegressOutcome> run_baseline(const Baseline& baseline);
 /// The baseline text with every expected value replaced by the actual one (comments: how to regenerate).
 std::string baseline_yaml(const Baseline& baseline, const std::vector<RegressOutcome>& outcomes);
 
+/// A baseline value as the file writes it (six significant digits): an update changes a case only when this does.
+std::string baseline_value_text(double value);
+
 }  // namespace rollsim::selection
