@@ -252,7 +252,7 @@ SkipReason check_configuration(const EpaTestRow& r, std::string& detail) {
   if (*r.road_c_n_s2_per_m2 <= 0.0 || *r.road_c_n_s2_per_m2 > 4.0)
     return absurd(detail, "target C [N s^2/m^2]", *r.road_c_n_s2_per_m2, "0-4");
   for (double v_mps : {2.0, 10.0, 20.0, kRoadLoadPowerSpeed_mps, 30.0, 40.0}) {
-    const double f_n = *r.road_a_n + v_mps * (*r.road_b_n_s_per_m + v_mps * *r.road_c_n_s2_per_m2);
+    const double f_n = target_road_load_n(r, v_mps);
     if (f_n <= 0.0 || f_n > 5000.0) return absurd(detail, "target road load at " + format_value(units::mps_to_kmh(v_mps)) + " km/h [N]", f_n, "0-5000 N");
   }
   if (!r.rated_power_w) return missing(detail, "Rated Horsepower");

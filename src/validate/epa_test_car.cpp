@@ -68,10 +68,13 @@ const char* missing_derived_field(const EpaTestRow& row) {
   return nullptr;
 }
 
+double target_road_load_n(const EpaTestRow& row, double speed_mps) {
+  return *row.road_a_n + speed_mps * (*row.road_b_n_s_per_m + speed_mps * *row.road_c_n_s2_per_m2);
+}
+
 EpaTestRow result_configuration(const EpaTestRow& row) {
   if (!row.derived || missing_derived_field(row) || !row.road_a_n || !row.road_b_n_s_per_m || !row.road_c_n_s2_per_m2) return row;
-  const double v = kRoadLoadPowerSpeed_mps;
-  const double tested_power_w = (*row.road_a_n + v * (*row.road_b_n_s_per_m + v * *row.road_c_n_s2_per_m2)) * v;
+  const double tested_power_w = target_road_load_n(row, kRoadLoadPowerSpeed_mps) * kRoadLoadPowerSpeed_mps;
   if (!(tested_power_w > 0.0)) return row;
   EpaTestRow r = row;
   r.test_mass_kg = row.derived->test_mass_kg;

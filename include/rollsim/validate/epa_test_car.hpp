@@ -65,6 +65,9 @@ struct EpaTestRow {
   std::optional<DerivedConfiguration> derived;
 };
 
+/// The row's target road load [N] at `speed_mps`, A + B v + C v^2; the row must hold all three coefficients.
+double target_road_load_n(const EpaTestRow& row, double speed_mps);
+
 /// EPA's road-load horsepower is the target road load's power at this speed, 50 mph.
 inline constexpr double kRoadLoadPowerSpeed_mps = 50.0 * units::kMpsPerMph;
 
