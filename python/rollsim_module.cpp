@@ -169,6 +169,7 @@ py::list api_compare(py::object vehicle, std::vector<std::string> tyres, py::obj
     py::gil_scoped_release released;
     cmp = selection::compare_tyres(v, list.tyres, c, copt);
   }
+  for (const auto& w : selection::trace_warnings(cmp)) warn(w);
   py::list out;
   for (const auto& j : selection::comparison_json(cmp)) out.append(from_json(j.str()));
   return out;
@@ -203,6 +204,7 @@ py::list api_sweep(py::object tyre, std::vector<py::tuple> axes, py::object load
     warn(*r.stopped + " (the " + std::to_string(r.points.size()) + " valid points of " +
          std::to_string(r.planned_points) + " are returned)");
   }
+  if (const std::string w = selection::sweep_trace_warning(r); !w.empty()) warn(w);
   py::list out;
   for (const auto& j : selection::sweep_json(r)) out.append(from_json(j.str()));
   return out;
@@ -379,7 +381,8 @@ columns: time_s, speed_kmh, rolling_force_n, battery_power_kw, ...; empty with t
 vehicle: file, shipped name or dict; tyres: files or shipped names; catalogue: a folder of tyre files (used when
 given, or when tyres is empty: the shipped tyres/catalogue); diameter_tolerance_pct [%]. Returns a list of dicts,
 the fitting tyres ranked best first (rank 1..), then the unfit ones (rank None, with the reason). Broken catalogue
-files are skipped with a warning.)");
+files are skipped with a warning. followed_trace is False (with max_deficit_kmh [km/h] and a warning) where the car
+could not follow the cycle on that tyre: its figure is then for a slower drive.)");
 
   m.def("sweep", &api_sweep, "tyre"_a, "axes"_a, py::kw_only(), "load_n"_a = py::none(), "speed_kmh"_a = 80.0,
         "vehicle"_a = py::none(), "cycle"_a = "nedc", "threads"_a = py::none(),
@@ -390,7 +393,8 @@ width [mm], load [N], load-pct [%], speed [km/h]; steps default 11. load_n [N] (
 load), speed_kmh [km/h]. With vehicle (and cycle) each point is a forward simulation of the car (on `threads`
 threads, default every core). Returns a list of dicts, one per point: the swept values (pressure_bar,
 diameter_mm, width_mm, load_n, load_pct, speed_kmh), the load_n and speed_kmh evaluated at when not swept, rrc,
-rr_force_n, rr_power_w, deflection_m, and the car's kwh_per_10km or l_per_100km. A range leaving the
+rr_force_n, rr_power_w, deflection_m, and the car's kwh_per_10km or l_per_100km with followed_trace (False, and a
+warning, where the car could not follow the cycle). A range leaving the
 model's domain stops with a warning and returns the valid points.)");
 
   m.def("tyre_fit", &api_tyre_fit, "size"_a, py::kw_only(), "points"_a = py::none(), "label"_a = py::none(),

@@ -16,6 +16,7 @@
 #include "rollsim/common/yaml_reader.hpp"
 #include "rollsim/selection/common.hpp"
 #include "rollsim/selection/compare.hpp"
+#include "rollsim/selection/front_end.hpp"
 #include "rollsim/selection/regress.hpp"
 #include "rollsim/selection/sensitivity.hpp"
 #include "rollsim/selection/sweep.hpp"
@@ -168,6 +169,64 @@ TEST(SelectionCompare, OversizeAndOverloadedTyresAreMarkedNotRanked) {
   EXPECT_EQ(c.unfit[1].tyre.name, "weak");
   EXPECT_TRUE(has(c.unfit[1].fit.reason, "load")) << c.unfit[1].fit.reason;
   EXPECT_TRUE(has(c.unfit[1].fit.reason, "capacity")) << c.unfit[1].fit.reason;
+}
+
+namespace {
+
+// A trace that ramps to `top_kmh` at 2 m/s^2, holds it for 60 s and stops: nothing beyond a car's top speed.
+DriveCycle cruise_at(double top_kmh) {
+  DriveCycle c;
+  c.name = "cruise";
+  const double top_mps = units::kmh_to_mps(top_kmh);
+  const double ramp_s = std::ceil(top_mps / 2.0);
+  for (double t = 0.0; t <= 2.0 * ramp_s + 60.0; t += 1.0) {
+    const double v = t < ramp_s ? 2.0 * t : t < ramp_s + 60.0 ? top_mps : std::max(0.0, top_mps - 2.0 * (t - ramp_s - 60.0));
+    c.time_s.push_back(t);
+    c.speed_mps.push_back(std::min(v, top_mps));
+    c.grade.push_back(0.0);
+  }
+  return c;
+}
+
+}  // namespace
+
+TEST(SelectionCompare, AFigureOfACarThatFellBehindTheCycleSaysSo) {
+  // The EV's motor turns at most 10390 rpm through a 7.94 reduction on a 0.305 m wheel: 150.4 km/h, whatever
+  // its power. On a 200 km/h cruise it must fall at least 200 - 150.4 km/h behind, on every tyre; on NEDC (120 km/h
+  // at most) it follows on every tyre. Before, compare ranked both alike and said nothing.
+  const Vehicle ev = vehicle("ev");
+  const double kinematic_top_kmh = units::mps_to_kmh(10390.0 * 2.0 * M_PI / 60.0 / 7.94 * 0.305);
+  CompareOptions o;
+  o.diameter_tolerance_pct = 10.0;
+  const Comparison fast = compare_tyres(ev, {tyre("low-rrc")}, cruise_at(200.0), o);
+  ASSERT_EQ(fast.ranked.size(), 2u);
+  for (const auto& r : fast.ranked) {
+    EXPECT_FALSE(r.followed_trace) << r.tyre.name;
+    EXPECT_GE(units::mps_to_kmh(r.max_deficit_mps), 200.0 - kinematic_top_kmh - 0.5) << r.tyre.name;
+  }
+  const auto warnings = trace_warnings(fast);
+  ASSERT_EQ(warnings.size(), 2u);
+  EXPECT_TRUE(has(warnings[0], "could not follow cruise")) << warnings[0];
+  EXPECT_TRUE(has(warnings[0], "slower drive")) << warnings[0];
+  bool json_says = false;
+  for (const auto& j : comparison_json(fast)) json_says = json_says || has(j.str(), "\"followed_trace\": false");
+  EXPECT_TRUE(json_says);
+
+  const Comparison nedc = compare_tyres(ev, {tyre("low-rrc")}, load_cycle("nedc"), o);
+  for (const auto& r : nedc.ranked) {
+    EXPECT_TRUE(r.followed_trace) << r.tyre.name;
+    EXPECT_DOUBLE_EQ(r.max_deficit_mps, 0.0);
+  }
+  EXPECT_TRUE(trace_warnings(nedc).empty());
+
+  // The sweep and the sensitivities run the same figure and carry the same flag.
+  const SweepResult swept = sweep_vehicle(ev, tyre("nominal"), cruise_at(200.0), one_axis(SweepParam::Pressure, 2.0, 3.0, 2));
+  ASSERT_EQ(swept.points.size(), 2u);
+  for (const auto& p : swept.points) EXPECT_FALSE(p.followed_trace);
+  EXPECT_TRUE(has(sweep_trace_warning(swept), "at 2 of 2 points")) << sweep_trace_warning(swept);
+  EXPECT_TRUE(has(sweep_csv(swept), ",no\n"));
+  EXPECT_FALSE(vehicle_sensitivity(ev, tyre("nominal"), cruise_at(200.0), 4000.0, 80 / 3.6).followed_trace);
+  EXPECT_TRUE(vehicle_sensitivity(ev, tyre("nominal"), load_cycle("nedc"), 4000.0, 80 / 3.6).followed_trace);
 }
 
 TEST(SelectionCompare, LoadCapacityGrowsWithPressureUpToTheRating) {

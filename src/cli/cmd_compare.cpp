@@ -55,6 +55,7 @@ void print_table(const selection::Comparison& c, bool replay) {
   for (std::size_t i = 0; i < c.ranked.size(); ++i) row(c.ranked[i], std::to_string(i + 1));
   for (const auto& r : c.unfit) row(r, "-");
   std::cout << t.render();
+  for (const auto& w : selection::trace_warnings(c)) std::cout << "WARNING: " << w << "\n";
   if (c.shows_range) {
     std::cout << "own tyre: " << fixed(c.own_value, 4) << " " << unit << ", range "
               << fixed(c.own_range_km, 1) << " km; range column: gained (+) or lost (-) km\n";
@@ -69,7 +70,7 @@ void print_json(const selection::Comparison& c) {
 void print_csv(const selection::Comparison& c, bool header) {
   if (header) {
     std::cout << "vehicle,cycle,rank,tyre,size,pressure_bar,rrc_80kmh,rr_power_80kmh_w,value,unit,diff_pct,range_km,"
-                 "range_change_km,fits,reason\n";
+                 "range_change_km,fits,reason,followed_trace,max_deficit_kmh\n";
   }
   auto q = [](const std::string& s) {
     std::string o = "\"";
@@ -83,7 +84,8 @@ void print_csv(const selection::Comparison& c, bool header) {
               << fixed(r.value, 5) << "," << c.unit << "," << fixed(r.diff_pct, 3) << ","
               << (c.shows_range ? fixed(r.range_km, 2) : "") << ","
               << (c.shows_range ? fixed(r.range_change_km, 2) : "") << "," << (r.fit.fits ? "yes" : "no") << ","
-              << q(r.fit.reason) << "\n";
+              << q(r.fit.reason) << "," << (r.followed_trace ? "yes" : "no") << ","
+              << fixed(units::mps_to_kmh(r.max_deficit_mps), 2) << "\n";
   };
   for (std::size_t i = 0; i < c.ranked.size(); ++i) emit(c.ranked[i], static_cast<int>(i + 1));
   for (const auto& r : c.unfit) emit(r, 0);
@@ -113,6 +115,10 @@ void run_compare(const CompareOptionsText& o, const ProcessGroup& group) {
       if (o.json) print_json(cmp);
       else if (o.csv) print_csv(cmp, csv_header);
       else print_table(cmp, o.replay);
+      // The table carries the warnings; beside machine-readable output they go to stderr, not lost in a field.
+      if (o.json || o.csv) {
+        for (const auto& w : selection::trace_warnings(cmp)) std::cerr << "warning: " << w << "\n";
+      }
       csv_header = false;
     }
   }

@@ -19,6 +19,10 @@ struct SensitivityOptionsText {
   bool json = false;
 };
 
+constexpr const char* trace_warning =
+    "the car could not follow the cycle in the base run or a perturbed one: the energy elasticities mix the "
+    "tyre's effect with a change of the drive itself";
+
 std::string value_text(const selection::SensitivityRow& r) {
   switch (r.parameter) {
     case TyreParameter::OuterDiameter:
@@ -68,7 +72,9 @@ void run_sensitivity(const SensitivityOptionsText& o) {
     JsonObject j;
     j.add("tyre", s.tyre).add("load_n", s.load_n).add("speed_kmh", units::mps_to_kmh(s.speed_mps))
         .add("relative_step", s.relative_step).add("rr_power_w", s.rr_power_w);
-    if (vehicle) j.add("vehicle", s.vehicle).add("cycle", s.cycle).add(s.energy_unit, s.energy);
+    if (vehicle) {
+      j.add("vehicle", s.vehicle).add("cycle", s.cycle).add(s.energy_unit, s.energy).add("followed_trace", s.followed_trace);
+    }
     for (const auto& r : s.rows) {
       j.add("elasticity_rr_power_" + r.key, r.power_elasticity);
       if (r.energy_elasticity) j.add("elasticity_" + s.energy_unit + "_" + r.key, *r.energy_elasticity);
@@ -76,6 +82,7 @@ void run_sensitivity(const SensitivityOptionsText& o) {
     j.add("dominant_rr_power", s.dominant_power);
     if (vehicle) j.add("dominant_energy", s.dominant_energy);
     std::cout << j.str() << "\n";
+    if (vehicle && !s.followed_trace) std::cerr << "warning: " << trace_warning << "\n";
     return;
   }
   std::cout << "Sensitivity of tyre " << s.tyre << " at " << fixed(s.load_n, 0) << " N, "
@@ -104,6 +111,7 @@ void run_sensitivity(const SensitivityOptionsText& o) {
   if (vehicle) {
     std::cout << "(car: load = test mass, all wheel loads scaled together; diameter also changes the gearing)\n";
   }
+  if (vehicle && !s.followed_trace) std::cout << "WARNING: " << trace_warning << "\n";
 }
 
 }  // namespace

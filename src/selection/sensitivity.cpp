@@ -46,7 +46,9 @@ Sensitivity vehicle_sensitivity(const Vehicle& vehicle, const TyreSpec& tyre, co
   s.energy_unit = energy_unit(vehicle);
   Vehicle base = vehicle;
   fit_tyres(base, tyre);
-  s.energy = run_forward(base, cycle).value;
+  const EnergyFigure at_base = run_forward(base, cycle);
+  s.energy = at_base.value;
+  s.followed_trace = at_base.followed_trace;
   for (auto& row : s.rows) {
     double y[2];
     const double f[2] = {1.0 + h, 1.0 - h};
@@ -66,7 +68,9 @@ Sensitivity vehicle_sensitivity(const Vehicle& vehicle, const TyreSpec& tyre, co
         case TyreParameter::Speed: break;
       }
       fit_tyres(v, t);
-      y[k] = run_forward(v, cycle).value;
+      const EnergyFigure e = run_forward(v, cycle);
+      y[k] = e.value;
+      s.followed_trace = s.followed_trace && e.followed_trace;
     }
     // d ln y / d ln x by central differences in ln x, consistent with explain_tyre.
     row.energy_elasticity = std::log(y[0] / y[1]) / std::log(f[0] / f[1]);

@@ -246,13 +246,18 @@ SweepResult sweep_vehicle(const Vehicle& vehicle, const TyreSpec& tyre, const Dr
       p.rr = evaluate_rolling_resistance(ps.tyre.state, ps.load_n, units::kmh_to_mps(ps.speed_kmh));
       Vehicle v = vehicle;
       fit_tyres(v, ps.tyre);
-      p.energy = run_model(VehicleModel::with_tyres_of(base, v), cycle, o.replay).value;
+      const EnergyFigure e = run_model(VehicleModel::with_tyres_of(base, v), cycle, o.replay);
+      p.energy = e.value;
+      p.followed_trace = e.followed_trace;
+      p.max_deficit_mps = e.max_deficit_mps;
     } catch (const std::exception& e) {
       error = e.what();
     }
     std::string bytes;
     put(bytes, p.rr);
     put(bytes, p.energy);
+    put(bytes, p.followed_trace);
+    put(bytes, p.max_deficit_mps);
     put(bytes, error);
     return bytes;
   };
@@ -264,6 +269,8 @@ SweepResult sweep_vehicle(const Vehicle& vehicle, const TyreSpec& tyre, const Dr
     std::string_view in = results[i];
     take(in, p.rr);
     take(in, p.energy);
+    take(in, p.followed_trace);
+    take(in, p.max_deficit_mps);
     take(in, error);
     if (!error.empty()) {
       r.stopped = stop_message(o.axes, pts[i], error, r.points);
@@ -292,19 +299,33 @@ std::vector<std::pair<std::string, double>> sweep_point_columns(const SweepResul
   return out;
 }
 
+std::string sweep_trace_warning(const SweepResult& r) {
+  std::size_t behind = 0;
+  double worst_mps = 0.0;
+  for (const auto& p : r.points) {
+    behind += p.followed_trace ? 0 : 1;
+    worst_mps = std::max(worst_mps, p.max_deficit_mps);
+  }
+  if (behind == 0) return {};
+  return "at " + std::to_string(behind) + " of " + std::to_string(r.points.size()) +
+         " points the car could not follow the cycle" +
+         (worst_mps > 0.0 ? " (up to " + fixed(units::mps_to_kmh(worst_mps), 1) + " km/h behind)" : "") +
+         ": their figures (followed_trace no) are for a slower drive than the cycle's";
+}
+
 std::string sweep_csv(const SweepResult& r) {
   std::ostringstream out;
   SweepPoint names_only;  // the header needs no point: a sweep that stopped at its first still has one
   names_only.values.resize(r.axes.size());
   for (const auto& [name, value] : sweep_point_columns(r, names_only)) out << name << ",";
   out << "rrc,rr_force_n,rr_power_w,deflection_m";
-  if (r.vehicle) out << "," << r.energy_unit;
+  if (r.vehicle) out << "," << r.energy_unit << ",followed_trace";
   out << "\n";
   for (const auto& p : r.points) {
     for (const auto& [name, value] : sweep_point_columns(r, p)) out << format_value(value) << ",";
     out << fixed(p.rr.rrc, 7) << "," << fixed(p.rr.rr_force_n, 4) << "," << fixed(p.rr.rr_power_w, 3) << ","
         << fixed(p.rr.deflection_m, 6);
-    if (r.vehicle) out << "," << fixed(p.energy, 5);
+    if (r.vehicle) out << "," << fixed(p.energy, 5) << "," << (p.followed_trace ? "yes" : "no");
     out << "\n";
   }
   return out.str();

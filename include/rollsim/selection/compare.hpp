@@ -43,6 +43,8 @@ struct CandidateResult {
   double diff_pct = 0.0;          ///< relative to the own tyre, + = uses more
   double range_km = 0.0;          ///< battery-only cars
   double range_change_km = 0.0;   ///< battery-only cars, + = gains range
+  bool followed_trace = true;     ///< false: the car fell behind the cycle on this tyre (EnergyFigure)
+  double max_deficit_mps = 0.0;   ///< how far behind, at worst
 };
 
 /// One vehicle on one cycle: the fitting tyres ranked best first, then the unfit ones (unranked, same order as given).

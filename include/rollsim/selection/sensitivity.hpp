@@ -31,6 +31,9 @@ struct Sensitivity {
   std::vector<SensitivityRow> rows;       ///< diameter, width, pressure, load
   std::string vehicle, cycle, energy_unit;  ///< vehicle mode
   double energy = 0.0;                    ///< vehicle mode: energy/fuel at the base point
+  /// Vehicle mode: false when the car fell behind the cycle in the base run or a perturbed one; the energy
+  /// elasticities then mix the tyre's effect with a change of the drive itself.
+  bool followed_trace = true;
   std::string dominant_power;             ///< name of the parameter with the largest |power elasticity|
   std::string dominant_energy;            ///< same for energy (vehicle mode)
 };

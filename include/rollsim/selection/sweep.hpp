@@ -58,6 +58,8 @@ struct SweepPoint {
   double speed_kmh = 0.0;
   RollingResistance rr;                ///< the tyre at (load, speed)
   double energy = 0.0;                 ///< vehicle sweeps: kWh/10 km or l/100 km
+  bool followed_trace = true;          ///< vehicle sweeps: false where the car fell behind (EnergyFigure)
+  double max_deficit_mps = 0.0;        ///< vehicle sweeps: how far behind, at worst
 };
 
 struct SweepResult {
@@ -69,6 +71,10 @@ struct SweepResult {
   /// Set when the sweep left the model's domain: the point where it stopped and why.
   std::optional<std::string> stopped;
 };
+
+/// Vehicle sweeps: a warning when the car fell behind the cycle at some points (their figures are for a slower
+/// drive and do not compare with the others'), or empty.
+std::string sweep_trace_warning(const SweepResult& result);
 
 /// The tyre with one parameter set (user units); load/speed parameters leave the tyre unchanged.
 TyreSpec with_parameter(const TyreSpec& tyre, SweepParam p, double value);
