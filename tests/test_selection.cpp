@@ -219,6 +219,16 @@ TEST(SelectionCompare, AFigureOfACarThatFellBehindTheCycleSaysSo) {
   }
   EXPECT_TRUE(trace_warnings(nedc).empty());
 
+  // A replay keeps to the trace: it cannot fall behind, and says instead that it left out the unmet demand.
+  o.replay = true;
+  const Comparison replayed = compare_tyres(ev, {tyre("low-rrc")}, cruise_at(200.0), o);
+  for (const auto& r : replayed.ranked) {
+    EXPECT_FALSE(r.followed_trace) << r.tyre.name;
+    EXPECT_DOUBLE_EQ(r.max_deficit_mps, 0.0);
+  }
+  ASSERT_EQ(trace_warnings(replayed).size(), 2u);
+  EXPECT_TRUE(has(trace_warnings(replayed)[0], "leaves out the demand")) << trace_warnings(replayed)[0];
+
   // The sweep and the sensitivities run the same figure and carry the same flag.
   const SweepResult swept = sweep_vehicle(ev, tyre("nominal"), cruise_at(200.0), one_axis(SweepParam::Pressure, 2.0, 3.0, 2));
   ASSERT_EQ(swept.points.size(), 2u);

@@ -307,10 +307,13 @@ std::string sweep_trace_warning(const SweepResult& r) {
     worst_mps = std::max(worst_mps, p.max_deficit_mps);
   }
   if (behind == 0) return {};
-  return "at " + std::to_string(behind) + " of " + std::to_string(r.points.size()) +
-         " points the car could not follow the cycle" +
-         (worst_mps > 0.0 ? " (up to " + fixed(units::mps_to_kmh(worst_mps), 1) + " km/h behind)" : "") +
-         ": their figures (followed_trace no) are for a slower drive than the cycle's";
+  const std::string where = "at " + std::to_string(behind) + " of " + std::to_string(r.points.size()) + " points ";
+  // Forward runs fall behind; a replay keeps to the trace and leaves out what the powertrain could not give.
+  return worst_mps > 0.0 ? where + "the car could not follow the cycle (up to " +
+                               fixed(units::mps_to_kmh(worst_mps), 1) +
+                               " km/h behind): their figures (followed_trace no) are for a slower drive than the cycle's"
+                         : where + "the cycle asks more than the car's powertrain gives: the replay's figures "
+                                   "(followed_trace no) leave out the demand it could not meet";
 }
 
 std::string sweep_csv(const SweepResult& r) {
