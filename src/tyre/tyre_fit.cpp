@@ -369,7 +369,8 @@ std::string sigma_source(const TyreFit& fit) {
 void write_fitted_tyre_yaml(std::ostream& out, const FittedTyreFile& file, const TyreFit& fit) {
   const HysteresisConstants& h = fit.tyre.hysteresis;
   out << "# Written by 'rollsim tyre fit': hysteresis model fitted to " << fit.residuals.size()
-      << " point(s), RMS relative error " << num(fit.rms_relative_error * 100.0) << " %.\n";
+      << " point(s), RMS relative error " << fixed(fit.rms_relative_error * 100.0, 2)
+      << " %.\n";  // as the command prints it: an exact fit reads 0.00, not its rounding noise
   out << "# 95 % intervals (Jacobian covariance, relative scatter " << num(fit.sigma_relative * 100.0) << " % "
       << sigma_source(fit) << "):\n";
   for (const auto& e : fit.params) {
