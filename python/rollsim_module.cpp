@@ -310,6 +310,7 @@ py::dict api_tyre_fit(const std::string& size, py::object points, py::object lab
   }
   const TyreFitPlan plan = plan_tyre_fit(in);
   const TyreFit fit = fit_hysteresis(plan.start, plan.request);
+  for (const auto& w : fit.warnings) warn(w);
   FittedTyreFile file;
   file.name = name;
   file.size = size;

@@ -723,3 +723,15 @@ TEST(TyreFileModel, ThesisIsTheDefaultAndHysteresisNeedsItsLevel) {
   EXPECT_THROW(load_tyre_file(write("y.yaml", base + "model:\n  rrc_ref: 0.008\n")), InputError);  // thesis kind
   EXPECT_THROW(load_tyre_file(write("z.yaml", base + "model: magic\n")), InputError);
 }
+
+// Two points whose force falls with load (10 kg/t at 3 kN, 5 kg/t at 6 kN: 30 N both, a little less at 6 kN in the
+// fitted law) contradict every measured tyre; the fit says so. A pair whose force grows as Z^0.95, the J2452 sets'
+// median, does not draw the warning (before session 14 neither did).
+TEST(TyreFit, AForceFallingWithLoadIsSaid) {
+  const TyreFit bad = fit_two_points({210e3, 3000.0, 80 / 3.6, 0.010, "a"}, {210e3, 6000.0, 80 / 3.6, 0.005, "b"});
+  ASSERT_EQ(bad.warnings.size(), 1u);
+  EXPECT_NE(bad.warnings[0].find("falls with load"), std::string::npos) << bad.warnings[0];
+  const double rrc_6kn = 0.010 * std::pow(2.0, 0.95 - 1.0);
+  const TyreFit good = fit_two_points({210e3, 3000.0, 80 / 3.6, 0.010, "a"}, {210e3, 6000.0, 80 / 3.6, rrc_6kn, "b"});
+  EXPECT_TRUE(good.warnings.empty());
+}

@@ -250,6 +250,7 @@ void run_fit(const FitOptions& o) {
   in.free = parse_free(o.free);
   const TyreFitPlan plan = plan_tyre_fit(in);
   const TyreFit fit = fit_hysteresis(plan.start, plan.request);
+  for (const auto& w : fit.warnings) std::cerr << "warning: " << w << "\n";
 
   FittedTyreFile file;
   file.name = o.name.empty() ? std::filesystem::path(o.output).stem().string() : o.name;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iterator>
+#include <optional>
 #include <set>
 #include <string>
 #include <utility>
@@ -241,6 +242,31 @@ std::vector<HysteresisParam> identifiable_params(const std::vector<RrcPoint>& po
   return out;
 }
 
+namespace {
+
+// The RR force's log-slope against load at the reference point (80 km/h): every measured set rises with load
+// (J2452 load exponents 0.89-1.09). Not held as a bound, because the load and the deflection exponents share it;
+// a fit whose force falls with load is said, since the points then contradict every measured tyre.
+std::optional<std::string> force_falling_with_load(const TyreFit& fit) {
+  const bool load_free = std::any_of(fit.params.begin(), fit.params.end(), [](const ParamEstimate& e) {
+    return e.param == HysteresisParam::LoadExponent || e.param == HysteresisParam::SpeedLossLoadExponent;
+  });
+  if (!load_free) return std::nullopt;
+  const HysteresisConstants& h = fit.tyre.hysteresis;
+  const double speed_mps = units::kmh_to_mps(80.0), step = 1.1;
+  auto force_n = [&](double load_n) {
+    return load_n * model_rrc(fit.tyre, {h.reference_pressure_pa, load_n, speed_mps, 0.0, ""});
+  };
+  const double slope = std::log(force_n(h.reference_load_n * step) / force_n(h.reference_load_n / step)) /
+                       std::log(step * step);
+  if (slope > 0.0) return std::nullopt;
+  return "the fitted rolling-resistance force falls with load (log-slope " + fixed(slope, 2) + " at " +
+         fixed(h.reference_load_n, 0) + " N, " + fixed(h.reference_pressure_pa / 1e3, 0) +
+         " kPa, 80 km/h), where every measured tyre's rises (the nine Michelin J2452 sets: 0.89-1.09): check the points' loads and RRCs";
+}
+
+}  // namespace
+
 TyreFit fit_hysteresis(const TyreState& start_in, const FitRequest& r) {
   std::vector<HysteresisParam> free = r.free.empty() ? identifiable_params(r.points) : r.free;
   check_request(r, free);
@@ -273,6 +299,7 @@ TyreFit fit_hysteresis(const TyreState& start_in, const FitRequest& r) {
         fit.params.push_back({p, 0.0, 0.0, 0.0, 0.0, true});
         fit.held.erase(std::find(fit.held.begin(), fit.held.end(), p));
       }
+      if (const auto w = force_falling_with_load(fit)) fit.warnings.push_back(*w);
       return fit;
     }
   }

@@ -68,6 +68,8 @@ struct TyreFit {
   int degrees_of_freedom = 0;                 ///< points - free parameters
   double sigma_relative = 0.0;                ///< relative measurement scatter used for the intervals
   bool sigma_from_residuals = false;          ///< false: the assumed uncertainty (see sigma_source)
+  /// What the points made of the tyre that no measured tyre does (the front ends print them as warnings).
+  std::vector<std::string> warnings;
 };
 
 /// Where the fit's scatter comes from, for its reports: "from the residuals", or why it is the assumed one.
