@@ -140,6 +140,18 @@ class SelectionApi(unittest.TestCase):
         expected, _, _ = cli("compare", "--vehicle", "ev", "--tyre", "low-rrc", "--tyre", "175-65R15", "--json")
         self.assertEqual(rollsim.compare("ev", tyres=["low-rrc", "175-65R15"]), expected)
 
+    def test_compare_warns_when_the_car_cannot_follow_the_cycle(self):
+        # ev.yaml's motor allows 150 km/h; a 200 km/h cruise leaves it behind on every tyre.
+        time_s = np.arange(0.0, 161.0)
+        speed_kmh = np.minimum(200.0, 2.0 * 3.6 * time_s)
+        speed_kmh[-30:] = np.linspace(200.0, 0.0, 30)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            rows = rollsim.compare("ev", tyres=["175-65R15"], cycle=(time_s, speed_kmh))
+        self.assertTrue(all(not r["followed_trace"] and r["max_deficit_kmh"] > 40.0 for r in rows), rows)
+        self.assertEqual(sum("could not follow" in str(w.message) for w in caught), len(rows))
+        self.assertTrue(all(r["followed_trace"] for r in rollsim.compare("ev", tyres=["175-65R15"])))
+
     def test_sweep_matches_cli(self):
         expected, _, _ = cli("sweep", "--tyre", "175-70R14", "--param", "pressure", "--from", "1.5", "--to", "3.5",
                              "--steps", "5", "--param", "speed", "--from", "40", "--to", "120", "--steps", "3",
