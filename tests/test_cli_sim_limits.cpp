@@ -53,6 +53,21 @@ TEST_F(SimLimitsCli, EmptyBatteryIsReportedWithTimeAndDistance) {
   EXPECT_TRUE(has(nedc.out, "\"battery_empty\": false")) << nedc.out;
 }
 
+// Several runs share one table, where the single run's warnings are not printed: each run whose figures are not the
+// trace's (the car fell behind, its battery ran empty) is named under the table (before session 14 only the
+// "max err" column hinted at it, while "diff %" compared drives 34-55 km/h apart).
+TEST_F(SimLimitsCli, ATableOfRunsNamesEachRunWhoseFiguresAreNotTheTraces) {
+  const std::string fast = write("fast.csv", "time_s,speed_kmh\n0,0\n30,200\n120,200\n160,0\n");
+  const auto out = run_rollsim("simulate --vehicle ev --tyre nominal --tyre 175-65R15 --cycle nedc --cycle " + fast);
+  ASSERT_EQ(out.exit_code, 0) << out.err;
+  EXPECT_TRUE(has(out.out, "WARNING: fast, nominal: the car could not follow the trace, falling up to ")) << out.out;
+  EXPECT_TRUE(has(out.out, "WARNING: fast, 175-65R15: the car could not follow")) << out.out;
+  EXPECT_FALSE(has(out.out, "WARNING: nedc")) << out.out;
+  const auto empty = run_rollsim("simulate --vehicle ev --cycle nedc --cycle " + repeated_nedc(73));
+  ASSERT_EQ(empty.exit_code, 0) << empty.err;
+  EXPECT_TRUE(has(empty.out, "WARNING: nedc_many, nominal: the usable battery ran empty after ")) << empty.out;
+}
+
 // A standstill-only trace: the car did not move, so per-distance figures are undefined and said to be, never
 // inf or NaN; the JSON has null for them.
 TEST_F(SimLimitsCli, StandstillOnlyTraceSaysPerDistanceFiguresAreUndefined) {

@@ -98,6 +98,11 @@ void run_simulate(const SimulateOptions& o) {
   }
   std::cout << base.name << " (" << (o.replay ? "replay" : "forward") << " simulation)\n" << t.render();
   std::cout << "diff %: against the first tyre on the same cycle\n";
+  for (const auto& run : runs) {
+    for (const auto& c : report::run_caveats(run.result)) {
+      std::cout << "WARNING: " << run.result.cycle << ", " << run.tyre_label << ": " << c << "\n";
+    }
+  }
 }
 
 }  // namespace

@@ -17,6 +17,11 @@ std::vector<std::pair<std::string, double>> energy_terms_kwh(const SimulationRes
 /// closure, tracking error and shortfalls; with `solver_stats`, CVODE's counters.
 std::string summary_text(const SimulationResult& r, bool solver_stats);
 
+/// One line per thing that makes a run's figures differ from the trace's own: the car fell behind it (or, in a
+/// replay, could not deliver it), or the usable battery ran empty; empty when neither. For tables of several runs,
+/// where the summary's own warnings are not printed.
+std::vector<std::string> run_caveats(const SimulationResult& r);
+
 /// JSON with at least distance_km, aec_kwh_per_10km (electric), fuel_l_per_100km (combustion), co2_g_per_km,
 /// energy_breakdown_kwh, max_speed_error_kmh.
 JsonObject to_json(const SimulationResult& r, const std::string& tyre_label);
