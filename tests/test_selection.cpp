@@ -206,7 +206,7 @@ TEST(SelectionCompare, AFigureOfACarThatFellBehindTheCycleSaysSo) {
   }
   const auto warnings = trace_warnings(fast);
   ASSERT_EQ(warnings.size(), 2u);
-  EXPECT_TRUE(has(warnings[0], "could not follow cruise")) << warnings[0];
+  EXPECT_TRUE(has(warnings[0], "on nominal (own), cruise: the car could not follow the trace")) << warnings[0];
   EXPECT_TRUE(has(warnings[0], "slower drive")) << warnings[0];
   bool json_says = false;
   for (const auto& j : comparison_json(fast)) json_says = json_says || has(j.str(), "\"followed_trace\": false");
@@ -227,7 +227,7 @@ TEST(SelectionCompare, AFigureOfACarThatFellBehindTheCycleSaysSo) {
     EXPECT_DOUBLE_EQ(r.max_deficit_mps, 0.0);
   }
   ASSERT_EQ(trace_warnings(replayed).size(), 2u);
-  EXPECT_TRUE(has(trace_warnings(replayed)[0], "leaves out the demand")) << trace_warnings(replayed)[0];
+  EXPECT_TRUE(has(trace_warnings(replayed)[0], "leave out the demand")) << trace_warnings(replayed)[0];
 
   // The sweep and the sensitivities run the same figure and carry the same flag.
   const SweepResult swept = sweep_vehicle(ev, tyre("nominal"), cruise_at(200.0), one_axis(SweepParam::Pressure, 2.0, 3.0, 2));

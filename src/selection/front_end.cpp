@@ -8,6 +8,7 @@
 #include "rollsim/common/format.hpp"
 #include "rollsim/common/units.hpp"
 #include "rollsim/common/yaml_reader.hpp"
+#include "rollsim/report/simulation_report.hpp"
 
 namespace rollsim::selection {
 
@@ -80,15 +81,8 @@ std::vector<std::string> trace_warnings(const Comparison& c) {
   std::vector<std::string> out;
   auto check = [&](const CandidateResult& r) {
     if (!r.simulated || r.followed_trace) return;
-    const std::string on = "on " + r.tyre.name + (r.is_own ? " (own)" : "");
-    // Forward runs fall behind; a replay keeps to the trace and leaves out what the powertrain could not give.
-    out.push_back(r.max_deficit_mps > 0.0
-                      ? on + " the car could not follow " + c.cycle + ", falling up to " +
-                            fixed(units::mps_to_kmh(r.max_deficit_mps), 1) +
-                            " km/h behind: its figure is for a slower drive than the cycle's and does not compare with "
-                            "a run that followed"
-                      : on + " " + c.cycle + " asks more than the car's powertrain gives: the replay's figure leaves "
-                             "out the demand it could not meet and does not compare with a run that met it");
+    out.push_back("on " + r.tyre.name + (r.is_own ? " (own)" : "") + ", " + c.cycle + ": " +
+                  report::shortfall_caveat(r.max_deficit_mps));
   };
   for (const auto& r : c.ranked) check(r);
   for (const auto& r : c.unfit) check(r);

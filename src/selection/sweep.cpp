@@ -10,6 +10,7 @@
 #include "rollsim/common/error.hpp"
 #include "rollsim/common/parallel.hpp"
 #include "rollsim/common/units.hpp"
+#include "rollsim/report/simulation_report.hpp"
 #include "rollsim/report/table.hpp"
 #include "rollsim/selection/common.hpp"
 
@@ -307,13 +308,8 @@ std::string sweep_trace_warning(const SweepResult& r) {
     worst_mps = std::max(worst_mps, p.max_deficit_mps);
   }
   if (behind == 0) return {};
-  const std::string where = "at " + std::to_string(behind) + " of " + std::to_string(r.points.size()) + " points ";
-  // Forward runs fall behind; a replay keeps to the trace and leaves out what the powertrain could not give.
-  return worst_mps > 0.0 ? where + "the car could not follow the cycle (up to " +
-                               fixed(units::mps_to_kmh(worst_mps), 1) +
-                               " km/h behind): their figures (followed_trace no) are for a slower drive than the cycle's"
-                         : where + "the cycle asks more than the car's powertrain gives: the replay's figures "
-                                   "(followed_trace no) leave out the demand it could not meet";
+  return "at " + std::to_string(behind) + " of " + std::to_string(r.points.size()) +
+         " points (followed_trace no): " + report::shortfall_caveat(worst_mps);
 }
 
 std::string sweep_csv(const SweepResult& r) {
