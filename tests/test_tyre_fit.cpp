@@ -645,6 +645,11 @@ TEST(CliTyreFit, BadInputGetsOneNamedErrorAndNoFile) {
       {"--size '205/55 R16 91V' --j2452 -0.4,0.9,0.1", {"--j2452", "expected ALPHA,BETA,A,B,C"}},
       {"--size '205/55 R16 91V' --point 210,4000,0,0.009", {"--point", "speed 0 km/h"}},
       {"--size '205/55 R16 91V' --point 0.009 --free rrc_ref,bogus", {"--free", "bogus"}},
+      // A light-truck (C2) size has neither the passenger ISO point nor the C1 label bands (before session 14 it
+      // got both, and a file at 2.1 bar).
+      {"--size 'LT245/75R16 120/116S' --label C", {"--label C", "light-truck", "C2"}},
+      {"--size 'LT245/75R16 120/116S' --point 0.008", {"--point 0.008", "light-truck"}},
+      {"--size 'LT245/75R16 120/116S' --point 450,9000,80,0.008", {"--pressure-bar", "light-truck"}},
   };
   for (const auto& c : cases) {
     const CmdResult r = fit(c.args + o);
