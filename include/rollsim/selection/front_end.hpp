@@ -28,8 +28,8 @@ std::string tyre_size_text(const TyreSpec& tyre);
 /// One object per tyre: the ranked ones best first, then the unfit ones (rank null).
 std::vector<JsonObject> comparison_json(const Comparison& comparison);
 
-/// One message per simulated tyre on which the car could not follow the cycle, saying that its figure is for a
-/// slower drive (no "warning:" prefix: each front end adds its own); empty when every run followed.
+/// One message per simulated tyre on which the car could not follow the cycle, saying what its figure measured
+/// instead (report::shortfall_caveat; no "warning:" prefix: each front end adds its own); empty when all followed.
 std::vector<std::string> trace_warnings(const Comparison& comparison);
 
 /// A sweep as given: one --param, --from, --to (and optionally --steps) per axis; numbers as text.

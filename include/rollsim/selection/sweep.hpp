@@ -72,8 +72,8 @@ struct SweepResult {
   std::optional<std::string> stopped;
 };
 
-/// Vehicle sweeps: a warning when the car fell behind the cycle at some points (their figures are for a slower
-/// drive and do not compare with the others'), or empty.
+/// Vehicle sweeps: a warning naming how many points could not follow the cycle and what their figures measured
+/// instead (report::shortfall_caveat), or empty.
 std::string sweep_trace_warning(const SweepResult& result);
 
 /// The tyre with one parameter set (user units); load/speed parameters leave the tyre unchanged.
