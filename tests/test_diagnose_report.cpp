@@ -411,3 +411,33 @@ TEST(DiagnoseReportCli, CamryRecordingsGiveAReportAndAnUnwritableDirFailsFirst) 
 
 }  // namespace
 }  // namespace rollsim
+
+namespace rollsim {
+
+// A finding that fits nothing (the residual left above the noise floor) has no held-out figures: the text prints
+// none for it and the JSON has null, where both printed "0.000 -> 0.000" (session 14, on the Camry's own
+// recordings); a fitted finding keeps its line and numbers.
+TEST(DiagnoseReport, AFindingThatFitsNothingPrintsNoHeldOutFigures) {
+  Diagnosis d;
+  d.verdict = "missing_physics";
+  Finding residual;
+  residual.effect = "unexplained";
+  residual.parameters.push_back({"residual_to_noise_variance_ratio", "1", 3.3, 3.3, 3.3});
+  Finding fitted;
+  fitted.effect = "aux_load";
+  fitted.parameters.push_back({"power_w", "W", 500.0, 400.0, 600.0});
+  fitted.energy_share_pct = 2.0;
+  fitted.heldout_rmse_before_j = 10e3, fitted.heldout_rmse_after_j = 7.5e3;
+  fitted.heldout_scored = true;
+  d.findings = {residual, fitted};
+  const std::string text = diagnosis_text(d);
+  std::size_t lines = 0;
+  for (std::size_t at = text.find("held-out RMSE"); at != std::string::npos; at = text.find("held-out RMSE", at + 1)) ++lines;
+  EXPECT_EQ(lines, 1u) << text;
+  EXPECT_NE(text.find("held-out RMSE 10.000 -> 7.500 kJ/window"), std::string::npos) << text;
+  const std::string json = diagnosis_json(d);
+  EXPECT_NE(json.find("\"heldout_rmse_before\": null"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"heldout_rmse_before\": 10000"), std::string::npos) << json;
+}
+
+}  // namespace rollsim

@@ -192,6 +192,7 @@ void set_finding_metrics(Finding& f, const Model& before, const Eigen::VectorXd&
   f.heldout_energy_error_pct_after = energy_error_pct(after_pred, y);
   f.heldout_lag1_autocorrelation_before = lag1_autocorrelation(Eigen::VectorXd(y - before.heldout));
   f.heldout_lag1_autocorrelation_after = lag1_autocorrelation(Eigen::VectorXd(y - after_pred));
+  f.heldout_scored = true;
 }
 
 }  // namespace rollsim::diag

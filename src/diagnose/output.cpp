@@ -53,6 +53,8 @@ std::string diagnosis_json(const Diagnosis& d) {
   os << "  \"findings\": [";
   for (std::size_t i = 0; i < d.findings.size(); ++i) {
     const auto& f = d.findings[i];
+    // A finding that fitted nothing has no held-out figures: null, not the zeros its fields start at.
+    const auto scored = [&f](double x) { return f.heldout_scored ? num(x) : std::string("null"); };
     os << (i ? "," : "") << "\n    {\"effect\": \"" << f.effect << "\", ";
     if (!f.description.empty()) os << "\"description\": " << json_string(f.description) << ", ";
     os << "\"parameters\": {";
@@ -72,12 +74,12 @@ std::string diagnosis_json(const Diagnosis& d) {
       os << (k ? ", " : "") << json_string(f.separating_tests[k]);
     os << "], \"delta_bic\": " << num(f.delta_bic)
        << ", \"energy_share_pct\": " << (std::isnan(f.energy_share_pct) ? "null" : num(f.energy_share_pct))
-       << ", \"heldout_rmse_before\": " << num(f.heldout_rmse_before_j)
-       << ", \"heldout_rmse_after\": " << num(f.heldout_rmse_after_j)
-       << ", \"heldout_energy_error_pct_before\": " << num(f.heldout_energy_error_pct_before)
-       << ", \"heldout_energy_error_pct_after\": " << num(f.heldout_energy_error_pct_after)
-       << ", \"heldout_lag1_autocorrelation_before\": " << num(f.heldout_lag1_autocorrelation_before)
-       << ", \"heldout_lag1_autocorrelation_after\": " << num(f.heldout_lag1_autocorrelation_after);
+       << ", \"heldout_rmse_before\": " << scored(f.heldout_rmse_before_j)
+       << ", \"heldout_rmse_after\": " << scored(f.heldout_rmse_after_j)
+       << ", \"heldout_energy_error_pct_before\": " << scored(f.heldout_energy_error_pct_before)
+       << ", \"heldout_energy_error_pct_after\": " << scored(f.heldout_energy_error_pct_after)
+       << ", \"heldout_lag1_autocorrelation_before\": " << scored(f.heldout_lag1_autocorrelation_before)
+       << ", \"heldout_lag1_autocorrelation_after\": " << scored(f.heldout_lag1_autocorrelation_after);
     if (f.road_profile) {
       auto array = [&os](const char* key, const std::vector<double>& v) {
         os << "\"" << key << "\": [";
@@ -165,7 +167,8 @@ std::string diagnosis_text(const Diagnosis& d) {
          << *lo << " to " << *hi << " m from the start's (with its 95 % band in --json, road_profile)\n";
     }
     if (!std::isnan(f.energy_share_pct)) os << "    " << f.energy_share_pct << " % of the measured energy (in-sample)\n";
-    os << "    held-out RMSE " << f.heldout_rmse_before_j / 1e3 << " -> " << f.heldout_rmse_after_j / 1e3
+    if (f.heldout_scored)
+      os << "    held-out RMSE " << f.heldout_rmse_before_j / 1e3 << " -> " << f.heldout_rmse_after_j / 1e3
        << " kJ/window, trip energy error " << f.heldout_energy_error_pct_before << " -> " << f.heldout_energy_error_pct_after
        << " %, residual lag-1 autocorrelation " << f.heldout_lag1_autocorrelation_before << " -> "
        << f.heldout_lag1_autocorrelation_after << " (0: white)\n";

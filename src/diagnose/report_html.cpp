@@ -76,8 +76,10 @@ void findings_table(std::ostream& os, const Diagnosis& d) {
     os << "<tr><td>" << html_escape(f.effect) << "</td><td class=\"params\">";
     for (std::size_t k = 0; k < f.parameters.size(); ++k) os << (k ? "<br>" : "") << html_escape(parameter_text(f.parameters[k]));
     os << "</td>";
-    if (is_fitted(f))
-      os << "<td class=\"num\">" << fixed(f.energy_share_pct, 2) << " %</td><td class=\"num\">" << kj(f.heldout_rmse_before_j)
+    // A road profile is scored on held-out windows but is no single effect's energy: its share is a dash.
+    if (f.heldout_scored)
+      os << "<td class=\"num\">" << (is_fitted(f) ? fixed(f.energy_share_pct, 2) + " %" : std::string("&mdash;"))
+         << "</td><td class=\"num\">" << kj(f.heldout_rmse_before_j)
          << " &rarr; " << kj(f.heldout_rmse_after_j) << "</td><td class=\"num\">" << fixed(f.heldout_energy_error_pct_before, 2)
          << " &rarr; " << fixed(f.heldout_energy_error_pct_after, 2) << "</td><td class=\"num\">" << fixed(f.delta_bic, 1) << "</td>";
     else

@@ -463,6 +463,7 @@ std::optional<Finding> infer_road_profile(const SelectionContext& sc, const std:
   f.heldout_energy_error_pct_after = energy_error_pct(Eigen::VectorXd(pred + oof), sw.measured_j);
   f.heldout_lag1_autocorrelation_before = lag1_autocorrelation(r);
   f.heldout_lag1_autocorrelation_after = lag1_autocorrelation(Eigen::VectorXd(r - oof));
+  f.heldout_scored = true;
   f.road_profile = std::move(prof);
   m = extended(m, sig60, s);
   return f;

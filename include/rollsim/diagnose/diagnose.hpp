@@ -142,6 +142,9 @@ struct Finding {
   double heldout_energy_error_pct_before = 0.0, heldout_energy_error_pct_after = 0.0;
   /// Whiteness of the held-out window residual: its lag-1 autocorrelation (0 for white noise), before and after.
   double heldout_lag1_autocorrelation_before = 0.0, heldout_lag1_autocorrelation_after = 0.0;
+  /// The held-out figures above were computed: a fitted effect or road profile. A finding that fits nothing (the
+  /// residual left above the noise floor, a shape with the impossible sign) has none, and they are not printed.
+  bool heldout_scored = false;
   EffectParameters fitted;  ///< for --write-vehicle
   std::optional<RecoveredProfile> road_profile;  ///< road_profile findings: the profile itself
 };
