@@ -556,7 +556,7 @@ std::string bench_text(const BenchResult& r) {
       line(num(r.sparse_summary[t].threshold) + (static_cast<int>(t) == r.sparse_best ? " (best)" : ""), r.sparse_summary[t]);
     line("BIC per recording", r.sparse_bic_summary);
   }
-  os << "\n" << std::fixed << std::setprecision(1) << r.seconds << " s on " << r.threads << " threads\n" << std::defaultfloat;
+  os << "\n" << std::fixed << std::setprecision(1) << r.seconds << " s on " << r.threads << (r.threads == 1 ? " thread\n" : " threads\n") << std::defaultfloat;
   return os.str();
 }
 
