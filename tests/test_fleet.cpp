@@ -86,7 +86,9 @@ TEST(Fleet, ABadColumnMappingNamesTheManifestAndTheGroupsLine) {
   const auto n = test::run_rollsim("diagnose --fleet '" + write_manifest("nopreset.csv", "vehicle,recording\ntwizy," + twizy + "\n") + "'");
   EXPECT_NE(n.exit_code, 0);
   EXPECT_NE(n.err.find("missing required column 'time_s'"), std::string::npos) << n.err;
-  EXPECT_NE(n.err.find("in a fleet manifest: its columns or preset column"), std::string::npos) << n.err;
+  EXPECT_NE(n.err.find("map a source column to time_s in the manifest's columns cell (time_s=SOURCE) or with its preset"),
+            std::string::npos) << n.err;
+  EXPECT_EQ(n.err.find("--column"), std::string::npos) << n.err;
 }
 
 TEST(Fleet, PerRecordingOptionsAreRefusedNotIgnored) {

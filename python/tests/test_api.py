@@ -195,6 +195,14 @@ class DiagnoseApi(unittest.TestCase):
         self.assertEqual(got, expected)
         self.assertIn(got["verdict"], ("nothing_missing", "missing_physics", "unexplained"))
 
+    def test_a_missing_column_is_mapped_the_python_way(self):
+        # The hint names columns={...}, not the command line's --column, which Python has not got.
+        rec = str(SHARED / "data" / "recordings" / "rsk_renault_twizy" / "T1_07_01_2021.csv")
+        with self.assertRaises(rollsim.InputError) as caught:
+            rollsim.diagnose(vehicle="twizy", recordings=[rec])
+        self.assertIn("with columns={'time_s': SOURCE}", str(caught.exception))
+        self.assertNotIn("--column", str(caught.exception))
+
 
 class GilRelease(unittest.TestCase):
     def test_python_runs_while_a_simulation_runs(self):

@@ -37,7 +37,8 @@ void run_diagnose(const DiagnoseCliOptions& o) {
   if (!o.write_vehicle.empty()) check_output_file(o.write_vehicle, "--write-vehicle");
   // Column mapping: a preset, then the vehicle file's own logger mapping, then the command line's options.
   YamlMap vehicle_file = YamlMap::load_file(vehicle_path);
-  const ColumnMapping mapping = assemble_mapping(o.preset, vehicle_file, o.columns, o.scales);
+  ColumnMapping mapping = assemble_mapping(o.preset, vehicle_file, o.columns, o.scales);
+  mapping.how_to_map = "with --column CANONICAL=SOURCE";
   std::vector<Recording> recs;
   for (const auto& r : o.recordings) recs.push_back(load_recording(r, mapping));
   for (const auto& r : recs)

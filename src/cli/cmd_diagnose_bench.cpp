@@ -43,7 +43,8 @@ void register_diagnose_bench_command(CLI::App& app, const ProcessGroup& group) {
   sub->callback([o, &group] {
     const Vehicle v = load_vehicle_file(resolve_data_file(o->vehicle, "vehicles", ".yaml", "--vehicle"));
     BenchOptions b = o->bench;
-    const ColumnMapping mapping = preset_mapping(o->real_trace_preset);
+    ColumnMapping mapping = preset_mapping(o->real_trace_preset);
+    mapping.how_to_map = "with a --real-trace-preset that names it";
     for (const auto& path : o->real_traces) b.real_traces.push_back(cycle_of_recording(load_recording(path, mapping)));
     b.progress = group.is_root() && isatty(STDERR_FILENO) != 0;
     b.map_cases = group.mapper();

@@ -14,8 +14,16 @@ namespace rollsim {
 
 namespace {
 
-// The same mapping in a fleet manifest is a row's columns or preset, not an option: a hint must name both.
-constexpr const char* kFleetMapping = " (in a fleet manifest: its columns or preset column)";
+// "; map a source column to CANONICAL" and how the front end says it (ColumnMapping::how_to_map); `target` in
+// place of a single column's name (e.g. "one of them") keeps the placeholder in the how.
+std::string map_hint(const ColumnMapping& m, const std::string& canonical, const std::string& target = "") {
+  std::string how = m.how_to_map;
+  if (target.empty()) {
+    for (auto at = how.find("CANONICAL"); at != std::string::npos; at = how.find("CANONICAL", at + canonical.size()))
+      how.replace(at, 9, canonical);
+  }
+  return "; map a source column to " + (target.empty() ? canonical : target) + (how.empty() ? "" : " " + how);
+}
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kSecondsPerDay = 86400.0;
@@ -198,6 +206,7 @@ ColumnMapping assemble_mapping(const std::string& preset, YamlMap& vehicle_file,
 ColumnMapping merge_mapping(ColumnMapping base, const ColumnMapping& overrides) {
   for (const auto& [k, v] : overrides.source_for_canonical) base.source_for_canonical[k] = v;
   for (const auto& [k, v] : overrides.scale_for_canonical) base.scale_for_canonical[k] = v;
+  if (!overrides.how_to_map.empty()) base.how_to_map = overrides.how_to_map;
   return base;
 }
 
@@ -225,14 +234,13 @@ Recording load_recording(const std::string& path, const ColumnMapping& mapping) 
     if (source_of(canonical).empty()) continue;  // dropped: its scale has nothing to scale
     if (!find(canonical)) {
       throw InputError(path, "a scale is given for " + canonical + " but the file has no column '" + source_of(canonical) +
-                                 "'; " + found + "; map one with --column " + canonical + "=SOURCE" + kFleetMapping);
+                                 "'; " + found + map_hint(mapping, canonical));
     }
   }
   auto require = [&](const std::string& canonical) {
     const auto col = find(canonical);
     if (!col) {
-      throw InputError(path, "missing required column '" + canonical + "'; " + found + "; map one with --column " +
-                                 canonical + "=SOURCE" + kFleetMapping);
+      throw InputError(path, "missing required column '" + canonical + "'; " + found + map_hint(mapping, canonical));
     }
     return *col;
   };
@@ -489,12 +497,12 @@ Recording load_recording(const std::string& path, const ColumnMapping& mapping) 
     const std::string have = rec.battery_voltage_v ? "battery_voltage_v" : "battery_current_a";
     const std::string lack = rec.battery_voltage_v ? "battery_current_a" : "battery_voltage_v";
     throw InputError(path, "has " + have + " ('" + source_of(have) + "') but no " + lack +
-                               "; battery power needs both; " + found + "; map it with --column " + lack + "=SOURCE");
+                               "; battery power needs both; " + found + map_hint(mapping, lack));
   }
   if (!rec.battery_power_w && !rec.battery_voltage_v && !rec.soc_fraction && !rec.fuel_rate_m3ps) {
     throw InputError(path, "has no energy channel: need one of battery_power_kw, battery_voltage_v with "
                            "battery_current_a, soc_pct or fuel_rate_lph; " + found +
-                               "; map one with --column CANONICAL=SOURCE (e.g. --column soc_pct=Soc)" + kFleetMapping);
+                               map_hint(mapping, "", "one of them"));
   }
   return rec;
 }

@@ -42,6 +42,10 @@ struct Recording {
 struct ColumnMapping {
   std::map<std::string, std::string> source_for_canonical;
   std::map<std::string, double> scale_for_canonical;
+  /// How the user of a front end maps a column, for the loader's hints, with CANONICAL standing for the column's
+  /// name: "with --column CANONICAL=SOURCE" (command line), "with columns={'CANONICAL': SOURCE}" (Python). Each
+  /// front end sets its own; empty, a hint names only the column to map.
+  std::string how_to_map;
 };
 
 /// The canonical column names, in the order above.
