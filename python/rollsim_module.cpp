@@ -26,6 +26,7 @@
 #include "rollsim/tyre/tyre_fit_plan.hpp"
 #include "rollsim/tyre/tyre_model.hpp"
 #include "rollsim/tyre/tyre_request.hpp"
+#include "rollsim/validate/front_end.hpp"
 #include "rollsim/vehicle/vehicle.hpp"
 
 namespace py = pybind11;
@@ -340,6 +341,26 @@ py::dict api_tyre_fit(const std::string& size, py::object points, py::object lab
   return out;
 }
 
+py::dict api_validate(const std::string& list, py::object threads) {
+  const unsigned n = threads.is_none() ? 0u
+                                       : static_cast<unsigned>(parse_option_number(number_text(threads), "threads",
+                                                                                   Range::closed(1, 1024)));
+  const auto rows = validate::read_epa_test_car_list(list);
+  validate::Validation v;
+  {
+    py::gil_scoped_release released;
+    v = validate::validate_epa_list(rows, n);
+  }
+  py::list summary, out_rows;
+  for (const auto& s : validate::summarise(v)) summary.append(from_json(validate::summary_line_json(s).str()));
+  for (const auto& r : v.rows) out_rows.append(from_json(validate::row_json(r).str()));
+  py::dict out;
+  out["fitted"] = from_json(validate::fitted_json(v.fitted).str());
+  out["summary"] = summary;
+  out["rows"] = out_rows;
+  return out;
+}
+
 }  // namespace
 
 PYBIND11_MODULE(rollsim, m) {
@@ -412,6 +433,15 @@ points determine); rrc_uncertainty_pct [%]; pressure_bar [bar] and name of the t
 it to (every command takes it). Returns {'fit': dict, 'params': [dict per constant], 'residuals': [dict per
 point], 'tyre': the tyre file as a dict, which tyre(...) and simulate(tyre=...) take}. Same keys, values and errors
 as the command line.)");
+
+  m.def("validate", &api_validate, "epa_test_car_list"_a, py::kw_only(), "threads"_a = py::none(),
+        R"(Every car of an EPA Test Car List CSV simulated from its certification row (`rollsim validate --json`).
+
+epa_test_car_list: the list's CSV; threads: worker threads (default every core); the GIL is released while it
+runs. Returns {'fitted': the constants fitted on the fitting half with their row counts, 'summary': [dict per
+powertrain, cycle and half: count, median_error_pct, median_abs_error_pct, p90_abs_error_pct], 'rows': [dict per
+row, in file order: the --json keys (test_number, make, model, fuel, cycle, half, measured, predicted, unit,
+error_pct, or skipped with its reason)]}.)");
 
   m.def("engine_map", &api_engine_map, "engine"_a, "speed_rpm"_a, "torque_nm"_a,
         R"(The library's fuel map (EngineMap) of an engine_map vehicle's `powertrain.engine` block.

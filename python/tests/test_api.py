@@ -204,6 +204,28 @@ class DiagnoseApi(unittest.TestCase):
         self.assertNotIn("--column", str(caught.exception))
 
 
+class ValidateApi(unittest.TestCase):
+    def test_validate_matches_cli_and_its_summary_is_its_rows(self):
+        epa = str(SHARED / "data" / "vehicles" / "epa_test_car_list_2022_part.csv")
+        expected, _, _ = cli("validate", "--epa-test-car-list", epa, "--json", "--threads", "2")
+        got = rollsim.validate(epa, threads=2)
+        self.assertEqual(got["rows"], expected)
+        # The summary's held-out petrol FTP-75 line, recomputed here from the rows it summarises.
+        errors = [r["error_pct"] for r in got["rows"]
+                  if r["fuel"] == "petrol" and r["cycle"] == "FTP-75" and r["half"] == "held-out" and "error_pct" in r]
+        line = next(s for s in got["summary"]
+                    if (s["powertrain"], s["cycle"], s["half"]) == ("petrol", "FTP-75", "held-out"))
+        self.assertEqual(line["count"], len(errors))
+        self.assertAlmostEqual(line["median_abs_error_pct"], float(np.median(np.abs(errors))), places=9)
+        # The fitted constants are physical and each was set by rows of the fitting half.
+        fitted = got["fitted"]
+        self.assertTrue(0.3 < fitted["petrol_indicated_efficiency"] < 0.6, fitted)
+        self.assertTrue(0.7 < fitted["charge_efficiency"] <= 1.0, fitted)
+        self.assertGreater(fitted["petrol_rows"], 0)
+        with self.assertRaises(rollsim.InputError):
+            rollsim.validate(str(SHARED / "no_such_list.csv"))
+
+
 class GilRelease(unittest.TestCase):
     def test_python_runs_while_a_simulation_runs(self):
         # A worker thread runs NEDC simulations; the main thread notes the time at each turn of a loop while the

@@ -12,6 +12,7 @@
 #include "rollsim/common/json.hpp"
 #include "rollsim/report/gnuplot.hpp"
 #include "rollsim/report/table.hpp"
+#include "rollsim/validate/front_end.hpp"
 #include "rollsim/validate/validate.hpp"
 #include "selection_cli.hpp"
 
@@ -22,25 +23,6 @@ struct ValidateOptionsText {
   std::string list, plot, threads;
   bool json = false;
 };
-
-JsonObject row_json(const validate::RowOutcome& o) {
-  const auto& r = *o.row;
-  JsonObject j;
-  j.add("test_number", r.test_number).add("make", r.make).add("model", r.model).add("fuel", o.powertrain);
-  j.add("cycle", validate::to_string(r.cycle)).add("procedure", r.procedure).add("line", static_cast<int>(r.line));
-  j.add("half", o.fitting_half ? "fitting" : "held-out");
-  if (r.derived) j.add("analytically_derived", true).add("adfe_base_test", r.derived->base_test);
-  if (o.skip != validate::SkipReason::none) {
-    j.add("skipped", validate::to_string(o.skip) + (o.skip_detail.empty() ? "" : ": " + o.skip_detail));
-    return j;
-  }
-  j.add("measured", o.measured).add("predicted", o.predicted).add("unit", o.unit).add("error_pct", o.error_pct());
-  if (o.measured_from_kwh_per_100mi) j.add("measured_read_as", "kWh/100 mi");
-  if (r.cycle == validate::EpaCycle::ftp75) {
-    for (int b = 0; b < 3; ++b) j.add("predicted_bag" + std::to_string(b + 1) + "_mpg", o.predicted_bag_mpg[b]);
-  }
-  return j;
-}
 
 void print_summary(const validate::Validation& v) {
   const auto& f = v.fitted;
@@ -146,7 +128,7 @@ void run_validate(const ValidateOptionsText& o, const ProcessGroup& group) {
   const auto v = validate::validate_epa_list(rows, threads, group.mapper());
   if (!o.plot.empty() && group.is_root()) plot(v, o.plot);
   if (o.json) {
-    for (const auto& r : v.rows) std::cout << row_json(r).str() << "\n";
+    for (const auto& r : v.rows) std::cout << validate::row_json(r).str() << "\n";
     return;
   }
   print_summary(v);
