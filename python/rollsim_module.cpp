@@ -341,6 +341,24 @@ py::dict api_tyre_fit(const std::string& size, py::object points, py::object lab
   return out;
 }
 
+py::dict api_sensitivity(py::object tyre, py::object vehicle, py::object cycle, py::object load_n, double speed_kmh) {
+  const double speed_mps =
+      units::kmh_to_mps(parse_option_number(format_value(speed_kmh), "--speed-kmh", Range::open_low(0.0, 500.0)));
+  std::optional<Vehicle> v;
+  if (!vehicle.is_none()) v = vehicle_from(vehicle);
+  const std::optional<TyreSpec> t = tyre_from(tyre);
+  std::optional<double> at_n;
+  if (!load_n.is_none()) at_n = parse_option_number(number_text(load_n), "--load-n", Range::open_low(0.0, 1e6));
+  const DriveCycle c = v ? cycle_from(cycle) : DriveCycle{};
+  selection::Sensitivity s;
+  {
+    py::gil_scoped_release released;
+    s = selection::sensitivity_of(v, t, c, at_n, speed_mps);
+  }
+  if (const auto w = selection::sensitivity_trace_warning(s); !w.empty()) warn(w);
+  return from_json(selection::sensitivity_json(s).str());
+}
+
 py::dict api_validate(const std::string& list, py::object threads) {
   const unsigned n = threads.is_none() ? 0u
                                        : static_cast<unsigned>(parse_option_number(number_text(threads), "threads",
@@ -433,6 +451,16 @@ points determine); rrc_uncertainty_pct [%]; pressure_bar [bar] and name of the t
 it to (every command takes it). Returns {'fit': dict, 'params': [dict per constant], 'residuals': [dict per
 point], 'tyre': the tyre file as a dict, which tyre(...) and simulate(tyre=...) take}. Same keys, values and errors
 as the command line.)");
+
+  m.def("sensitivity", &api_sensitivity, "tyre"_a = py::none(), py::kw_only(), "vehicle"_a = py::none(),
+        "cycle"_a = "nedc", "load_n"_a = py::none(), "speed_kmh"_a = 80.0,
+        R"(Elasticities of a tyre's RR power and RRC, and with a car of its energy or fuel (`rollsim sensitivity --json`).
+
+tyre: file, shipped name or dict (default: the car's own); vehicle: file, shipped name or dict (its energy
+elasticities on cycle, by forward simulation); load_n [N] (default: the car's heaviest wheel load, else 80 % of
+the tyre's maximum load) and speed_kmh [km/h]: the tyre's operating point. Returns one dict: elasticity_rr_power_<key>
+and, with a car, elasticity_<kwh_per_10km or l_per_100km>_<key> for outer_diameter, section_width, pressure and
+load (% per %), the dominant parameters, and the car's figure with followed_trace.)");
 
   m.def("validate", &api_validate, "epa_test_car_list"_a, py::kw_only(), "threads"_a = py::none(),
         R"(Every car of an EPA Test Car List CSV simulated from its certification row (`rollsim validate --json`).

@@ -152,6 +152,18 @@ class SelectionApi(unittest.TestCase):
         self.assertEqual(sum("could not follow" in str(w.message) for w in caught), len(rows))
         self.assertTrue(all(r["followed_trace"] for r in rollsim.compare("ev", tyres=["175-65R15"])))
 
+    def test_sensitivity_matches_cli(self):
+        expected, _, _ = cli("sensitivity", "--vehicle", "ev", "--cycle", "nedc", "--json")
+        self.assertEqual([rollsim.sensitivity(vehicle="ev")], expected)
+        expected, _, _ = cli("sensitivity", "--tyre", "175-70R14", "--load-n", "3500", "--speed-kmh", "100", "--json")
+        got = rollsim.sensitivity("175-70R14", load_n=3500, speed_kmh=100)
+        self.assertEqual([got], expected)
+        # The thesis' trends: RR power grows with load and falls with pressure.
+        self.assertGreater(got["elasticity_rr_power_load"], 0.0)
+        self.assertLess(got["elasticity_rr_power_pressure"], 0.0)
+        with self.assertRaises(rollsim.InputError):
+            rollsim.sensitivity()
+
     def test_sweep_matches_cli(self):
         expected, _, _ = cli("sweep", "--tyre", "175-70R14", "--param", "pressure", "--from", "1.5", "--to", "3.5",
                              "--steps", "5", "--param", "speed", "--from", "40", "--to", "120", "--steps", "3",

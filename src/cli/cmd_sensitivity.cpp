@@ -8,6 +8,7 @@
 #include "rollsim/common/units.hpp"
 #include "rollsim/report/table.hpp"
 #include "rollsim/selection/common.hpp"
+#include "rollsim/selection/front_end.hpp"
 #include "rollsim/selection/sensitivity.hpp"
 #include "selection_cli.hpp"
 
@@ -18,10 +19,6 @@ struct SensitivityOptionsText {
   std::string tyre, vehicle, cycle = "nedc", load_n, speed_kmh = "80";
   bool json = false;
 };
-
-constexpr const char* trace_warning =
-    "the car could not follow the cycle in the base run or a perturbed one: the energy elasticities mix the "
-    "tyre's effect with a change of the drive itself";
 
 std::string value_text(const selection::SensitivityRow& r) {
   switch (r.parameter) {
@@ -40,49 +37,16 @@ void run_sensitivity(const SensitivityOptionsText& o) {
       units::kmh_to_mps(parse_option_number(o.speed_kmh, "--speed-kmh", Range::open_low(0.0, 500.0)));
   std::optional<Vehicle> vehicle;
   if (!o.vehicle.empty()) vehicle = load_vehicle_file(resolve_data_file(o.vehicle, "vehicles", ".yaml", "--vehicle"));
-  TyreSpec tyre;
+  std::optional<TyreSpec> tyre;
   if (!o.tyre.empty()) tyre = load_tyre_file(resolve_data_file(o.tyre, "tyres", ".yaml", "--tyre"));
-  else if (vehicle && vehicle->front_tyre) tyre = *vehicle->front_tyre;
-  else throw InputError("--tyre", "missing: the car has no tyre model (coast-down road load); give --tyre");
-
-  // Operating point: --load-n, else the car's heaviest wheel load, else 80 % of the tyre's maximum load.
-  double load_n = 0.0;
-  if (!o.load_n.empty()) {
-    load_n = parse_option_number(o.load_n, "--load-n", Range::open_low(0.0, 1e6));
-  } else if (vehicle) {
-    const auto w = wheel_loads(vehicle->body, 0.0);
-    load_n = std::max(w.front_n, w.rear_n);
-  } else if (tyre.max_load_n > 0.0) {
-    load_n = 0.8 * tyre.max_load_n;
-  } else {
-    throw InputError("--load-n", "missing: the tyre's maximum load is unknown; give --load-n N");
-  }
-  selection::Sensitivity s;
-  try {
-    if (vehicle) {
-      s = selection::vehicle_sensitivity(*vehicle, tyre, load_cycle(o.cycle, "--cycle"), load_n, speed_mps);
-    } else {
-      s = selection::tyre_sensitivity(tyre, load_n, speed_mps);
-    }
-  } catch (const ModelDomainError& e) {
-    throw InputError(tyre.source + " at " + fixed(load_n, 0) + " N", e.what());
-  }
+  std::optional<double> load_n;
+  if (!o.load_n.empty()) load_n = parse_option_number(o.load_n, "--load-n", Range::open_low(0.0, 1e6));
+  const DriveCycle cycle = vehicle ? load_cycle(o.cycle, "--cycle") : DriveCycle{};
+  const selection::Sensitivity s = selection::sensitivity_of(vehicle, tyre, cycle, load_n, speed_mps);
 
   if (o.json) {
-    JsonObject j;
-    j.add("tyre", s.tyre).add("load_n", s.load_n).add("speed_kmh", units::mps_to_kmh(s.speed_mps))
-        .add("relative_step", s.relative_step).add("rr_power_w", s.rr_power_w);
-    if (vehicle) {
-      j.add("vehicle", s.vehicle).add("cycle", s.cycle).add(s.energy_unit, s.energy).add("followed_trace", s.followed_trace);
-    }
-    for (const auto& r : s.rows) {
-      j.add("elasticity_rr_power_" + r.key, r.power_elasticity);
-      if (r.energy_elasticity) j.add("elasticity_" + s.energy_unit + "_" + r.key, *r.energy_elasticity);
-    }
-    j.add("dominant_rr_power", s.dominant_power);
-    if (vehicle) j.add("dominant_energy", s.dominant_energy);
-    std::cout << j.str() << "\n";
-    if (vehicle && !s.followed_trace) std::cerr << "warning: " << trace_warning << "\n";
+    std::cout << selection::sensitivity_json(s).str() << "\n";
+    if (const auto w = selection::sensitivity_trace_warning(s); !w.empty()) std::cerr << "warning: " << w << "\n";
     return;
   }
   std::cout << "Sensitivity of tyre " << s.tyre << " at " << fixed(s.load_n, 0) << " N, "
@@ -111,7 +75,7 @@ void run_sensitivity(const SensitivityOptionsText& o) {
   if (vehicle) {
     std::cout << "(car: load = test mass, all wheel loads scaled together; diameter also changes the gearing)\n";
   }
-  if (vehicle && !s.followed_trace) std::cout << "WARNING: " << trace_warning << "\n";
+  if (const auto w = selection::sensitivity_trace_warning(s); !w.empty()) std::cout << "WARNING: " << w << "\n";
 }
 
 }  // namespace

@@ -89,6 +89,52 @@ std::vector<std::string> trace_warnings(const Comparison& c) {
   return out;
 }
 
+Sensitivity sensitivity_of(const std::optional<Vehicle>& vehicle, const std::optional<TyreSpec>& tyre_given,
+                           const DriveCycle& cycle, std::optional<double> load_n, double speed_mps) {
+  TyreSpec tyre;
+  if (tyre_given) tyre = *tyre_given;
+  else if (vehicle && vehicle->front_tyre) tyre = *vehicle->front_tyre;
+  else if (vehicle) throw InputError("--tyre", "missing: the car has no tyre model (coast-down road load); give --tyre");
+  else throw InputError("--tyre", "missing: give a tyre and/or --vehicle");
+  double at_n = 0.0;
+  if (load_n) {
+    at_n = *load_n;
+  } else if (vehicle) {
+    const auto w = wheel_loads(vehicle->body, 0.0);
+    at_n = std::max(w.front_n, w.rear_n);
+  } else if (tyre.max_load_n > 0.0) {
+    at_n = 0.8 * tyre.max_load_n;
+  } else {
+    throw InputError("--load-n", "missing: the tyre's maximum load is unknown; give --load-n N");
+  }
+  try {
+    return vehicle ? vehicle_sensitivity(*vehicle, tyre, cycle, at_n, speed_mps) : tyre_sensitivity(tyre, at_n, speed_mps);
+  } catch (const ModelDomainError& e) {
+    throw InputError(tyre.source + " at " + fixed(at_n, 0) + " N", e.what());
+  }
+}
+
+JsonObject sensitivity_json(const Sensitivity& s) {
+  const bool car = !s.energy_unit.empty();  // set in vehicle mode only
+  JsonObject j;
+  j.add("tyre", s.tyre).add("load_n", s.load_n).add("speed_kmh", units::mps_to_kmh(s.speed_mps))
+      .add("relative_step", s.relative_step).add("rr_power_w", s.rr_power_w);
+  if (car) j.add("vehicle", s.vehicle).add("cycle", s.cycle).add(s.energy_unit, s.energy).add("followed_trace", s.followed_trace);
+  for (const auto& r : s.rows) {
+    j.add("elasticity_rr_power_" + r.key, r.power_elasticity);
+    if (r.energy_elasticity) j.add("elasticity_" + s.energy_unit + "_" + r.key, *r.energy_elasticity);
+  }
+  j.add("dominant_rr_power", s.dominant_power);
+  if (car) j.add("dominant_energy", s.dominant_energy);
+  return j;
+}
+
+std::string sensitivity_trace_warning(const Sensitivity& s) {
+  if (s.energy_unit.empty() || s.followed_trace) return {};
+  return "the car could not follow the cycle in the base run or a perturbed one: the energy elasticities mix the "
+         "tyre's effect with a change of the drive itself";
+}
+
 SweepOptions sweep_options_from_request(const SweepRequest& o) {
   if (o.params.empty()) throw InputError("--param", "missing: pressure, diameter, width, load, load-pct or speed");
   if (o.params.size() > 2) throw InputError("--param", "at most two parameters (a grid)");

@@ -5,7 +5,10 @@
 #include <vector>
 
 #include "rollsim/common/json.hpp"
+#include <optional>
+
 #include "rollsim/selection/compare.hpp"
+#include "rollsim/selection/sensitivity.hpp"
 #include "rollsim/selection/sweep.hpp"
 #include "rollsim/tyre/tyre_spec.hpp"
 
@@ -31,6 +34,21 @@ std::vector<JsonObject> comparison_json(const Comparison& comparison);
 /// One message per simulated tyre on which the car could not follow the cycle, saying what its figure measured
 /// instead (report::shortfall_caveat; no "warning:" prefix: each front end adds its own); empty when all followed.
 std::vector<std::string> trace_warnings(const Comparison& comparison);
+
+/// The sensitivities a user asks for: the tyre (default: the car's own), with a car also its energy elasticities on
+/// `cycle`; the operating point's load `load_n` [N] (default: the car's heaviest wheel load, else 80 % of the tyre's
+/// maximum) at `speed_mps`. Errors name the option as the command line does (--tyre, --load-n) and, for a point
+/// outside the model's domain, the tyre's file and the load.
+Sensitivity sensitivity_of(const std::optional<Vehicle>& vehicle, const std::optional<TyreSpec>& tyre,
+                           const DriveCycle& cycle, std::optional<double> load_n, double speed_mps);
+
+/// One object: the point, RR power, every elasticity (elasticity_rr_power_<key>, elasticity_<unit>_<key>), the
+/// dominant parameters; with a car its figure and followed_trace.
+JsonObject sensitivity_json(const Sensitivity& sensitivity);
+
+/// With a car that fell behind its cycle in the base run or a perturbed one: what that does to the energy
+/// elasticities (no "warning:" prefix); empty otherwise.
+std::string sensitivity_trace_warning(const Sensitivity& sensitivity);
 
 /// A sweep as given: one --param, --from, --to (and optionally --steps) per axis; numbers as text.
 struct SweepRequest {
