@@ -291,3 +291,22 @@ TEST(RegressLibrary, MissingVehicleNamesTheCase) {
   }
   std::filesystem::remove_all(dir);
 }
+
+// A case whose car cannot follow its cycle still guards its figure, but the outcome says it is a slower drive's
+// (regress prints it under its table; session 14).
+TEST(RegressLibrary, ACaseWhoseCarFellBehindSaysSo) {
+  const auto dir = std::filesystem::temp_directory_path() / ("rollsim_test_regress_" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "fast.csv") << "time_s,speed_kmh\n0,0\n30,200\n120,200\n160,0\n";
+  const auto file = dir / "b.yaml";
+  std::ofstream(file) << "cases:\n  - name: fast\n    vehicle: ev\n    tyre: nominal\n    cycle: " << (dir / "fast.csv").string()
+                      << "\n    unit: kwh_per_10km\n    expected: 2.5\n    tolerance_pct: 50\n"
+                         "  - name: nedc\n    vehicle: ev\n    tyre: nominal\n    cycle: nedc\n"
+                         "    unit: kwh_per_10km\n    expected: 1.647\n    tolerance_pct: 0.5\n";
+  const auto outcomes = run_baseline(load_baseline(file.string()));
+  ASSERT_EQ(outcomes.size(), 2u);
+  EXPECT_FALSE(outcomes[0].followed_trace);
+  EXPECT_GT(units::mps_to_kmh(outcomes[0].max_deficit_mps), 40.0);  // the motor allows 150 km/h (see above)
+  EXPECT_TRUE(outcomes[1].followed_trace);
+  std::filesystem::remove_all(dir);
+}

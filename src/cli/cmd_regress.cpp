@@ -5,6 +5,7 @@
 
 #include "commands.hpp"
 #include "rollsim/common/atomic_file.hpp"
+#include "rollsim/report/simulation_report.hpp"
 #include "rollsim/report/table.hpp"
 #include "rollsim/selection/common.hpp"
 #include "rollsim/selection/regress.hpp"
@@ -34,6 +35,9 @@ int run_regress(const RegressOptionsText& o) {
     drifted += r.drifted;
   }
   std::cout << t.render();
+  for (const auto& r : outcomes) {
+    if (!r.followed_trace) std::cout << "WARNING: case '" << r.c.name << "': " << report::shortfall_caveat(r.max_deficit_mps) << "\n";
+  }
   if (o.update) {
     write_files_atomically({{o.file, "--update", selection::baseline_yaml(b, outcomes)}});
     std::size_t changed = 0;

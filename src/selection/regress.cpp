@@ -66,7 +66,10 @@ std::vector<RegressOutcome> run_baseline(const Baseline& b) {
       }
       RegressOutcome o;
       o.c = c;
-      o.actual = run_forward(v, cycle).value;
+      const EnergyFigure e = run_forward(v, cycle);
+      o.actual = e.value;
+      o.followed_trace = e.followed_trace;
+      o.max_deficit_mps = e.max_deficit_mps;
       o.drift_pct = (o.actual / c.expected - 1.0) * 100.0;
       o.drifted = !(std::abs(o.drift_pct) <= c.tolerance_pct);
       out.push_back(o);
