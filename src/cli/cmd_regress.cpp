@@ -67,7 +67,7 @@ int run_regress(const RegressOptionsText& o) {
               << "run 'rollsim regress " << o.file << " --update'\n";
     return 1;
   }
-  std::cout << "all " << outcomes.size() << " cases within tolerance\n";
+  std::cout << (outcomes.size() == 1 ? "the case is" : "all " + std::to_string(outcomes.size()) + " cases") << " within tolerance\n";
   return 0;
 }
 
