@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "rollsim/common/distribute.hpp"
+#include "rollsim/common/error.hpp"
 #include "rollsim/common/yaml_reader.hpp"
 #include "rollsim/selection/compare.hpp"
 #include "rollsim/selection/sweep.hpp"
@@ -107,6 +108,18 @@ TEST(Distribute, AFailingCaseIsNamedAndIsTheLowestThatFailed) {
   } catch (const CaseFailure& e) {
     EXPECT_EQ(e.case_index(), 3u);
     EXPECT_STREQ(e.what(), "case 4 of 8 failed: no solution at point 3");
+    EXPECT_FALSE(e.bad_input());
+  }
+  // A case that met bad input says so, for the program to report it as bad input (exit 2, its own message).
+  try {
+    map_cases_locally(4, 2, [](std::size_t k) -> CaseBytes {
+      if (k == 2) throw InputError("fleet.csv: group 'b' (line 3)", "file 'x.csv' not found");
+      return "ok";
+    }, {});
+    FAIL() << "no failure";
+  } catch (const CaseFailure& e) {
+    EXPECT_TRUE(e.bad_input());
+    EXPECT_EQ(e.reason(), "fleet.csv: group 'b' (line 3): file 'x.csv' not found");
   }
 }
 

@@ -76,7 +76,11 @@ TEST(Fleet, ABadColumnMappingNamesTheManifestAndTheGroupsLine) {
       "badcol.csv", "group,vehicle,recording,columns\nok,camry_2018," + camry + ",\nbad,camry_2018," + camry +
                         ",speed_kmh=No Such Column\n");
   const auto r = test::run_rollsim("diagnose --fleet '" + path + "'");
-  EXPECT_NE(r.exit_code, 0);
+  // Bad input met inside a group is bad input: exit 2 and its own message (before session 14: exit 1, "case 2 of 2
+  // failed: ...").
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_EQ(r.err.rfind("error: ", 0), 0u) << r.err;
+  EXPECT_EQ(r.err.find("case 2 of 2"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("badcol.csv: group 'bad' (line 3)"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("No Such Column"), std::string::npos) << r.err;
   EXPECT_TRUE(r.out.empty()) << r.out;

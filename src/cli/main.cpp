@@ -62,6 +62,9 @@ int main(int argc, char** argv) {
   } catch (const rollsim::ModelDomainError& e) {
     return report(group, e, true, 2);
   } catch (const rollsim::CaseFailure& e) {
+    // Bad input met inside a case (a fleet manifest's file or column) is bad input like any other: its own message,
+    // which names the file and line, and exit 2. A case that failed to compute keeps its case number, and exit 1.
+    if (e.bad_input()) return report(group, std::runtime_error(e.reason()), true, 2);
     return report(group, e, true, 1);
   } catch (const std::exception& e) {
     return report(group, e, group.size() == 1, 1);

@@ -7,6 +7,7 @@
 #include <limits>
 #include <mutex>
 
+#include "rollsim/common/error.hpp"
 #include "rollsim/common/parallel.hpp"
 
 namespace rollsim {
@@ -18,6 +19,7 @@ std::vector<CaseBytes> map_cases_locally(std::size_t tasks, unsigned threads, co
   std::mutex failure_mutex;
   std::size_t failed_case = std::numeric_limits<std::size_t>::max();
   std::string failure;
+  bool bad_input = false;
   try {
     parallel_for(tasks, threads, [&](std::size_t k) {
       try {
@@ -28,6 +30,7 @@ std::vector<CaseBytes> map_cases_locally(std::size_t tasks, unsigned threads, co
         if (k < failed_case) {
           failed_case = k;
           failure = e.what();
+          bad_input = dynamic_cast<const InputError*>(&e) != nullptr;
         }
         throw;
       }
@@ -37,7 +40,7 @@ std::vector<CaseBytes> map_cases_locally(std::size_t tasks, unsigned threads, co
   } catch (const std::exception&) {
     throw CaseFailure(failed_case,
                       "case " + std::to_string(failed_case + 1) + " of " + std::to_string(tasks) + " failed: " + failure,
-                      failure);
+                      failure, bad_input);
   }
   return out;
 }

@@ -69,6 +69,7 @@ std::string local_blob(std::size_t tasks, unsigned threads, int rank, int size, 
     blob.assign(1, '\1');
     put(blob, r + e.case_index() * n);
     put(blob, e.reason());
+    put(blob, e.bad_input());
   }
   return blob;
 }
@@ -99,6 +100,7 @@ std::vector<CaseBytes> ProcessGroup::map(std::size_t tasks, unsigned threads, co
   std::vector<CaseBytes> out(tasks);
   std::size_t failed = std::numeric_limits<std::size_t>::max();
   std::string why;
+  bool bad_input = false;
   for (std::size_t q = 0; q < blobs.size(); ++q) {
     std::string_view in(blobs[q]);
     const char status = in.front();
@@ -106,11 +108,14 @@ std::vector<CaseBytes> ProcessGroup::map(std::size_t tasks, unsigned threads, co
     if (status != 0) {
       std::size_t k = 0;
       std::string w;
+      bool input = false;
       take(in, k);
       take(in, w);
+      take(in, input);
       if (k < failed) {
         failed = k;
         why = w;
+        bad_input = input;
       }
       continue;
     }
@@ -120,7 +125,7 @@ std::vector<CaseBytes> ProcessGroup::map(std::size_t tasks, unsigned threads, co
     throw CaseFailure(failed,
                       "case " + std::to_string(failed + 1) + " of " + std::to_string(tasks) + " failed (rank " +
                           std::to_string(failed % static_cast<std::size_t>(size_)) + "): " + why,
-                      why);
+                      why, bad_input);
   }
   return out;
 }

@@ -28,14 +28,18 @@ using CaseMap =
 /// A case whose body threw: every process throws the same one (the lowest failing case), so all of them end.
 class CaseFailure : public std::runtime_error {
  public:
-  CaseFailure(std::size_t case_index, const std::string& what, const std::string& reason)
-      : std::runtime_error(what), case_index_(case_index), reason_(reason) {}
+  CaseFailure(std::size_t case_index, const std::string& what, const std::string& reason, bool bad_input = false)
+      : std::runtime_error(what), case_index_(case_index), reason_(reason), bad_input_(bad_input) {}
   std::size_t case_index() const { return case_index_; }
   const std::string& reason() const { return reason_; }  ///< the body's own message
+  /// The body threw an InputError: the case met bad input (a manifest's file, a column), which the program reports
+  /// as bad input, its own message alone, rather than as a case that failed to compute.
+  bool bad_input() const { return bad_input_; }
 
  private:
   std::size_t case_index_;
   std::string reason_;
+  bool bad_input_;
 };
 
 /// The map on this process alone (parallel_for over its threads).
