@@ -29,7 +29,8 @@ void register_diagnose_bench_command(CLI::App& app, const ProcessGroup& group) {
   CLI::App* sub = app.add_subcommand("diagnose-bench", "Scorecard of rollsim diagnose on synthetic recordings with concealed effects, beside two baselines");
   sub->add_option("--vehicle", o->vehicle, "Vehicle YAML (electric; default ev)")->type_name("FILE");
   sub->add_option("--seeds", o->bench.seeds, "Seeds per effect case (default 20)")->check(CLI::Range(1, 1000));
-  sub->add_option("--null-seeds", o->bench.null_seeds, "Seeds of the null and time-reversed null (default 200)")->check(CLI::Range(1, 5000));
+  sub->add_option("--null-seeds", o->bench.null_seeds, "Seeds of the null and time-reversed null (default 200); the fuel and SOC channels' nulls and the "
+                  "trip-scatter null run a quarter of them, at least 50, and the 4-trip null half, at least 100 (not with --quick)")->check(CLI::Range(1, 5000));
   sub->add_option("--threads", o->bench.threads, "Worker threads (default: every core)");
   sub->add_flag("--quick", o->bench.quick, "CI subset: warm-up at 30 %, two pairs, the nulls");
   sub->add_option("--real-trace", o->real_traces, "A real recording whose speed trace also carries the null and a "
