@@ -590,6 +590,11 @@ TEST(CliTyreFit, OnePointFileIsANormalTyreFileThatReproducesThePoint) {
   ASSERT_EQ(t.exit_code, 0) << t.err;
   EXPECT_NEAR(json_number(t.out, "rrc"), 0.0085, 0.0085 * 1e-7);
   EXPECT_TRUE(has(t.out, "\"model\": \"hysteresis\""));
+  // Its table names its own three parts, not the thesis' damping mechanisms (before session 14: Coulomb, viscous,
+  // drag over a fitted tyre's static loss, frequency rise and speed-squared loss).
+  const CmdResult table = rollsim::test::run_rollsim("tyre '" + out.string() + "'");
+  EXPECT_TRUE(has(table.out, "static  freq. rise  V^2 loss")) << table.out;
+  EXPECT_FALSE(has(table.out, "Coulomb")) << table.out;
   // The thesis' mechanisms do not describe this model: --explain says so instead of printing them.
   const CmdResult x = rollsim::test::run_rollsim("tyre '" + out.string() + "' --explain");
   EXPECT_EQ(x.exit_code, 2);

@@ -135,8 +135,12 @@ void run_tyre(const TyreOptions& o) {
   }
 
   std::cout << describe_tyre(spec);
+  // The three parts of the RRC: the thesis model's damping mechanisms, or a fitted (hysteresis) tyre's loss at
+  // zero speed, its rise with the rotation frequency and its speed-squared loss (the JSON keeps one set of keys).
+  const bool thesis = spec.state.model == TyreModelKind::Thesis;
   report::TextTable t({"tyre", "p [bar]", "load [N]", "speed [km/h]", "Kz [N/mm]", "defl [mm]", "contact [mm]",
-                       "RRC x1000", "Coulomb", "viscous", "drag", "F_RR [N]", "P_RR [W]"});
+                       "RRC x1000", thesis ? "Coulomb" : "static", thesis ? "viscous" : "freq. rise",
+                       thesis ? "drag" : "V^2 loss", "F_RR [N]", "P_RR [W]"});
   t.set_left_aligned(0);
   for (std::size_t i = 0; i < results.size(); ++i) {
     const auto& r = results[i];
