@@ -400,7 +400,8 @@ size='175/70 R14 84T'; or outer_radius_m [m] and width_m [m].
 pressure_bar [bar] (required without a file; overrides a file's), load_n [N] or load_pct [% of the maximum load,
 default 80], speed_kmh [km/h]: a number gives one dict of numbers, an array gives a dict of arrays (one per speed).
 Keys: rrc [-], rr_force_n [N], rr_power_w [W], stiffness_n_per_m, deflection_m, contact_length_m, offset_e_m,
-rrc_coulomb, rrc_viscous, rrc_rotational_drag, and the tyre's geometry, pressure and load.)");
+rrc_coulomb, rrc_viscous, rrc_rotational_drag (a fitted tyre's static loss, frequency rise and speed-squared loss),
+and the tyre's geometry, pressure and load.)");
 
   m.def("simulate", &api_simulate, "vehicle"_a = "ev", "tyre"_a = py::none(), "cycle"_a = "nedc", "replay"_a = false,
         "trace"_a = true,
