@@ -221,7 +221,7 @@ py::object api_diagnose(py::object vehicle, std::vector<std::string> recordings,
   std::vector<std::string> column_options, scale_options;
   for (auto item : columns) column_options.push_back(item.first.cast<std::string>() + "=" + item.second.cast<std::string>());
   for (auto item : scales) scale_options.push_back(item.first.cast<std::string>() + "=" + number_text(item.second));
-  ColumnMapping mapping = assemble_mapping(preset, vehicle_file, column_options, scale_options);
+  ColumnMapping mapping = assemble_mapping(preset, vehicle_file, column_options, scale_options, "columns", "scales");
   mapping.how_to_map = "with columns={'CANONICAL': SOURCE}";
   std::vector<Recording> recs;
   for (const auto& r : recordings) recs.push_back(load_recording(r, mapping));

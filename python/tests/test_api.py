@@ -214,6 +214,10 @@ class DiagnoseApi(unittest.TestCase):
             rollsim.diagnose(vehicle="twizy", recordings=[rec])
         self.assertIn("with columns={'time_s': SOURCE}", str(caught.exception))
         self.assertNotIn("--column", str(caught.exception))
+        # A bad entry of columns= is named as columns, not as the command line's --column.
+        with self.assertRaises(rollsim.InputError) as caught:
+            rollsim.diagnose(vehicle="twizy", recordings=[rec], preset="rsk_twizy", columns={"time_s": ""})
+        self.assertTrue(str(caught.exception).startswith("columns 'time_s='"), str(caught.exception))
 
 
 class ValidateApi(unittest.TestCase):

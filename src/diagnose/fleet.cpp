@@ -70,7 +70,8 @@ FleetManifest read_fleet_manifest(const std::string& path) {
     FleetRecording fr{rec.string(), {}, t.row_line[r]};
     try {
       YamlMap vehicle_file = YamlMap::load_file(vehicle_path);
-      fr.mapping = assemble_mapping(cell(preset), vehicle_file, split_list(cell(columns)), split_list(cell(scales)));
+      fr.mapping = assemble_mapping(cell(preset), vehicle_file, split_list(cell(columns)), split_list(cell(scales)),
+                                    "columns", "scales");
       fr.mapping.how_to_map = "in the manifest's columns cell (CANONICAL=SOURCE) or with its preset";
     } catch (const InputError& e) {
       throw InputError(path + ": line " + std::to_string(fr.line), e.what());

@@ -53,6 +53,15 @@ std::string parameter_text(const ParameterEstimate& p) {
 
 bool is_fitted(const Finding& f) { return !std::isnan(f.energy_share_pct); }
 
+// What a finding that fits nothing is, by the parameter it reports: the residual left above the noise floor, or a
+// catalogue shape fitted with the impossible sign (its parameter is "opposite_...").
+std::string unfitted_words(const Finding& f) {
+  for (const auto& p : f.parameters) {
+    if (p.name.rfind("opposite_", 0) == 0) return "a catalogue shape with the impossible sign, so not that effect";
+  }
+  return "the residual left above the recording's noise floor";
+}
+
 std::string kj(double j) { return num3(j / 1e3); }
 
 std::string verdict_words(const std::string& verdict) {
@@ -83,7 +92,7 @@ void findings_table(std::ostream& os, const Diagnosis& d) {
          << " &rarr; " << kj(f.heldout_rmse_after_j) << "</td><td class=\"num\">" << fixed(f.heldout_energy_error_pct_before, 2)
          << " &rarr; " << fixed(f.heldout_energy_error_pct_after, 2) << "</td><td class=\"num\">" << fixed(f.delta_bic, 1) << "</td>";
     else
-      os << "<td colspan=\"4\">not a fitted effect: the residual left above the recording's noise floor</td>";
+      os << "<td colspan=\"4\">not a fitted effect: " << html_escape(unfitted_words(f)) << "</td>";
     os << "<td>";
     for (std::size_t k = 0; k < f.confounded_with.size(); ++k) os << (k ? "<br>" : "") << html_escape(f.confounded_with[k]);
     os << (f.confounded_with.empty() ? "none" : "") << "</td><td class=\"wide\">";

@@ -113,25 +113,26 @@ double Recording::distance_m() const {
 
 const std::vector<std::string>& canonical_recording_columns() { return kCanonical; }
 
-void parse_column_option(const std::string& text, ColumnMapping& mapping) {
-  auto [canonical, source] = split_option("--column", text, "SOURCE, e.g. speed_kmh=Dyno_Spd[mph]", true);
+void parse_column_option(const std::string& text, ColumnMapping& mapping, const std::string& option) {
+  auto [canonical, source] = split_option(option, text, "SOURCE, e.g. speed_kmh=Dyno_Spd[mph]", true);
+  const std::string where = option + " '" + text + "'";
   if (source.empty() && (canonical == "time_s" || canonical == "speed_kmh")) {
-    throw InputError("--column '" + text + "'", "'" + canonical + "' is required and cannot be dropped; map it to a column");
+    throw InputError(where, "'" + canonical + "' is required and cannot be dropped; map it to a column");
   }
   // Shells keep quotes typed inside a single-quoted argument; a source name never starts and ends with one.
   if (source.size() >= 2 && (source.front() == '\'' || source.front() == '"') && source.back() == source.front()) {
     source = source.substr(1, source.size() - 2);
   }
   if (mapping.source_for_canonical.count(canonical)) {
-    throw InputError("--column '" + text + "'", "'" + canonical + "' is already mapped to '" +
-                                                    mapping.source_for_canonical[canonical] + "'; give it once");
+    throw InputError(where, "'" + canonical + "' is already mapped to '" + mapping.source_for_canonical[canonical] +
+                                "'; give it once");
   }
   mapping.source_for_canonical[canonical] = source;
 }
 
-void parse_scale_option(const std::string& text, ColumnMapping& mapping) {
-  const auto [canonical, value] = split_option("--scale", text, "FACTOR, e.g. speed_kmh=1.609344");
-  const std::string where = "--scale '" + text + "'";
+void parse_scale_option(const std::string& text, ColumnMapping& mapping, const std::string& option) {
+  const auto [canonical, value] = split_option(option, text, "FACTOR, e.g. speed_kmh=1.609344");
+  const std::string where = option + " '" + text + "'";
   if (canonical == "time_s" || canonical == "date") {
     throw InputError(where, "'" + canonical + "' cannot be scaled; scale the value columns only");
   }
@@ -193,13 +194,14 @@ ColumnMapping preset_mapping(const std::string& name) {
 }
 
 ColumnMapping assemble_mapping(const std::string& preset, YamlMap& vehicle_file, const std::vector<std::string>& columns,
-                               const std::vector<std::string>& scales) {
+                               const std::vector<std::string>& scales, const std::string& column_option,
+                               const std::string& scale_option) {
   ColumnMapping mapping;
   if (!preset.empty()) mapping = preset_mapping(preset);
   mapping = merge_mapping(mapping, column_mapping_from_yaml(vehicle_file));
   ColumnMapping overrides;
-  for (const auto& c : columns) parse_column_option(c, overrides);
-  for (const auto& s : scales) parse_scale_option(s, overrides);
+  for (const auto& c : columns) parse_column_option(c, overrides, column_option);
+  for (const auto& s : scales) parse_scale_option(s, overrides, scale_option);
   return merge_mapping(mapping, overrides);
 }
 

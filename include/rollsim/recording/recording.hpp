@@ -52,10 +52,11 @@ struct ColumnMapping {
 const std::vector<std::string>& canonical_recording_columns();
 
 /// Adds one `--column CANONICAL=SOURCE` option to `mapping`; `--column CANONICAL=` (nothing after '=') drops the
-/// column (a preset's mapping included; time_s and speed_kmh cannot be dropped). Throws InputError naming the option.
-void parse_column_option(const std::string& text, ColumnMapping& mapping);
+/// column (a preset's mapping included; time_s and speed_kmh cannot be dropped). Throws InputError naming the option
+/// as its front end calls it (`option`: "--column", a manifest's "columns" cell, Python's "columns").
+void parse_column_option(const std::string& text, ColumnMapping& mapping, const std::string& option = "--column");
 /// Adds one `--scale CANONICAL=FACTOR` option (finite, non-zero) to `mapping`; throws InputError naming it.
-void parse_scale_option(const std::string& text, ColumnMapping& mapping);
+void parse_scale_option(const std::string& text, ColumnMapping& mapping, const std::string& option = "--scale");
 
 /// Reads the optional blocks `recording_columns: {canonical: source}` and `recording_scale: {canonical: factor}`
 /// of a vehicle file (both marked read on `file`); errors name the file and key.
@@ -73,8 +74,10 @@ std::vector<std::string> preset_mapping_names();
 ColumnMapping merge_mapping(ColumnMapping base, const ColumnMapping& overrides);
 /// The mapping a diagnosis uses: the preset (if named), then the vehicle file's own logger blocks, then the
 /// `--column C=S` and `--scale C=F` options, each overriding the one before.
+/// `column_option` and `scale_option` name the two as the front end does (errors quote them).
 ColumnMapping assemble_mapping(const std::string& preset, YamlMap& vehicle_file, const std::vector<std::string>& columns,
-                               const std::vector<std::string>& scales);
+                               const std::vector<std::string>& scales, const std::string& column_option = "--column",
+                               const std::string& scale_option = "--scale");
 
 /// Longest run of missing values (empty cell or NaN) bridged by linear interpolation; longer runs are errors.
 inline constexpr double kMaxBridgedRun_s = 5.0;
