@@ -201,8 +201,8 @@ TEST(SelectionCompare, AFigureOfACarThatFellBehindTheCycleSaysSo) {
   const Comparison fast = compare_tyres(ev, {tyre("low-rrc")}, cruise_at(200.0), o);
   ASSERT_EQ(fast.ranked.size(), 2u);
   for (const auto& r : fast.ranked) {
-    EXPECT_FALSE(r.followed_trace) << r.tyre.name;
-    EXPECT_GE(units::mps_to_kmh(r.max_deficit_mps), 200.0 - kinematic_top_kmh - 0.5) << r.tyre.name;
+    EXPECT_FALSE(r.trace.followed) << r.tyre.name;
+    EXPECT_GE(units::mps_to_kmh(r.trace.max_deficit_mps), 200.0 - kinematic_top_kmh - 0.5) << r.tyre.name;
   }
   const auto warnings = trace_warnings(fast);
   ASSERT_EQ(warnings.size(), 2u);
@@ -214,8 +214,8 @@ TEST(SelectionCompare, AFigureOfACarThatFellBehindTheCycleSaysSo) {
 
   const Comparison nedc = compare_tyres(ev, {tyre("low-rrc")}, load_cycle("nedc"), o);
   for (const auto& r : nedc.ranked) {
-    EXPECT_TRUE(r.followed_trace) << r.tyre.name;
-    EXPECT_DOUBLE_EQ(r.max_deficit_mps, 0.0);
+    EXPECT_TRUE(r.trace.followed) << r.tyre.name;
+    EXPECT_DOUBLE_EQ(r.trace.max_deficit_mps, 0.0);
   }
   EXPECT_TRUE(trace_warnings(nedc).empty());
 
@@ -223,8 +223,8 @@ TEST(SelectionCompare, AFigureOfACarThatFellBehindTheCycleSaysSo) {
   o.replay = true;
   const Comparison replayed = compare_tyres(ev, {tyre("low-rrc")}, cruise_at(200.0), o);
   for (const auto& r : replayed.ranked) {
-    EXPECT_FALSE(r.followed_trace) << r.tyre.name;
-    EXPECT_DOUBLE_EQ(r.max_deficit_mps, 0.0);
+    EXPECT_FALSE(r.trace.followed) << r.tyre.name;
+    EXPECT_DOUBLE_EQ(r.trace.max_deficit_mps, 0.0);
   }
   ASSERT_EQ(trace_warnings(replayed).size(), 2u);
   EXPECT_TRUE(has(trace_warnings(replayed)[0], "leave out the demand")) << trace_warnings(replayed)[0];
@@ -232,7 +232,7 @@ TEST(SelectionCompare, AFigureOfACarThatFellBehindTheCycleSaysSo) {
   // The sweep and the sensitivities run the same figure and carry the same flag.
   const SweepResult swept = sweep_vehicle(ev, tyre("nominal"), cruise_at(200.0), one_axis(SweepParam::Pressure, 2.0, 3.0, 2));
   ASSERT_EQ(swept.points.size(), 2u);
-  for (const auto& p : swept.points) EXPECT_FALSE(p.followed_trace);
+  for (const auto& p : swept.points) EXPECT_FALSE(p.trace.followed);
   EXPECT_TRUE(has(sweep_trace_warning(swept), "at 2 of 2 points")) << sweep_trace_warning(swept);
   EXPECT_TRUE(has(sweep_csv(swept), ",no\n"));
   EXPECT_FALSE(vehicle_sensitivity(ev, tyre("nominal"), cruise_at(200.0), 4000.0, 80 / 3.6).followed_trace);
@@ -305,8 +305,8 @@ TEST(RegressLibrary, ACaseWhoseCarFellBehindSaysSo) {
                          "    unit: kwh_per_10km\n    expected: 1.647\n    tolerance_pct: 0.5\n";
   const auto outcomes = run_baseline(load_baseline(file.string()));
   ASSERT_EQ(outcomes.size(), 2u);
-  EXPECT_FALSE(outcomes[0].followed_trace);
-  EXPECT_GT(units::mps_to_kmh(outcomes[0].max_deficit_mps), 40.0);  // the motor allows 150 km/h (see above)
-  EXPECT_TRUE(outcomes[1].followed_trace);
+  EXPECT_FALSE(outcomes[0].trace.followed);
+  EXPECT_GT(units::mps_to_kmh(outcomes[0].trace.max_deficit_mps), 40.0);  // the motor allows 150 km/h (see above)
+  EXPECT_TRUE(outcomes[1].trace.followed);
   std::filesystem::remove_all(dir);
 }

@@ -84,8 +84,8 @@ void print_csv(const selection::Comparison& c, bool header) {
               << fixed(r.value, 5) << "," << c.unit << "," << fixed(r.diff_pct, 3) << ","
               << (c.shows_range ? fixed(r.range_km, 2) : "") << ","
               << (c.shows_range ? fixed(r.range_change_km, 2) : "") << "," << (r.fit.fits ? "yes" : "no") << ","
-              << q(r.fit.reason) << "," << (r.followed_trace ? "yes" : "no") << ","
-              << fixed(units::mps_to_kmh(r.max_deficit_mps), 2) << "\n";
+              << q(r.fit.reason) << "," << (r.trace.followed ? "yes" : "no") << ","
+              << fixed(units::mps_to_kmh(r.trace.max_deficit_mps), 2) << "\n";
   };
   for (std::size_t i = 0; i < c.ranked.size(); ++i) emit(c.ranked[i], static_cast<int>(i + 1));
   for (const auto& r : c.unfit) emit(r, 0);

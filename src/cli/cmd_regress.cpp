@@ -36,7 +36,7 @@ int run_regress(const RegressOptionsText& o) {
   }
   std::cout << t.render();
   for (const auto& r : outcomes) {
-    if (!r.followed_trace) std::cout << "WARNING: case '" << r.c.name << "': " << report::shortfall_caveat(r.max_deficit_mps) << "\n";
+    if (!r.trace.followed) std::cout << "WARNING: case '" << r.c.name << "': " << report::shortfall_caveat(r.trace) << "\n";
   }
   if (o.update) {
     write_files_atomically({{o.file, "--update", selection::baseline_yaml(b, outcomes)}});

@@ -131,10 +131,10 @@ std::string summary_text(const SimulationResult& r, bool solver_stats) {
   return o.str();
 }
 
-std::string shortfall_caveat(double max_deficit_mps) {
+std::string shortfall_caveat(const TraceFollowing& trace) {
   // Forward runs fall behind; a replay keeps to the trace and leaves out what the powertrain could not give.
-  return max_deficit_mps > 0.0 ? "the car could not follow the trace, falling up to " +
-                                     fixed(units::mps_to_kmh(max_deficit_mps), 1) +
+  return trace.max_deficit_mps > 0.0 ? "the car could not follow the trace, falling up to " +
+                                     fixed(units::mps_to_kmh(trace.max_deficit_mps), 1) +
                                      " km/h behind: its figures are for a slower drive than the cycle's"
                                : "the trace asks more than the powertrain gives: the replay's figures leave out the "
                                  "demand it could not meet";
@@ -142,11 +142,7 @@ std::string shortfall_caveat(double max_deficit_mps) {
 
 std::vector<std::string> run_caveats(const SimulationResult& r) {
   std::vector<std::string> out;
-  if (!r.shortfalls.empty()) {
-    double worst_mps = 0.0;
-    for (const auto& s : r.shortfalls) worst_mps = std::max(worst_mps, s.max_deficit_mps);
-    out.push_back(shortfall_caveat(worst_mps));
-  }
+  if (const TraceFollowing t = r.trace_following(); !t.followed) out.push_back(shortfall_caveat(t));
   if (r.battery && r.battery_empty) {
     out.push_back("the usable battery ran empty after " + fixed(r.battery_empty->distance_m / 1000.0, 3) +
                   " km: a real car would have stopped there");

@@ -1,8 +1,6 @@
 // Running a car for tyre selection and its headline figure.
 #include "rollsim/selection/common.hpp"
 
-#include <algorithm>
-
 #include "rollsim/common/error.hpp"
 
 namespace rollsim::selection {
@@ -23,8 +21,7 @@ EnergyFigure energy_figure(const SimulationResult& r) {
     f.unit = "kwh_per_10km";
     f.range_km = r.range_km();
   }
-  f.followed_trace = r.shortfalls.empty();
-  for (const auto& s : r.shortfalls) f.max_deficit_mps = std::max(f.max_deficit_mps, s.max_deficit_mps);
+  f.trace = r.trace_following();
   return f;
 }
 

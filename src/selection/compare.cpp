@@ -68,8 +68,7 @@ std::string simulate_candidate(const Vehicle& vehicle, const VehicleModel& base,
     const EnergyFigure e = run_model(VehicleModel::with_tyres_of(base, v), cycle, o.replay);
     c.value = e.value;
     c.range_km = e.range_km;
-    c.followed_trace = e.followed_trace;
-    c.max_deficit_mps = e.max_deficit_mps;
+    c.trace = e.trace;
     c.simulated = true;
   } catch (const std::exception& e) {
     // An overloaded tyre may have no solution at all; it is reported, not ranked.
@@ -78,9 +77,9 @@ std::string simulate_candidate(const Vehicle& vehicle, const VehicleModel& base,
     c.value = c.range_km = NAN;
   }
   std::string bytes;
-  for (double x : {c.rrc_80, c.rr_power_80_w, c.value, c.range_km, c.max_deficit_mps}) put(bytes, x);
+  for (double x : {c.rrc_80, c.rr_power_80_w, c.value, c.range_km}) put(bytes, x);
   put(bytes, c.simulated);
-  put(bytes, c.followed_trace);
+  put(bytes, c.trace);
   put(bytes, c.error);
   return bytes;
 }
@@ -90,9 +89,9 @@ CandidateResult evaluated(const Vehicle& vehicle, const TyreSpec& own, const Tyr
   CandidateResult c;
   c.tyre = tyre;
   c.fit = check_fit(vehicle, own, tyre, o.diameter_tolerance_pct);
-  for (double* x : {&c.rrc_80, &c.rr_power_80_w, &c.value, &c.range_km, &c.max_deficit_mps}) take(in, *x);
+  for (double* x : {&c.rrc_80, &c.rr_power_80_w, &c.value, &c.range_km}) take(in, *x);
   take(in, c.simulated);
-  take(in, c.followed_trace);
+  take(in, c.trace);
   take(in, c.error);
   return c;
 }

@@ -68,7 +68,7 @@ std::vector<JsonObject> comparison_json(const Comparison& c) {
         .add(c.unit, r.value)
         .add("diff_pct", r.diff_pct);
     if (c.shows_range) j.add("range_km", r.range_km).add("range_change_km", r.range_change_km);
-    j.add("followed_trace", r.followed_trace).add("max_deficit_kmh", units::mps_to_kmh(r.max_deficit_mps));
+    j.add("followed_trace", r.trace.followed).add("max_deficit_kmh", units::mps_to_kmh(r.trace.max_deficit_mps));
     j.add("fits", r.fit.fits).add("reason", r.fit.reason);
     out.push_back(j);
   };
@@ -80,9 +80,9 @@ std::vector<JsonObject> comparison_json(const Comparison& c) {
 std::vector<std::string> trace_warnings(const Comparison& c) {
   std::vector<std::string> out;
   auto check = [&](const CandidateResult& r) {
-    if (!r.simulated || r.followed_trace) return;
+    if (!r.simulated || r.trace.followed) return;
     out.push_back("on " + r.tyre.name + (r.is_own ? " (own)" : "") + ", " + c.cycle + ": " +
-                  report::shortfall_caveat(r.max_deficit_mps));
+                  report::shortfall_caveat(r.trace));
   };
   for (const auto& r : c.ranked) check(r);
   for (const auto& r : c.unfit) check(r);
@@ -172,7 +172,7 @@ std::vector<JsonObject> sweep_json(const SweepResult& r) {
     for (const auto& [name, value] : sweep_point_columns(r, p)) j.add(name, value);
     j.add("rrc", p.rr.rrc).add("rr_force_n", p.rr.rr_force_n).add("rr_power_w", p.rr.rr_power_w)
         .add("deflection_m", p.rr.deflection_m);
-    if (r.vehicle) j.add(r.energy_unit, p.energy).add("followed_trace", p.followed_trace);
+    if (r.vehicle) j.add(r.energy_unit, p.energy).add("followed_trace", p.trace.followed);
     out.push_back(j);
   }
   return out;

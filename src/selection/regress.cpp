@@ -68,8 +68,7 @@ std::vector<RegressOutcome> run_baseline(const Baseline& b) {
       o.c = c;
       const EnergyFigure e = run_forward(v, cycle);
       o.actual = e.value;
-      o.followed_trace = e.followed_trace;
-      o.max_deficit_mps = e.max_deficit_mps;
+      o.trace = e.trace;
       o.drift_pct = (o.actual / c.expected - 1.0) * 100.0;
       o.drifted = !(std::abs(o.drift_pct) <= c.tolerance_pct);
       out.push_back(o);

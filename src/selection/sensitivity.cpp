@@ -48,7 +48,7 @@ Sensitivity vehicle_sensitivity(const Vehicle& vehicle, const TyreSpec& tyre, co
   fit_tyres(base, tyre);
   const EnergyFigure at_base = run_forward(base, cycle);
   s.energy = at_base.value;
-  s.followed_trace = at_base.followed_trace;
+  s.followed_trace = at_base.trace.followed;
   for (auto& row : s.rows) {
     double y[2];
     const double f[2] = {1.0 + h, 1.0 - h};
@@ -70,7 +70,7 @@ Sensitivity vehicle_sensitivity(const Vehicle& vehicle, const TyreSpec& tyre, co
       fit_tyres(v, t);
       const EnergyFigure e = run_forward(v, cycle);
       y[k] = e.value;
-      s.followed_trace = s.followed_trace && e.followed_trace;
+      s.followed_trace = s.followed_trace && e.trace.followed;
     }
     // d ln y / d ln x by central differences in ln x, consistent with explain_tyre.
     row.energy_elasticity = std::log(y[0] / y[1]) / std::log(f[0] / f[1]);

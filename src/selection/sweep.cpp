@@ -249,29 +249,26 @@ SweepResult sweep_vehicle(const Vehicle& vehicle, const TyreSpec& tyre, const Dr
       fit_tyres(v, ps.tyre);
       const EnergyFigure e = run_model(VehicleModel::with_tyres_of(base, v), cycle, o.replay);
       p.energy = e.value;
-      p.followed_trace = e.followed_trace;
-      p.max_deficit_mps = e.max_deficit_mps;
+      p.trace = e.trace;
     } catch (const std::exception& e) {
       error = e.what();
     }
     std::string bytes;
     put(bytes, p.rr);
     put(bytes, p.energy);
-    put(bytes, p.followed_trace);
-    put(bytes, p.max_deficit_mps);
+    put(bytes, p.trace);
     put(bytes, error);
     return bytes;
   };
   const auto results = map_cases(o.map_cases, pts.size(), o.threads, body, o.progress);
   for (std::size_t i = 0; i < pts.size(); ++i) {
     const PointSetup ps = setup(tyre, o, pts[i]);
-    SweepPoint p{pts[i], ps.load_n, ps.speed_kmh, {}, 0.0};
+    SweepPoint p{pts[i], ps.load_n, ps.speed_kmh, {}, 0.0, {}};
     std::string error;
     std::string_view in = results[i];
     take(in, p.rr);
     take(in, p.energy);
-    take(in, p.followed_trace);
-    take(in, p.max_deficit_mps);
+    take(in, p.trace);
     take(in, error);
     if (!error.empty()) {
       r.stopped = stop_message(o.axes, pts[i], error, r.points);
@@ -302,14 +299,15 @@ std::vector<std::pair<std::string, double>> sweep_point_columns(const SweepResul
 
 std::string sweep_trace_warning(const SweepResult& r) {
   std::size_t behind = 0;
-  double worst_mps = 0.0;
+  TraceFollowing worst;
   for (const auto& p : r.points) {
-    behind += p.followed_trace ? 0 : 1;
-    worst_mps = std::max(worst_mps, p.max_deficit_mps);
+    behind += p.trace.followed ? 0 : 1;
+    worst.followed = worst.followed && p.trace.followed;
+    worst.max_deficit_mps = std::max(worst.max_deficit_mps, p.trace.max_deficit_mps);
   }
   if (behind == 0) return {};
   return "at " + std::to_string(behind) + " of " + std::to_string(r.points.size()) +
-         " points (followed_trace no): " + report::shortfall_caveat(worst_mps);
+         " points (followed_trace no): " + report::shortfall_caveat(worst);
 }
 
 std::string sweep_csv(const SweepResult& r) {
@@ -324,7 +322,7 @@ std::string sweep_csv(const SweepResult& r) {
     for (const auto& [name, value] : sweep_point_columns(r, p)) out << format_value(value) << ",";
     out << fixed(p.rr.rrc, 7) << "," << fixed(p.rr.rr_force_n, 4) << "," << fixed(p.rr.rr_power_w, 3) << ","
         << fixed(p.rr.deflection_m, 6);
-    if (r.vehicle) out << "," << fixed(p.energy, 5) << "," << (p.followed_trace ? "yes" : "no");
+    if (r.vehicle) out << "," << fixed(p.energy, 5) << "," << (p.trace.followed ? "yes" : "no");
     out << "\n";
   }
   return out.str();

@@ -57,6 +57,13 @@ double SimulationResult::fuel_l_per_100km() const {
 double SimulationResult::co2_g_per_km() const {
   return moved() ? (fuel ? fuel->co2_kg : 0.0) * 1e3 / (distance_m / 1000.0) : std::nan("");
 }
+TraceFollowing SimulationResult::trace_following() const {
+  TraceFollowing t;
+  t.followed = shortfalls.empty();
+  for (const auto& s : shortfalls) t.max_deficit_mps = std::max(t.max_deficit_mps, s.max_deficit_mps);
+  return t;
+}
+
 double SimulationResult::range_km() const {
   if (!moved()) return std::nan("");
   const double per_m = (energy.battery_terminal_j + energy.battery_loss_j) / distance_m;

@@ -17,9 +17,9 @@ std::vector<std::pair<std::string, double>> energy_terms_kwh(const SimulationRes
 /// closure, tracking error and shortfalls; with `solver_stats`, CVODE's counters.
 std::string summary_text(const SimulationResult& r, bool solver_stats);
 
-/// What a run that fell `max_deficit_mps` behind its trace (0: a replay that could not deliver it) measured
-/// instead: the one wording of every front end's warning about such a run.
-std::string shortfall_caveat(double max_deficit_mps);
+/// What a run that did not follow its trace (`trace.followed` false) measured instead: the one wording of every
+/// front end's warning about such a run.
+std::string shortfall_caveat(const TraceFollowing& trace);
 
 /// One line per thing that makes a run's figures differ from the trace's own: the car fell behind it (or, in a
 /// replay, could not deliver it), or the usable battery ran empty; empty when neither. For tables of several runs,

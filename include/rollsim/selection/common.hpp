@@ -14,10 +14,9 @@ struct EnergyFigure {
   double value = 0.0;     ///< kWh/10 km or l/100 km
   std::string unit;       ///< "kwh_per_10km" or "l_per_100km"
   double range_km = 0.0;  ///< electric only, 0 otherwise
-  /// False when the car fell behind the trace (a shortfall): the figure is then for a slower drive than the
-  /// cycle's, and figures of runs that differ in this do not compare.
-  bool followed_trace = true;
-  double max_deficit_mps = 0.0;  ///< largest speed deficit behind the trace (0 in replay, which cannot fall behind)
+  /// Not followed: the figure is for a slower drive than the cycle's (or, in replay, leaves out the demand the
+  /// powertrain could not meet), and figures of runs that differ in this do not compare.
+  TraceFollowing trace;
 };
 
 /// "l_per_100km" for a car whose powertrain burns fuel, "kwh_per_10km" otherwise.

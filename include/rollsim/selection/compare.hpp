@@ -6,6 +6,7 @@
 
 #include "rollsim/common/distribute.hpp"
 #include "rollsim/cycle/drive_cycle.hpp"
+#include "rollsim/sim/simulation.hpp"
 #include "rollsim/tyre/tyre_spec.hpp"
 #include "rollsim/vehicle/vehicle.hpp"
 #include "rollsim/common/units.hpp"
@@ -43,8 +44,7 @@ struct CandidateResult {
   double diff_pct = 0.0;          ///< relative to the own tyre, + = uses more
   double range_km = 0.0;          ///< battery-only cars
   double range_change_km = 0.0;   ///< battery-only cars, + = gains range
-  bool followed_trace = true;     ///< false: the car fell behind the cycle on this tyre (EnergyFigure)
-  double max_deficit_mps = 0.0;   ///< how far behind, at worst
+  TraceFollowing trace;           ///< whether the car kept to the cycle on this tyre (EnergyFigure)
 };
 
 /// One vehicle on one cycle: the fitting tyres ranked best first, then the unfit ones (unranked, same order as given).

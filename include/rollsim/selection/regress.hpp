@@ -4,6 +4,8 @@
 #include <string>
 #include <vector>
 
+#include "rollsim/sim/simulation.hpp"
+
 namespace rollsim::selection {
 
 struct RegressCase {
@@ -29,8 +31,7 @@ struct RegressOutcome {
   double actual = 0.0;
   double drift_pct = 0.0;  ///< (actual - expected) / expected, %
   bool drifted = false;    ///< |drift| > tolerance
-  bool followed_trace = true;    ///< false: the car fell behind the case's cycle (its figure guards a slower drive)
-  double max_deficit_mps = 0.0;  ///< how far behind, at worst
+  TraceFollowing trace;  ///< not followed: the car fell behind the case's cycle (its figure guards a slower drive)
 };
 
 /// Runs every case forward. A missing vehicle, tyre or cycle, or a unit that does not match the car, throws

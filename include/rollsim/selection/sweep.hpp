@@ -10,6 +10,7 @@
 
 #include "rollsim/common/distribute.hpp"
 #include "rollsim/cycle/drive_cycle.hpp"
+#include "rollsim/sim/simulation.hpp"
 #include "rollsim/tyre/tyre_model.hpp"
 #include "rollsim/tyre/tyre_spec.hpp"
 #include "rollsim/vehicle/vehicle.hpp"
@@ -58,8 +59,7 @@ struct SweepPoint {
   double speed_kmh = 0.0;
   RollingResistance rr;                ///< the tyre at (load, speed)
   double energy = 0.0;                 ///< vehicle sweeps: kWh/10 km or l/100 km
-  bool followed_trace = true;          ///< vehicle sweeps: false where the car fell behind (EnergyFigure)
-  double max_deficit_mps = 0.0;        ///< vehicle sweeps: how far behind, at worst
+  TraceFollowing trace;                ///< vehicle sweeps: whether the car kept to the cycle (EnergyFigure)
 };
 
 struct SweepResult {

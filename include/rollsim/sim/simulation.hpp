@@ -90,6 +90,13 @@ struct Shortfall {
   double at_s = 0.0;             ///< when it was largest
 };
 
+/// Whether a run kept to its trace, in one value that the front ends carry and compare: false where the car fell
+/// behind (forward) or the powertrain could not deliver the trace (replay, which cannot fall behind: deficit 0).
+struct TraceFollowing {
+  bool followed = true;
+  double max_deficit_mps = 0.0;  ///< largest speed deficit behind the trace over every shortfall
+};
+
 /// Where an electric car's usable battery ran empty (its state of charge reached 0).
 struct BatteryDepletion {
   double time_s = 0.0;
@@ -155,6 +162,8 @@ struct SimulationResult {
   double co2_g_per_km() const;
   /// Distance on the usable battery at this consumption [km] (battery chemical energy, incl. its loss).
   double range_km() const;
+  /// The shortfalls summed up: followed when there are none, and the largest deficit among them.
+  TraceFollowing trace_following() const;
 };
 
 /// Forward simulation: a driver (cycle feed-forward + PI) follows the trace; CVODES integrates speed,
