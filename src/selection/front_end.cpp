@@ -6,6 +6,7 @@
 
 #include "rollsim/common/error.hpp"
 #include "rollsim/common/format.hpp"
+#include "rollsim/common/input_file.hpp"
 #include "rollsim/common/units.hpp"
 #include "rollsim/common/yaml_reader.hpp"
 #include "rollsim/report/simulation_report.hpp"
@@ -18,8 +19,8 @@ CandidateList load_candidates(const std::vector<std::string>& tyres, bool use_ca
   if (!use_catalogue && !tyres.empty()) return out;
   namespace fs = std::filesystem;
   const std::string dir = catalogue.empty() ? data_root() + "/tyres/catalogue" : catalogue;
+  if (!is_folder_path(dir)) throw InputError("--catalogue " + dir, "not a folder");
   std::error_code ec;
-  if (!fs::is_directory(dir, ec)) throw InputError("--catalogue " + dir, "not a folder");
   std::vector<std::string> files;
   // Non-throwing iteration: a folder that cannot be listed is a named input error, not a system exception.
   for (fs::directory_iterator it(dir, ec), end; it != end; it.increment(ec)) {
