@@ -53,13 +53,11 @@ std::string parameter_text(const ParameterEstimate& p) {
 
 bool is_fitted(const Finding& f) { return !std::isnan(f.energy_share_pct); }
 
-// What a finding that fits nothing is, by the parameter it reports: the residual left above the noise floor, or a
-// catalogue shape fitted with the impossible sign (its parameter is "opposite_...").
+// What a finding that fits nothing is: a catalogue shape fitted with the impossible sign, or the residual left
+// above the noise floor.
 std::string unfitted_words(const Finding& f) {
-  for (const auto& p : f.parameters) {
-    if (p.name.rfind("opposite_", 0) == 0) return "a catalogue shape with the impossible sign, so not that effect";
-  }
-  return "the residual left above the recording's noise floor";
+  return f.wrong_sign ? "a catalogue shape with the impossible sign, so not that effect"
+                      : "the residual left above the recording's noise floor";
 }
 
 std::string kj(double j) { return num3(j / 1e3); }

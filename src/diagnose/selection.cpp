@@ -371,6 +371,7 @@ Finding wrong_sign_finding(const Candidate& c, const Passing& p, double inflate)
   const EffectInfo& info = effect_info(c.id);
   Finding f;
   f.effect = "unexplained";
+  f.wrong_sign = true;
   const double value = p.score.amplitude(), se = p.score.amplitude_se(inflate);
   f.description = info.opposite_sign + ": the residual has " + info.name + "'s shape with the impossible sign (" +
                   c.amplitude->name + " " + fixed(value, 3) + " " + c.amplitude->unit + "), so it is not " + info.name;

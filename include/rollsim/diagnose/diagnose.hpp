@@ -145,6 +145,8 @@ struct Finding {
   /// The held-out figures above were computed: a fitted effect or road profile. A finding that fits nothing (the
   /// residual left above the noise floor, a shape with the impossible sign) has none, and they are not printed.
   bool heldout_scored = false;
+  /// A catalogue shape fitted with the impossible sign: described by its shape, never named as the effect.
+  bool wrong_sign = false;
   EffectParameters fitted;  ///< for --write-vehicle
   std::optional<RecoveredProfile> road_profile;  ///< road_profile findings: the profile itself
 };
