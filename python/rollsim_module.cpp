@@ -374,6 +374,7 @@ py::dict api_validate(const std::string& list, py::object threads) {
   for (const auto& r : v.rows) out_rows.append(from_json(validate::row_json(r).str()));
   py::dict out;
   out["fitted"] = from_json(validate::fitted_json(v.fitted).str());
+  out["maker_calibration"] = from_json(validate::maker_calibration_json(v.maker_calibration).str());
   out["summary"] = summary;
   out["rows"] = out_rows;
   return out;
@@ -467,10 +468,13 @@ load (% per %), the dominant parameters, and the car's figure with followed_trac
         R"(Every car of an EPA Test Car List CSV simulated from its certification row (`rollsim validate --json`).
 
 epa_test_car_list: the list's CSV; threads: worker threads (default every core); the GIL is released while it
-runs. Returns {'fitted': the constants fitted on the fitting half with their row counts, 'summary': [dict per
-powertrain, cycle and half: count, median_error_pct, median_abs_error_pct, p90_abs_error_pct], 'rows': [dict per
-row, in file order: the --json keys (test_number, make, model, fuel, cycle, half, measured, predicted, unit,
-error_pct, or skipped with its reason)]}.)");
+runs. Returns {'fitted': the constants fitted on the fitting half with their row counts, 'maker_calibration': per
+energy source the empirical maker calibration's shrinkage and its leave-one-model-out score on the fitting half,
+'summary': [dict per powertrain, cycle and half: count, median_error_pct, median_abs_error_pct, p90_abs_error_pct,
+and the same with the maker calibration, prefixed maker_calibrated_], 'rows': [dict per row, in file order: the
+--json keys (test_number, make, model, fuel, cycle, half, measured, predicted, unit, error_pct, maker_factor,
+maker_calibrated, maker_calibrated_error_pct, or skipped with its reason)]}. `predicted` is the physics; the maker
+calibration explains nothing (README, "Validation").)");
 
   m.def("engine_map", &api_engine_map, "engine"_a, "speed_rpm"_a, "torque_nm"_a,
         R"(The library's fuel map (EngineMap) of an engine_map vehicle's `powertrain.engine` block.

@@ -592,20 +592,37 @@ TEST(EpaList, WholeListSkipsByNameAndAgreesAsReportedOnTheHeldOutHalf) {
   for (const auto& s : validate::summarise(v)) {
     if (s.half != "held-out" || s.count < 30) continue;
     if (s.powertrain == "petrol" && s.cycle == "HWFET") {
-      EXPECT_LE(s.median_abs_error_pct, 5.0);
-      EXPECT_LE(s.p90_abs_error_pct, 12.0);
+      EXPECT_LE(s.physics.median_abs_error_pct, 5.0);
+      EXPECT_LE(s.physics.p90_abs_error_pct, 12.0);
     }
     if (s.powertrain == "petrol" && s.cycle == "US06") {
-      EXPECT_LE(s.median_abs_error_pct, 5.0);
-      EXPECT_LE(s.p90_abs_error_pct, 12.0);
+      EXPECT_LE(s.physics.median_abs_error_pct, 5.0);
+      EXPECT_LE(s.physics.p90_abs_error_pct, 12.0);
     }
-    if (s.powertrain == "petrol") EXPECT_LT(s.median_abs_error_pct, 7.0) << s.cycle;
+    if (s.powertrain == "petrol") EXPECT_LT(s.physics.median_abs_error_pct, 7.0) << s.cycle;
     if (s.powertrain == "electric" && s.cycle == "CD HWFET") {
-      EXPECT_LE(s.median_abs_error_pct, 6.0);
-      EXPECT_LE(s.p90_abs_error_pct, 12.0);
+      EXPECT_LE(s.physics.median_abs_error_pct, 6.0);
+      EXPECT_LE(s.physics.p90_abs_error_pct, 12.0);
     }
-    if (s.powertrain == "electric") EXPECT_LT(s.median_abs_error_pct, 8.0) << s.cycle;
+    if (s.powertrain == "electric") EXPECT_LT(s.physics.median_abs_error_pct, 8.0) << s.cycle;
   }
+  // The maker calibration (README, "The maker calibration"), judged on models it never saw: on the held-out half it
+  // meets every target the physics alone misses (at this commit petrol FTP-75 4.8 / 11.8 %, electric CD UDDS
+  // 1.9 / 10.4 %) and keeps those it meets. It leaves the physics' prediction as it was, and a fitting row's
+  // factor is learned without its own model.
+  for (const auto& s : validate::summarise(v)) {
+    if (s.half != "held-out" || s.count < 30) continue;
+    const bool petrol = s.powertrain == "petrol", electric = s.powertrain == "electric";
+    if (!petrol && !electric) continue;
+    EXPECT_LE(s.maker_calibrated.median_abs_error_pct, petrol ? 5.0 : 6.0) << s.powertrain << " " << s.cycle;
+    EXPECT_LE(s.maker_calibrated.p90_abs_error_pct, 12.0) << s.powertrain << " " << s.cycle;
+  }
+  for (const auto& o : v.rows) {
+    if (o.skip != validate::SkipReason::none) continue;
+    const double own_model = v.maker_calibration.factor(o.row->fuel, o.row->cycle, o.row->make, o.fitting_half ? o.row->model : "");
+    EXPECT_EQ(o.maker_factor, own_model) << o.row->test_number;
+  }
+
   // The fitted constants stay physical: gross indicated efficiency 0.3-0.5, charge efficiency below 1.
   EXPECT_GT(v.fitted.defaults.petrol_indicated_efficiency, 0.3);
   EXPECT_LT(v.fitted.defaults.petrol_indicated_efficiency, 0.5);

@@ -233,6 +233,26 @@ class ValidateApi(unittest.TestCase):
                     if (s["powertrain"], s["cycle"], s["half"]) == ("petrol", "FTP-75", "held-out"))
         self.assertEqual(line["count"], len(errors))
         self.assertAlmostEqual(line["median_abs_error_pct"], float(np.median(np.abs(errors))), places=9)
+        # The maker calibration recomputed here from its definition: a held-out row's factor is exp(-median of
+        # ln(predicted / measured) x n / (n + k)) over the n fitting rows of its make, fuel and cycle.
+        k = got["maker_calibration"]["petrol"]["shrinkage_rows"]
+        self.assertIsNotNone(k)
+        fitting = {}
+        for r in got["rows"]:
+            if "error_pct" in r and r["half"] == "fitting":
+                key = (r["fuel"], r["cycle"], r["make"].lower())
+                fitting.setdefault(key, []).append(np.log(r["predicted"] / r["measured"]))
+        calibrated = []
+        for r in got["rows"]:
+            if not ("error_pct" in r and r["half"] == "held-out" and r["fuel"] == "petrol"):
+                continue
+            e = fitting.get((r["fuel"], r["cycle"], r["make"].lower()), [])
+            expected_factor = np.exp(-np.median(e) * len(e) / (len(e) + k)) if e else 1.0
+            self.assertAlmostEqual(r["maker_factor"], expected_factor, places=12, msg=r["test_number"])
+            self.assertAlmostEqual(r["maker_calibrated"], r["predicted"] * r["maker_factor"], places=9)
+            if r["cycle"] == "FTP-75":
+                calibrated.append(r["maker_calibrated_error_pct"])
+        self.assertAlmostEqual(line["maker_calibrated_median_abs_error_pct"], float(np.median(np.abs(calibrated))), places=9)
         # The fitted constants are physical and each was set by rows of the fitting half.
         fitted = got["fitted"]
         self.assertTrue(0.3 < fitted["petrol_indicated_efficiency"] < 0.6, fitted)

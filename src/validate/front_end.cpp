@@ -1,5 +1,7 @@
 #include "rollsim/validate/front_end.hpp"
 
+#include <cmath>
+
 namespace rollsim::validate {
 
 JsonObject row_json(const RowOutcome& o) {
@@ -14,6 +16,8 @@ JsonObject row_json(const RowOutcome& o) {
     return j;
   }
   j.add("measured", o.measured).add("predicted", o.predicted).add("unit", o.unit).add("error_pct", o.error_pct());
+  j.add("maker_factor", o.maker_factor).add("maker_calibrated", o.maker_factor * o.predicted);
+  j.add("maker_calibrated_error_pct", o.maker_calibrated_error_pct());
   if (o.measured_from_kwh_per_100mi) j.add("measured_read_as", "kWh/100 mi");
   if (r.cycle == EpaCycle::ftp75) {
     for (int b = 0; b < 3; ++b) j.add("predicted_bag" + std::to_string(b + 1) + "_mpg", o.predicted_bag_mpg[b]);
@@ -31,11 +35,29 @@ JsonObject fitted_json(const FittedConstants& f) {
   return j;
 }
 
+JsonObject maker_calibration_json(const MakerCalibration& c) {
+  JsonObject j;
+  for (const auto& [fuel, choice] : c.choices()) {
+    JsonObject one;
+    // Infinite shrinkage (no calibration) is written as null: JSON has no infinity.
+    if (std::isinf(choice.shrinkage_rows)) one.add_null("shrinkage_rows");
+    else one.add("shrinkage_rows", choice.shrinkage_rows);
+    one.add("rows", static_cast<int>(choice.rows)).add("groups", static_cast<int>(choice.groups));
+    one.add("fitting_mean_abs_log_error_physics", choice.mean_abs_log_error_uncalibrated);
+    one.add("fitting_mean_abs_log_error_calibrated", choice.mean_abs_log_error_calibrated);
+    j.add(to_string(fuel), one);
+  }
+  return j;
+}
+
 JsonObject summary_line_json(const SummaryLine& s) {
   JsonObject j;
   j.add("powertrain", s.powertrain).add("cycle", s.cycle).add("half", s.half).add("count", static_cast<int>(s.count));
-  j.add("median_error_pct", s.median_error_pct).add("median_abs_error_pct", s.median_abs_error_pct);
-  j.add("p90_abs_error_pct", s.p90_abs_error_pct);
+  j.add("median_error_pct", s.physics.median_error_pct).add("median_abs_error_pct", s.physics.median_abs_error_pct);
+  j.add("p90_abs_error_pct", s.physics.p90_abs_error_pct);
+  j.add("maker_calibrated_median_error_pct", s.maker_calibrated.median_error_pct);
+  j.add("maker_calibrated_median_abs_error_pct", s.maker_calibrated.median_abs_error_pct);
+  j.add("maker_calibrated_p90_abs_error_pct", s.maker_calibrated.p90_abs_error_pct);
   return j;
 }
 

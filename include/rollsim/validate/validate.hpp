@@ -7,6 +7,7 @@
 #include "rollsim/common/distribute.hpp"
 #include "rollsim/validate/epa_car.hpp"
 #include "rollsim/validate/epa_test_car.hpp"
+#include "rollsim/validate/maker_calibration.hpp"
 
 namespace rollsim::validate {
 
@@ -28,7 +29,11 @@ struct RowOutcome {
   double predicted_bag_mpg[3] = {0.0, 0.0, 0.0};
   /// The row's RND_ADJ_FE was read as kWh per 100 miles (electric rows below 60 "MPG", see README).
   bool measured_from_kwh_per_100mi = false;
+  /// The maker calibration's factor on `predicted` (maker_calibration.hpp): learned on the fitting half, and for a
+  /// fitting-half row without its own model's rows; 1 where the fitting half has no other car of its make and cycle.
+  double maker_factor = 1.0;
   double error_pct() const { return 100.0 * (predicted / measured - 1.0); }
+  double maker_calibrated_error_pct() const { return 100.0 * (maker_factor * predicted / measured - 1.0); }
 };
 
 /// The constants fitted on the fitting half, with how many rows set each.
@@ -40,12 +45,14 @@ struct FittedConstants {
 struct Validation {
   std::vector<RowOutcome> rows;   ///< one per input row, in file order
   FittedConstants fitted;
+  MakerCalibration maker_calibration;  ///< learned on the fitting half's predictions with the fitted constants
 };
 
 /// Classifies every row (skips with reasons, hybrids by rule), simulates the rest by kinematic replay with the
 /// nominal constants, fits the four constants of EpaDefaults on the fitting half, and predicts every row with
-/// them. `threads`: 0 for the hardware's concurrency; `map`: how the rows are spread (over MPI ranks by the CLI;
-/// empty: this process's threads).
+/// them; then learns the maker calibration on the fitting half and gives every row its factor. `threads`: 0 for
+/// the hardware's concurrency; `map`: how the rows are spread (over MPI ranks by the CLI; empty: this process's
+/// threads).
 Validation validate_epa_list(const std::vector<EpaTestRow>& rows, unsigned threads, const CaseMap& map = {});
 
 /// What a replay's trace (recorded) shows of the engine's transients: the sum of every rise of the segment fuel
@@ -85,11 +92,17 @@ double fuel_with_transients_m3(const SimulationResult& s, const TransientFuelPar
 /// UDDS (bags 3 + 2), weighted in gallons per mile. Bag 3 drives the same trace as bag 1.
 double ftp75_weighted_mpg(double bag1_gal, double bag2_gal, double bag3_gal, double bag1_miles, double bag2_miles);
 
-/// One line of the summary: a powertrain on a cycle, on one half (or all rows).
+/// Median signed error, median and 90th percentile (nearest rank) of |error| [%] of a set of rows.
+struct ErrorStats {
+  double median_error_pct = 0.0, median_abs_error_pct = 0.0, p90_abs_error_pct = 0.0;
+};
+
+/// One line of the summary: a powertrain on a cycle, on one half: the physics' errors, and with the maker
+/// calibration (a fitting-half row calibrated without its own model, so neither figure is in-sample).
 struct SummaryLine {
   std::string powertrain, cycle, half;  ///< half: "held-out", "fitting"
   std::size_t count = 0;
-  double median_error_pct = 0.0, median_abs_error_pct = 0.0, p90_abs_error_pct = 0.0;
+  ErrorStats physics, maker_calibrated;
 };
 std::vector<SummaryLine> summarise(const Validation& v);
 

@@ -1,0 +1,81 @@
+#include "rollsim/validate/maker_calibration.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <limits>
+
+#include "rollsim/common/statistics.hpp"
+
+namespace rollsim::validate {
+
+namespace {
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return s;
+}
+
+constexpr double kNoCalibration = std::numeric_limits<double>::infinity();
+
+// The group's log factor without `leave_out`'s rows, shrunk towards no correction by n / (n + shrinkage): a make
+// seen on two rows moves a prediction less than one seen on forty.
+template <class Rows>
+double shrunk_median(const Rows& rows, const std::string& leave_out, double shrinkage_rows) {
+  if (std::isinf(shrinkage_rows)) return 0.0;
+  std::vector<double> e;
+  for (const auto& r : rows) {
+    if (leave_out.empty() || r.model != leave_out) e.push_back(r.log_error);
+  }
+  if (e.empty()) return 0.0;
+  const double n = static_cast<double>(e.size());
+  return median(e) * n / (n + shrinkage_rows);
+}
+
+}  // namespace
+
+MakerCalibration MakerCalibration::fit(const std::vector<CalibrationSample>& fitting) {
+  MakerCalibration c;
+  for (const auto& s : fitting) c.groups_[{s.fuel, s.cycle, lower(s.make)}].push_back({lower(s.model), s.log_error});
+
+  std::map<EpaFuel, std::vector<const CalibrationSample*>> by_fuel;
+  for (const auto& s : fitting) by_fuel[s.fuel].push_back(&s);
+  for (const auto& [fuel, samples] : by_fuel) {
+    auto mean_abs_log_error = [&](double shrinkage_rows) {
+      double sum = 0.0;
+      for (const CalibrationSample* s : samples) {
+        const auto& group = c.groups_.at({s->fuel, s->cycle, lower(s->make)});
+        sum += std::abs(s->log_error - shrunk_median(group, lower(s->model), shrinkage_rows));
+      }
+      return sum / static_cast<double>(samples.size());
+    };
+    CalibrationChoice choice;
+    choice.rows = samples.size();
+    choice.shrinkage_rows = kNoCalibration;
+    choice.mean_abs_log_error_uncalibrated = mean_abs_log_error(kNoCalibration);
+    choice.mean_abs_log_error_calibrated = choice.mean_abs_log_error_uncalibrated;
+    // From the most shrinkage to the least, so a tie keeps the smaller correction.
+    for (auto k = std::rbegin(kShrinkageCandidates); k != std::rend(kShrinkageCandidates); ++k) {
+      const double score = mean_abs_log_error(*k);
+      if (score < choice.mean_abs_log_error_calibrated) {
+        choice.mean_abs_log_error_calibrated = score;
+        choice.shrinkage_rows = *k;
+      }
+    }
+    for (const auto& [key, rows] : c.groups_) {
+      if (std::get<0>(key) == fuel) ++choice.groups;
+    }
+    c.choices_[fuel] = choice;
+  }
+  return c;
+}
+
+double MakerCalibration::factor(EpaFuel fuel, EpaCycle cycle, const std::string& make, const std::string& leave_out_model) const {
+  const auto choice = choices_.find(fuel);
+  const auto group = groups_.find({fuel, cycle, lower(make)});
+  if (choice == choices_.end() || group == groups_.end()) return 1.0;
+  // The physics' log error is ln(predicted / measured); the calibration divides out its expected part.
+  return std::exp(-shrunk_median(group->second, lower(leave_out_model), choice->second.shrinkage_rows));
+}
+
+}  // namespace rollsim::validate
