@@ -83,8 +83,8 @@ void print_summary(const validate::Validation& v) {
               << "; fitting half's mean |log error| " << fixed(100.0 * c.mean_abs_log_error_uncalibrated, 2) << " -> "
               << fixed(100.0 * c.mean_abs_log_error_calibrated, 2) << " % over " << c.rows << " rows\n";
   }
-  std::cout << "with the maker calibration (a fitting-half row calibrated without its own model):";
-  std::cout << "\n" << table(lines, &validate::SummaryLine::maker_calibrated);
+  std::cout << "with the maker calibration (a fitting-half row calibrated without its own model):\n"
+            << table(lines, &validate::SummaryLine::maker_calibrated);
   std::map<std::string, std::size_t> skipped;
   for (const auto& o : v.rows) {
     if (o.skip != validate::SkipReason::none) ++skipped[validate::to_string(o.skip)];

@@ -1,7 +1,6 @@
 #include "rollsim/cycle/drive_cycle.hpp"
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <optional>
@@ -9,6 +8,7 @@
 #include "rollsim/common/csv.hpp"
 #include "rollsim/common/error.hpp"
 #include "rollsim/common/input_file.hpp"
+#include "rollsim/common/text.hpp"
 #include "rollsim/common/units.hpp"
 #include "rollsim/common/yaml_reader.hpp"
 
@@ -24,11 +24,6 @@ constexpr double kKinkTolerance_mps2 = 1e-5;
 // Elevation is differenced over at least this much travelled distance: GPS and map elevations are noisy
 // at the metre scale, and over a standing vehicle a plain difference would divide by zero.
 constexpr double kGradeBaseline_m = 10.0;
-
-std::string lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return s;
-}
 
 double lerp(const std::vector<double>& t, const std::vector<double>& y, std::size_t i, double at) {
   const double w = (at - t[i]) / (t[i + 1] - t[i]);
@@ -111,7 +106,7 @@ std::vector<std::string> shipped_cycle_names() {
 }
 
 DriveCycle load_cycle(const std::string& name_or_path, const std::string& option) {
-  std::string key = lower(name_or_path);
+  std::string key = lower_ascii(name_or_path);
   if (key == "wltc" || key == "wltc3b" || key == "wltc_3b") key = "wltc_class3b";
   const auto names = shipped_cycle_names();
   if (std::find(names.begin(), names.end(), key) != names.end()) {

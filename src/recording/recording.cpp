@@ -8,6 +8,7 @@
 
 #include "rollsim/common/csv.hpp"
 #include "rollsim/common/error.hpp"
+#include "rollsim/common/text.hpp"
 #include "rollsim/common/units.hpp"
 
 namespace rollsim {
@@ -38,11 +39,6 @@ const std::vector<std::string> kCanonical = {
     "soc_pct",  "fuel_rate_lph", "elevation_m", "grade_pct",     "ambient_temp_c",    "latitude",
     "longitude"};
 
-std::string lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return s;
-}
-
 std::string canonical_list() {
   std::string out;
   for (std::size_t i = 0; i < kCanonical.size(); ++i) out += (i ? ", " : "") + kCanonical[i];
@@ -70,7 +66,7 @@ std::pair<std::string, std::string> split_option(const std::string& option, cons
 
 bool is_missing(const std::string& cell) {
   if (cell.empty()) return true;
-  const std::string l = lower(cell);
+  const std::string l = lower_ascii(cell);
   return l == "nan" || l == "-nan" || l == "na" || l == "n/a" || l == "null";
 }
 
@@ -175,7 +171,7 @@ std::vector<std::string> preset_mapping_names() { return {"anl_d3", "rsk_twizy"}
 
 ColumnMapping preset_mapping(const std::string& name) {
   ColumnMapping m;
-  const std::string key = lower(name);
+  const std::string key = lower_ascii(name);
   if (key == "anl_d3") {
     m.source_for_canonical = {{"time_s", "Time[s]"},
                               {"speed_kmh", "Dyno_Spd[mph]"},

@@ -1,11 +1,11 @@
 #include "rollsim/validate/epa_test_car.hpp"
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 
 #include "rollsim/common/csv.hpp"
 #include "rollsim/common/error.hpp"
+#include "rollsim/common/text.hpp"
 #include "rollsim/common/units.hpp"
 
 namespace rollsim::validate {
@@ -16,14 +16,10 @@ constexpr double kKgPerLb = 0.45359237;
 using units::kNPerLbf;
 using units::kMpsPerMph;
 
-std::string lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return s;
-}
 bool has(const std::string& text, const char* part) { return text.find(part) != std::string::npos; }
 
 EpaCycle cycle_of(const std::string& procedure) {
-  const std::string p = lower(procedure);
+  const std::string p = lower_ascii(procedure);
   if (has(p, "20 degree") || has(p, "cold co")) return EpaCycle::cold;
   if (has(p, "charge depleting udds")) return EpaCycle::cd_udds;
   if (has(p, "charge depleting highway")) return EpaCycle::cd_highway;
@@ -36,7 +32,7 @@ EpaCycle cycle_of(const std::string& procedure) {
 }
 
 EpaFuel fuel_of(const std::string& text) {
-  const std::string f = lower(text);
+  const std::string f = lower_ascii(text);
   if (has(f, "cold co")) return EpaFuel::cold_test_fuel;
   if (f == "electricity") return EpaFuel::electricity;
   if (has(f, "hydrogen")) return EpaFuel::hydrogen;
@@ -47,7 +43,7 @@ EpaFuel fuel_of(const std::string& text) {
 }
 
 EpaTransmission transmission_of(const std::string& text) {
-  const std::string t = lower(text);
+  const std::string t = lower_ascii(text);
   if (has(t, "continuously variable")) return EpaTransmission::cvt;
   if (has(t, "manual")) return EpaTransmission::clutch;  // manual, automated manual (incl. dual clutch)
   if (has(t, "automatic")) return EpaTransmission::automatic;  // incl. semi-automatic (with a manual mode)
@@ -172,7 +168,7 @@ std::vector<EpaTestRow> read_epa_test_car_list(const std::string& path) {
     r.transmission_text = trim(cells[c_trans]);
     r.transmission = transmission_of(r.transmission_text);
     r.drive_text = trim(cells[c_drive]);
-    const std::string d = lower(r.drive_text);
+    const std::string d = lower_ascii(r.drive_text);
     r.all_wheel_drive = has(d, "all wheel") || has(d, "4-wheel");
     if (const auto v = number(c_etw)) r.test_mass_kg = *v * kKgPerLb;
     if (const auto v = number(c_disp)) r.displacement_m3 = *v * units::kM3PerLitre;
@@ -184,7 +180,7 @@ std::vector<EpaTestRow> read_epa_test_car_list(const std::string& path) {
     if (const auto v = number(c_c)) r.road_c_n_s2_per_m2 = *v * kNPerLbf / (kMpsPerMph * kMpsPerMph);
     r.measured = number(c_fe);
     for (int b = 0; b < 3; ++b) r.bag_mpg[b] = number(c_bag[b]);
-    if (lower(trim(cells[c_adfe])) == "yes") {
+    if (lower_ascii(trim(cells[c_adfe])) == "yes") {
       EpaTestRow::DerivedConfiguration d;
       d.base_test = trim(cells[c_adfe_test]);
       if (const auto v = number(c_adfe_etw)) d.test_mass_kg = *v * kKgPerLb;

@@ -1,20 +1,15 @@
 #include "rollsim/validate/maker_calibration.hpp"
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <limits>
 
 #include "rollsim/common/statistics.hpp"
+#include "rollsim/common/text.hpp"
 
 namespace rollsim::validate {
 
 namespace {
-
-std::string lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return s;
-}
 
 constexpr double kNoCalibration = std::numeric_limits<double>::infinity();
 
@@ -36,7 +31,7 @@ double shrunk_median(const Rows& rows, const std::string& leave_out, double shri
 
 MakerCalibration MakerCalibration::fit(const std::vector<CalibrationSample>& fitting) {
   MakerCalibration c;
-  for (const auto& s : fitting) c.groups_[{s.fuel, s.cycle, lower(s.make)}].push_back({lower(s.model), s.log_error});
+  for (const auto& s : fitting) c.groups_[{s.fuel, s.cycle, lower_ascii(s.make)}].push_back({lower_ascii(s.model), s.log_error});
 
   std::map<EpaFuel, std::vector<const CalibrationSample*>> by_fuel;
   for (const auto& s : fitting) by_fuel[s.fuel].push_back(&s);
@@ -44,8 +39,8 @@ MakerCalibration MakerCalibration::fit(const std::vector<CalibrationSample>& fit
     auto mean_abs_log_error = [&](double shrinkage_rows) {
       double sum = 0.0;
       for (const CalibrationSample* s : samples) {
-        const auto& group = c.groups_.at({s->fuel, s->cycle, lower(s->make)});
-        sum += std::abs(s->log_error - shrunk_median(group, lower(s->model), shrinkage_rows));
+        const auto& group = c.groups_.at({s->fuel, s->cycle, lower_ascii(s->make)});
+        sum += std::abs(s->log_error - shrunk_median(group, lower_ascii(s->model), shrinkage_rows));
       }
       return sum / static_cast<double>(samples.size());
     };
@@ -72,10 +67,10 @@ MakerCalibration MakerCalibration::fit(const std::vector<CalibrationSample>& fit
 
 double MakerCalibration::factor(EpaFuel fuel, EpaCycle cycle, const std::string& make, const std::string& leave_out_model) const {
   const auto choice = choices_.find(fuel);
-  const auto group = groups_.find({fuel, cycle, lower(make)});
+  const auto group = groups_.find({fuel, cycle, lower_ascii(make)});
   if (choice == choices_.end() || group == groups_.end()) return 1.0;
   // The physics' log error is ln(predicted / measured); the calibration divides out its expected part.
-  return std::exp(-shrunk_median(group->second, lower(leave_out_model), choice->second.shrinkage_rows));
+  return std::exp(-shrunk_median(group->second, lower_ascii(leave_out_model), choice->second.shrinkage_rows));
 }
 
 }  // namespace rollsim::validate

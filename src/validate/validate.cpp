@@ -7,9 +7,10 @@
 #include <map>
 #include <tuple>
 
-#include "rollsim/common/error.hpp"
 #include "rollsim/common/distribute.hpp"
+#include "rollsim/common/error.hpp"
 #include "rollsim/common/statistics.hpp"
+#include "rollsim/common/text.hpp"
 #include "rollsim/common/units.hpp"
 #include "rollsim/cycle/drive_cycle.hpp"
 #include "rollsim/powertrain/engine_map.hpp"
@@ -23,11 +24,6 @@ constexpr double kKwhPerGallonEquivalent = 33.705;  // EPA's energy content of a
 // FTP-75 weighting of the cold-start (bags 1+2) and hot-start (bags 3+2) UDDS, 40 CFR 600.113.
 constexpr double kColdWeight = 0.43, kHotWeight = 0.57;
 constexpr std::uint64_t kFnvOffset = 0xcbf29ce484222325ULL, kFnvPrime = 0x100000001b3ULL;
-
-std::string lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return s;
-}
 
 bool liquid(EpaFuel f) { return f == EpaFuel::petrol || f == EpaFuel::diesel || f == EpaFuel::e85; }
 bool charge_depleting(EpaCycle c) { return c == EpaCycle::cd_udds || c == EpaCycle::cd_highway || c == EpaCycle::cd_us06; }
@@ -61,10 +57,10 @@ Cycles shipped_cycles() {
 }
 
 // ---- hybrids: the list does not flag them, so three rules (README) ----
-std::string vehicle_key(const EpaTestRow& r) { return lower(r.make) + "|" + lower(r.model) + "|" + r.vehicle_id; }
+std::string vehicle_key(const EpaTestRow& r) { return lower_ascii(r.make) + "|" + lower_ascii(r.model) + "|" + r.vehicle_id; }
 
 bool name_says_hybrid(const EpaTestRow& r) {
-  const std::string m = lower(r.model);
+  const std::string m = lower_ascii(r.model);
   for (const char* word : {"hybrid", "plug-in", "prime", "4xe", "recharge", "tfsie"}) {
     if (m.find(word) != std::string::npos) return true;
   }
@@ -323,7 +319,7 @@ double ftp75_weighted_mpg(double bag1_gal, double bag2_gal, double bag3_gal, dou
 
 bool in_fitting_half(const EpaTestRow& row) {
   std::uint64_t h = kFnvOffset;
-  for (const char c : lower(row.make) + "|" + lower(row.model)) h = (h ^ static_cast<unsigned char>(c)) * kFnvPrime;
+  for (const char c : lower_ascii(row.make) + "|" + lower_ascii(row.model)) h = (h ^ static_cast<unsigned char>(c)) * kFnvPrime;
   return h % 2 == 0;
 }
 
