@@ -35,7 +35,9 @@ MakerCalibration MakerCalibration::fit(const std::vector<CalibrationSample>& fit
 
   std::map<EpaFuel, std::vector<const CalibrationSample*>> by_fuel;
   for (const auto& s : fitting) by_fuel[s.fuel].push_back(&s);
-  for (const auto& [fuel, samples] : by_fuel) {
+  for (const auto& entry : by_fuel) {
+    const EpaFuel fuel = entry.first;
+    const auto& samples = entry.second;  // not a structured binding: clang before 16 cannot capture one in C++20
     auto mean_abs_log_error = [&](double shrinkage_rows) {
       double sum = 0.0;
       for (const CalibrationSample* s : samples) {
