@@ -741,6 +741,24 @@ TEST(CliValidate, JsonRowsAndANamedErrorForAFileWithoutTheColumns) {
   ASSERT_EQ(t.exit_code, 0) << t.err;
   EXPECT_NE(t.out.find("simulated 0 of 0 FTP-75, HWFET, US06 and charge-depleting rows (none in this half)"),
             std::string::npos) << t.out;
+  // The list's third and fourth rows, the Aston Martin DBX's, are held out: with no fitting row there is no maker
+  // calibration to learn, and the summary says so; every row keeps the physics' prediction.
+  const auto held_out = dir / "held_out_only.csv";
+  {
+    std::ifstream in(kList);
+    std::ofstream out(held_out);
+    std::string line;
+    for (int i = 0; i < 5 && std::getline(in, line); ++i) {
+      if (i == 0 || i >= 3) out << line << "\n";
+    }
+  }
+  const auto h = test::run_rollsim("validate --epa-test-car-list " + held_out.string());
+  ASSERT_EQ(h.exit_code, 0) << h.err;
+  EXPECT_NE(h.out.find("fitting: simulated 0 of 0"), std::string::npos) << h.out;
+  EXPECT_NE(h.out.find("  none: the fitting half has no simulated row\n"), std::string::npos) << h.out;
+  const auto hj = test::run_rollsim("validate --json --epa-test-car-list " + held_out.string());
+  ASSERT_EQ(hj.exit_code, 0) << hj.err;
+  for (const auto& row : test::lines(hj.out)) EXPECT_NE(row.find("\"maker_factor\": 1,"), std::string::npos) << row;
 }
 
 }  // namespace

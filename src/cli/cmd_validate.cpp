@@ -76,6 +76,7 @@ void print_summary(const validate::Validation& v) {
   std::cout << table(lines, &validate::SummaryLine::physics);
   std::cout << "maker calibration, learned on the fitting half (empirical: it explains nothing): each make's median "
                "log error on each cycle, shrunk by n / (n + k) over its n rows, k chosen by leaving one model out\n";
+  if (v.maker_calibration.choices().empty()) std::cout << "  none: the fitting half has no simulated row\n";
   for (const auto& [fuel, c] : v.maker_calibration.choices()) {
     std::cout << "  " << validate::to_string(fuel) << ": "
               << (std::isinf(c.shrinkage_rows) ? "none (no k improves on the physics)"
