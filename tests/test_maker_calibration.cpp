@@ -111,3 +111,18 @@ TEST(MakerCalibration, WithOneModelPerMakeThereIsNothingToLearnAndNoCalibration)
   EXPECT_EQ(c.factor(EpaFuel::e85, EpaCycle::ftp75, "Ford"), 1.0);
   EXPECT_EQ(c.factor(EpaFuel::e85, EpaCycle::ftp75, "Ford", "F150"), 1.0);
 }
+
+TEST(MakerCalibration, AModelTheListLeavesBlankIsLeftOutLikeAnyOther) {
+  // The list may leave a model's name empty; those rows are one model (as the split treats them), so a fitting row
+  // of it is calibrated from the make's other models only, not from its own rows.
+  const std::vector<CalibrationSample> fitting = {
+      {EpaFuel::petrol, EpaCycle::hwfet, "X", "", 0.20},  {EpaFuel::petrol, EpaCycle::hwfet, "X", "", 0.21},
+      {EpaFuel::petrol, EpaCycle::hwfet, "X", "A", 0.19}, {EpaFuel::petrol, EpaCycle::hwfet, "X", "A", 0.20},
+      {EpaFuel::petrol, EpaCycle::hwfet, "Y", "B", -0.10}, {EpaFuel::petrol, EpaCycle::hwfet, "Y", "C", -0.11},
+  };
+  const auto c = MakerCalibration::fit(fitting);
+  ASSERT_EQ(c.choices().at(EpaFuel::petrol).shrinkage_rows, 0.0);
+  EXPECT_NEAR(c.factor(EpaFuel::petrol, EpaCycle::hwfet, "X", std::string()), std::exp(-0.195), 1e-12);
+  EXPECT_NEAR(c.factor(EpaFuel::petrol, EpaCycle::hwfet, "X", std::string("A")), std::exp(-0.205), 1e-12);
+  EXPECT_NEAR(c.factor(EpaFuel::petrol, EpaCycle::hwfet, "X"), std::exp(-0.20), 1e-12);
+}

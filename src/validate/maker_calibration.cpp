@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "rollsim/common/statistics.hpp"
 #include "rollsim/common/text.hpp"
@@ -16,11 +17,11 @@ constexpr double kNoCalibration = std::numeric_limits<double>::infinity();
 // The group's log factor without `leave_out`'s rows, shrunk towards no correction by n / (n + shrinkage): a make
 // seen on two rows moves a prediction less than one seen on forty.
 template <class Rows>
-double shrunk_median(const Rows& rows, const std::string& leave_out, double shrinkage_rows) {
+double shrunk_median(const Rows& rows, const std::optional<std::string>& leave_out, double shrinkage_rows) {
   if (std::isinf(shrinkage_rows)) return 0.0;
   std::vector<double> e;
   for (const auto& r : rows) {
-    if (leave_out.empty() || r.model != leave_out) e.push_back(r.log_error);
+    if (!leave_out || r.model != *leave_out) e.push_back(r.log_error);
   }
   if (e.empty()) return 0.0;
   const double n = static_cast<double>(e.size());
@@ -67,12 +68,14 @@ MakerCalibration MakerCalibration::fit(const std::vector<CalibrationSample>& fit
   return c;
 }
 
-double MakerCalibration::factor(EpaFuel fuel, EpaCycle cycle, const std::string& make, const std::string& leave_out_model) const {
+double MakerCalibration::factor(EpaFuel fuel, EpaCycle cycle, const std::string& make,
+                                const std::optional<std::string>& leave_out_model) const {
   const auto choice = choices_.find(fuel);
   const auto group = groups_.find({fuel, cycle, lower_ascii(make)});
   if (choice == choices_.end() || group == groups_.end()) return 1.0;
   // The physics' log error is ln(predicted / measured); the calibration divides out its expected part.
-  return std::exp(-shrunk_median(group->second, lower_ascii(leave_out_model), choice->second.shrinkage_rows));
+  const auto leave_out = leave_out_model ? std::optional<std::string>(lower_ascii(*leave_out_model)) : std::nullopt;
+  return std::exp(-shrunk_median(group->second, leave_out, choice->second.shrinkage_rows));
 }
 
 }  // namespace rollsim::validate

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <tuple>
 
 #include "rollsim/common/distribute.hpp"
@@ -296,7 +297,8 @@ void calibrate_makers(Validation& v) {
   v.maker_calibration = MakerCalibration::fit(fitting);
   for (auto& o : v.rows) {
     if (o.skip != SkipReason::none) continue;
-    o.maker_factor = v.maker_calibration.factor(o.row->fuel, o.row->cycle, o.row->make, o.fitting_half ? o.row->model : "");
+    const auto own_model = o.fitting_half ? std::optional<std::string>(o.row->model) : std::nullopt;
+    o.maker_factor = v.maker_calibration.factor(o.row->fuel, o.row->cycle, o.row->make, own_model);
   }
 }
 

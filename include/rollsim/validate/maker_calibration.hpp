@@ -8,6 +8,7 @@
 
 #include <cstddef>
 #include <map>
+#include <optional>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -43,8 +44,9 @@ class MakerCalibration {
 
   /// The factor on the physics' prediction (predicted x factor) for a row of this make on this cycle; 1 for a make
   /// or cycle the fitting half does not hold. `leave_out_model`: learn it without that model's rows (what a fitting
-  /// row is given, so no printed figure is in-sample).
-  double factor(EpaFuel fuel, EpaCycle cycle, const std::string& make, const std::string& leave_out_model = "") const;
+  /// row is given, so no printed figure is in-sample; a model the list leaves blank is one model, as in the split).
+  double factor(EpaFuel fuel, EpaCycle cycle, const std::string& make,
+                const std::optional<std::string>& leave_out_model = std::nullopt) const;
 
   const std::map<EpaFuel, CalibrationChoice>& choices() const { return choices_; }
 
