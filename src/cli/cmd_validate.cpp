@@ -73,16 +73,17 @@ void print_summary(const validate::Validation& v) {
                "not the tested vehicle the row describes\n";
   auto lines = validate::summarise(v);
   std::stable_sort(lines.begin(), lines.end(), [](const auto& a, const auto& b) { return a.half > b.half; });
-  std::cout << table(lines, &validate::SummaryLine::physics);
+  std::cout << "the physics (each car from its row alone, with the constants above):\n"
+            << table(lines, &validate::SummaryLine::physics);
   std::cout << "maker calibration, learned on the fitting half (empirical: it explains nothing): each make's median "
                "log error on each cycle, shrunk by n / (n + k) over its n rows, k chosen by leaving one model out\n";
   if (v.maker_calibration.choices().empty()) std::cout << "  none: the fitting half has no simulated row\n";
   for (const auto& [fuel, c] : v.maker_calibration.choices()) {
     std::cout << "  " << validate::to_string(fuel) << ": "
               << (std::isinf(c.shrinkage_rows) ? "none (no k improves on the physics)"
-                                               : "k = " + fixed(c.shrinkage_rows, 0) + " over " + std::to_string(c.groups) + " make-and-cycle groups")
-              << "; fitting half's mean |log error| " << fixed(100.0 * c.mean_abs_log_error_uncalibrated, 2) << " -> "
-              << fixed(100.0 * c.mean_abs_log_error_calibrated, 2) << " % over " << c.rows << " rows\n";
+                                               : "k = " + fixed(c.shrinkage_rows, 0) + " (" + std::to_string(c.groups) + " make-and-cycle groups)")
+              << "; mean |ln(predicted / measured)| over the fitting half's " << c.rows << " rows, each without its own model: "
+              << fixed(c.mean_abs_log_error_uncalibrated, 4) << " -> " << fixed(c.mean_abs_log_error_calibrated, 4) << "\n";
   }
   std::cout << "with the maker calibration (a fitting-half row calibrated without its own model):\n"
             << table(lines, &validate::SummaryLine::maker_calibrated);

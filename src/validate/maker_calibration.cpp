@@ -28,14 +28,18 @@ double shrunk_median(const Rows& rows, const std::optional<std::string>& leave_o
   return median(e) * n / (n + shrinkage_rows);
 }
 
+bool blank(const std::string& text) { return text.find_first_not_of(" \t") == std::string::npos; }
+
 }  // namespace
 
 MakerCalibration MakerCalibration::fit(const std::vector<CalibrationSample>& fitting) {
   MakerCalibration c;
-  for (const auto& s : fitting) c.groups_[{s.fuel, s.cycle, lower_ascii(s.make)}].push_back({lower_ascii(s.model), s.log_error});
-
   std::map<EpaFuel, std::vector<const CalibrationSample*>> by_fuel;
-  for (const auto& s : fitting) by_fuel[s.fuel].push_back(&s);
+  for (const auto& s : fitting) {
+    if (blank(s.make) || !std::isfinite(s.log_error)) continue;
+    c.groups_[{s.fuel, s.cycle, lower_ascii(s.make)}].push_back({lower_ascii(s.model), s.log_error});
+    by_fuel[s.fuel].push_back(&s);
+  }
   for (const auto& entry : by_fuel) {
     const EpaFuel fuel = entry.first;
     const auto& samples = entry.second;  // not a structured binding: clang before 16 cannot capture one in C++20
@@ -72,7 +76,7 @@ double MakerCalibration::factor(EpaFuel fuel, EpaCycle cycle, const std::string&
                                 const std::optional<std::string>& leave_out_model) const {
   const auto choice = choices_.find(fuel);
   const auto group = groups_.find({fuel, cycle, lower_ascii(make)});
-  if (choice == choices_.end() || group == groups_.end()) return 1.0;
+  if (choice == choices_.end() || group == groups_.end() || blank(make)) return 1.0;
   // The physics' log error is ln(predicted / measured); the calibration divides out its expected part.
   const auto leave_out = leave_out_model ? std::optional<std::string>(lower_ascii(*leave_out_model)) : std::nullopt;
   return std::exp(-shrunk_median(group->second, leave_out, choice->second.shrinkage_rows));

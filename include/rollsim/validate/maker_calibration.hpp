@@ -27,7 +27,7 @@ struct CalibrationSample {
 
 /// Per energy source: the shrinkage chosen by leave-one-model-out on the fitting half, and what it scored there.
 struct CalibrationChoice {
-  /// A group's factor is exp(median log error x n / (n + shrinkage_rows)) for its n rows; infinite: no calibration.
+  /// A group's factor is exp(-median log error x n / (n + shrinkage_rows)) for its n rows; infinite: no calibration.
   double shrinkage_rows = 0.0;
   double mean_abs_log_error_uncalibrated = 0.0;  ///< fitting half, the physics alone
   double mean_abs_log_error_calibrated = 0.0;    ///< fitting half, each row calibrated without its own model
@@ -36,14 +36,15 @@ struct CalibrationChoice {
 
 class MakerCalibration {
  public:
-  /// Learns the factors from the fitting half's samples. For each energy source, the shrinkage is the one of
+  /// Learns the factors from the fitting half's samples (a blank make or a log error that is not finite teaches
+  /// nothing and is passed over). For each energy source, the shrinkage is the one of
   /// kShrinkageCandidates (or none) that gives the smallest mean |log error| when every fitting row is calibrated
   /// from the other models of its make (leave one model out, as the held-out half is models the fit never saw);
   /// a tie keeps the larger shrinkage.
   static MakerCalibration fit(const std::vector<CalibrationSample>& fitting);
 
   /// The factor on the physics' prediction (predicted x factor) for a row of this make on this cycle; 1 for a make
-  /// or cycle the fitting half does not hold. `leave_out_model`: learn it without that model's rows (what a fitting
+  /// or cycle the fitting half does not hold, and for a blank make (rows without a make are not one maker's). `leave_out_model`: learn it without that model's rows (what a fitting
   /// row is given, so no printed figure is in-sample; a model the list leaves blank is one model, as in the split).
   double factor(EpaFuel fuel, EpaCycle cycle, const std::string& make,
                 const std::optional<std::string>& leave_out_model = std::nullopt) const;
