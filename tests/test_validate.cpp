@@ -610,8 +610,8 @@ TEST(EpaList, WholeListSkipsByNameAndAgreesAsReportedOnTheHeldOutHalf) {
   // The maker calibration (README, "The maker calibration"), judged on models it never saw: on the held-out half as
   // split it meets every target the physics alone misses (at this commit petrol FTP-75 4.8 / 11.8 %, electric CD
   // UDDS 1.9 / 10.4 %) and keeps those it meets. Many of those models are trims of nameplates the fitting half
-  // holds; for a new nameplate it does not meet them (scripts/validate-nameplates, README). It leaves the physics' prediction as it was, and a fitting row's
-  // factor is learned without its own model.
+  // holds; for a new nameplate it does not meet them (scripts/validate-nameplates, README). It leaves the physics'
+  // prediction as it was, and a fitting row's factor is learned without its own model.
   for (const auto& s : validate::summarise(v)) {
     if (s.half != "held-out" || s.count < 30) continue;
     const bool petrol = s.powertrain == "petrol", electric = s.powertrain == "electric";
