@@ -5,6 +5,7 @@
 #include <limits>
 #include <optional>
 
+#include "rollsim/common/csv.hpp"
 #include "rollsim/common/statistics.hpp"
 #include "rollsim/common/text.hpp"
 
@@ -28,27 +29,29 @@ double shrunk_median(const Rows& rows, const std::optional<std::string>& leave_o
   return median(e) * n / (n + shrinkage_rows);
 }
 
-bool blank(const std::string& text) { return text.find_first_not_of(" \t") == std::string::npos; }
-
 }  // namespace
 
 MakerCalibration MakerCalibration::fit(const std::vector<CalibrationSample>& fitting) {
   MakerCalibration c;
-  std::map<EpaFuel, std::vector<const CalibrationSample*>> by_fuel;
   for (const auto& s : fitting) {
-    if (blank(s.make) || !std::isfinite(s.log_error)) continue;
+    if (trim(s.make).empty() || !std::isfinite(s.log_error)) continue;
     c.groups_[{s.fuel, s.cycle, lower_ascii(s.make)}].push_back({lower_ascii(s.model), s.log_error});
-    by_fuel[s.fuel].push_back(&s);
+  }
+  // Each sample scored as a row of its group, looked up once: the candidates below score every sample again.
+  struct Scored {
+    const std::vector<ModelErrors>* group;
+    const ModelErrors* row;
+  };
+  std::map<EpaFuel, std::vector<Scored>> by_fuel;
+  for (const auto& [key, rows] : c.groups_) {
+    for (const auto& row : rows) by_fuel[std::get<0>(key)].push_back({&rows, &row});
   }
   for (const auto& entry : by_fuel) {
     const EpaFuel fuel = entry.first;
     const auto& samples = entry.second;  // not a structured binding: clang before 16 cannot capture one in C++20
     auto mean_abs_log_error = [&](double shrinkage_rows) {
       double sum = 0.0;
-      for (const CalibrationSample* s : samples) {
-        const auto& group = c.groups_.at({s->fuel, s->cycle, lower_ascii(s->make)});
-        sum += std::abs(s->log_error - shrunk_median(group, lower_ascii(s->model), shrinkage_rows));
-      }
+      for (const Scored& s : samples) sum += std::abs(s.row->log_error - shrunk_median(*s.group, s.row->model, shrinkage_rows));
       return sum / static_cast<double>(samples.size());
     };
     CalibrationChoice choice;
@@ -76,7 +79,7 @@ double MakerCalibration::factor(EpaFuel fuel, EpaCycle cycle, const std::string&
                                 const std::optional<std::string>& leave_out_model) const {
   const auto choice = choices_.find(fuel);
   const auto group = groups_.find({fuel, cycle, lower_ascii(make)});
-  if (choice == choices_.end() || group == groups_.end() || blank(make)) return 1.0;
+  if (choice == choices_.end() || group == groups_.end() || trim(make).empty()) return 1.0;
   // The physics' log error is ln(predicted / measured); the calibration divides out its expected part.
   const auto leave_out = leave_out_model ? std::optional<std::string>(lower_ascii(*leave_out_model)) : std::nullopt;
   return std::exp(-shrunk_median(group->second, leave_out, choice->second.shrinkage_rows));
