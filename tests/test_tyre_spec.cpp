@@ -51,7 +51,7 @@ TEST(TyreSize, ParsesPlainDesignationsWithAndWithoutSpaces) {
   EXPECT_NEAR(a.outer_radius_m, 19 * kInch / 2 + 0.155 * 0.70, 1e-12);
   EXPECT_EQ(a.load_index, 84);
   EXPECT_EQ(a.speed_symbol, "Q");
-  EXPECT_EQ(a.prefix, "");
+  EXPECT_EQ(a.prefix, SizePrefix::none);
   EXPECT_FALSE(a.extra_load);
 
   const TyreSize b = parse_tyre_size("175/65R15 84H", "t");
@@ -79,12 +79,12 @@ TEST(TyreSize, LoadIndexAndSpeedSymbolAreOptional) {
 
 TEST(TyreSize, ParsesPrefixesConstructionAndExtraLoad) {
   const TyreSize p = parse_tyre_size("P205/55R16 91V XL", "t");
-  EXPECT_EQ(p.prefix, "P");
+  EXPECT_EQ(p.prefix, SizePrefix::passenger);
   EXPECT_DOUBLE_EQ(p.section_width_m, 0.205);
   EXPECT_TRUE(p.extra_load);
 
   const TyreSize lt = parse_tyre_size("LT245/75R16 121/118S", "t");
-  EXPECT_EQ(lt.prefix, "LT");
+  EXPECT_EQ(lt.prefix, SizePrefix::light_truck);
   EXPECT_EQ(lt.load_index, 121);  // single-wheel rating comes first
   EXPECT_EQ(lt.speed_symbol, "S");
 

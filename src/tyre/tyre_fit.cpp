@@ -361,7 +361,7 @@ RrcPoint iso28580_point(const TyreSize& size, double rrc, const std::string& whe
     throw InputError(where, "the size '" + size.designation + "' has no load index, so the ISO 28580 load (80 % of "
                             "the load index's load) is unknown; give the size with its load index, e.g. '205/55 R16 91V'");
   }
-  if (size.prefix == "LT") {
+  if (size.prefix == SizePrefix::light_truck) {
     // ISO 28580 tests a C2 tyre at 85 % of its load at the pressure of its load-inflation table, and its EU label
     // has bands of its own: neither is built, and the passenger point would be a silently wrong one.
     throw InputError(where, "'" + size.designation + "' is a light-truck size (EU class C2): its ISO 28580 point "
@@ -369,7 +369,7 @@ RrcPoint iso28580_point(const TyreSize& size, double rrc, const std::string& whe
                             "bands are not built; give its measured point(s) as KPA,LOAD_N,KMH,RRC");
   }
   RrcPoint p;
-  p.pressure_pa = size.extra_load ? 250e3 : 210e3;
+  p.pressure_pa = iso28580_passenger_pressure_pa(size);
   p.load_n = 0.8 * *load_index_max_load_kg(*size.load_index) * units::kStandardGravity_mps2;
   p.speed_mps = units::kmh_to_mps(80.0);
   p.rrc = rrc;

@@ -56,11 +56,11 @@ std::vector<HysteresisParam> free_params_from_keys(const std::vector<std::string
 }
 
 double fitted_file_pressure_pa(const TyreSize& size, std::optional<double> pressure_bar, const std::string& where) {
-  if (!pressure_bar && size.prefix == "LT") {
+  if (!pressure_bar && size.prefix == SizePrefix::light_truck) {
     throw InputError(where, "missing: a light-truck tyre ('" + size.designation + "') runs at the pressure of its "
                             "load-inflation table, not a passenger tyre's 2.1 bar; give the pressure to write in bar");
   }
-  if (!pressure_bar) return size.extra_load ? 250e3 : 210e3;
+  if (!pressure_bar) return iso28580_passenger_pressure_pa(size);
   return units::bar_to_pa(checked_number(*pressure_bar, where, Range::closed(0.5, 6.0)));
 }
 

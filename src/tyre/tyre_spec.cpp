@@ -197,6 +197,8 @@ const char* kFormat =
 
 }  // namespace
 
+double iso28580_passenger_pressure_pa(const TyreSize& size) { return size.extra_load ? 250e3 : 210e3; }
+
 std::optional<double> load_index_max_load_kg(int load_index) {
   if (load_index < kFirstLoadIndex || load_index > kLastLoadIndex) return std::nullopt;
   return kLoadIndexKg[static_cast<std::size_t>(load_index - kFirstLoadIndex)];
@@ -214,9 +216,9 @@ TyreSize parse_tyre_size(const std::string& designation, const std::string& wher
   Cursor c{text};
   c.skip_spaces();
   if (c.eat("LT")) {
-    out.prefix = "LT";
+    out.prefix = SizePrefix::light_truck;
   } else if (c.eat("P")) {
-    out.prefix = "P";
+    out.prefix = SizePrefix::passenger;
   }
   const std::string width = c.digits();
   if (width.size() != 3) return fail("section width must be 3 digits in mm");

@@ -9,10 +9,14 @@
 
 namespace rollsim {
 
+/// The service prefix of a size designation: none (metric, "205/55 R16"), "P" (P-metric) or "LT" (light truck,
+/// EU class C2, whose ISO 28580 conditions and label bands differ from a passenger tyre's).
+enum class SizePrefix { none, passenger, light_truck };
+
 /// What a size designation such as "P205/55 R16 91V XL" says, in SI.
 struct TyreSize {
   std::string designation;          ///< as written by the user
-  std::string prefix;               ///< "", "P" or "LT"
+  SizePrefix prefix = SizePrefix::none;
   double section_width_m = 0.0;     ///< 205 mm
   double aspect_ratio = 0.0;        ///< 0.55
   double rim_diameter_m = 0.0;      ///< 16 in
@@ -25,6 +29,9 @@ struct TyreSize {
 /// Parses a designation; throws InputError(where, ...) naming `where` (file key or option) if it does not parse
 /// or its load index is outside the table.
 TyreSize parse_tyre_size(const std::string& designation, const std::string& where);
+
+/// ISO 28580's inflation for a passenger tyre (C1): 250 kPa for extra load, 210 kPa otherwise.
+double iso28580_passenger_pressure_pa(const TyreSize& size);
 
 /// Maximum load [kg] of an ETRTO/ISO load index; std::nullopt outside the table (indices 60..125 at least).
 std::optional<double> load_index_max_load_kg(int load_index);
