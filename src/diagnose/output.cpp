@@ -19,49 +19,51 @@ std::string num(double v) { return significant(v, 6); }
 using diag::num;
 
 std::string diagnosis_json(const Diagnosis& d) {
+  // JSON has no NaN or infinity: a figure a degenerate recording leaves undefined is null.
+  const auto jnum = [](double v) { return std::isfinite(v) ? num(v) : std::string("null"); };
   std::ostringstream os;
   os << "{\n  \"verdict\": \"" << d.verdict << "\",\n  \"channel\": \"" << d.channel << "\",\n";
-  os << "  \"windows\": " << d.windows << ",\n  \"effective_windows\": " << num(d.effective_windows) << ",\n";
-  os << "  \"calibration\": {\"channel_scale\": " << num(d.channel_scale) << ", \"rrc_level_change\": " << num(d.rrc_level_change)
-     << ", \"drag_change\": " << num(d.drag_change) << ", \"channel_scale_prior\": {\"low\": " << num(d.channel_scale_prior_low)
-     << ", \"high\": " << num(d.channel_scale_prior_high) << "}, \"channel_scale_free\": " << num(d.channel_scale_free) << ", \"rrc_level_change_free\": " << num(d.rrc_level_change_free)
-     << ", \"drag_change_free\": " << num(d.drag_change_free) << ", \"delta_bic_leaving_prior\": " << num(d.calibration_delta_bic_leaving_prior)
+  os << "  \"windows\": " << d.windows << ",\n  \"effective_windows\": " << jnum(d.effective_windows) << ",\n";
+  os << "  \"calibration\": {\"channel_scale\": " << jnum(d.channel_scale) << ", \"rrc_level_change\": " << jnum(d.rrc_level_change)
+     << ", \"drag_change\": " << jnum(d.drag_change) << ", \"channel_scale_prior\": {\"low\": " << jnum(d.channel_scale_prior_low)
+     << ", \"high\": " << jnum(d.channel_scale_prior_high) << "}, \"channel_scale_free\": " << jnum(d.channel_scale_free) << ", \"rrc_level_change_free\": " << jnum(d.rrc_level_change_free)
+     << ", \"drag_change_free\": " << jnum(d.drag_change_free) << ", \"delta_bic_leaving_prior\": " << jnum(d.calibration_delta_bic_leaving_prior)
      << ", \"channel_scale_outside_prior\": " << (d.channel_scale_outside_prior ? "true" : "false")
-     << ", \"scale_absorbed_energy_pct\": " << num(d.scale_absorbed_energy_pct) << "},\n";
-  os << "  \"adequacy\": {\"noise_floor_j\": " << num(d.noise_floor_j) << ", \"residual_to_noise_ratio\": "
-     << num(d.residual_to_noise_ratio) << ", \"z\": " << num(d.residual_to_noise_z) << ", \"scale_s\": " << num(d.adequacy_scale_s)
-     << ", \"after_findings_ratio\": " << num(d.final_residual_to_noise_ratio) << ", \"after_findings_z\": "
-     << num(d.final_residual_to_noise_z) << "},\n";
+     << ", \"scale_absorbed_energy_pct\": " << jnum(d.scale_absorbed_energy_pct) << "},\n";
+  os << "  \"adequacy\": {\"noise_floor_j\": " << jnum(d.noise_floor_j) << ", \"residual_to_noise_ratio\": "
+     << jnum(d.residual_to_noise_ratio) << ", \"z\": " << jnum(d.residual_to_noise_z) << ", \"scale_s\": " << jnum(d.adequacy_scale_s)
+     << ", \"after_findings_ratio\": " << jnum(d.final_residual_to_noise_ratio) << ", \"after_findings_z\": "
+     << jnum(d.final_residual_to_noise_z) << "},\n";
   os << "  \"lag_samples\": " << d.lag_samples << ",\n";
-  os << "  \"lag_s\": {\"value\": " << num(d.lag_s) << ", \"ci_low\": " << num(d.lag_ci_low_s) << ", \"ci_high\": " << num(d.lag_ci_high_s) << "},\n";
+  os << "  \"lag_s\": {\"value\": " << jnum(d.lag_s) << ", \"ci_low\": " << jnum(d.lag_ci_low_s) << ", \"ci_high\": " << jnum(d.lag_ci_high_s) << "},\n";
   os << "  \"engine_starts\": [";
   for (std::size_t i = 0; i < d.engine_starts.size(); ++i) {
     const auto& e = d.engine_starts[i];
     os << (i ? ", " : "") << "{\"recording\": " << json_string(e.recording) << ", \"start\": " << json_string(to_string(e.start))
-       << ", \"inferred\": " << (e.inferred ? "true" : "false") << ", \"early_excess\": " << num(e.early_excess)
-       << ", \"early_excess_ci\": [" << num(e.early_excess_ci_low) << ", " << num(e.early_excess_ci_high) << "]}";
+       << ", \"inferred\": " << (e.inferred ? "true" : "false") << ", \"early_excess\": " << jnum(e.early_excess)
+       << ", \"early_excess_ci\": [" << jnum(e.early_excess_ci_low) << ", " << jnum(e.early_excess_ci_high) << "]}";
   }
   os << "],\n";
   os << "  \"channel_sampling\": {\"chosen\": \"" << d.channel_sampling << "\", \"interval_over_instant_sse\": "
-     << num(d.channel_sampling_sse_ratio) << "},\n";
-  os << "  \"window_s\": " << num(d.window_s) << ",\n  \"notes\": [";
+     << jnum(d.channel_sampling_sse_ratio) << "},\n";
+  os << "  \"window_s\": " << jnum(d.window_s) << ",\n  \"notes\": [";
   for (std::size_t i = 0; i < d.notes.size(); ++i) os << (i ? ", " : "") << json_string(d.notes[i]);
   os << "],\n";
-  os << "  \"raw_trip_energy_error_pct\": " << num(d.raw_trip_energy_error_pct) << ",\n";
-  os << "  \"heldout_rmse_calibrated\": " << num(d.heldout_rmse_calibrated_j) << ",\n";
-  os << "  \"heldout_energy_error_pct_calibrated\": " << num(d.heldout_energy_error_pct_calibrated) << ",\n";
+  os << "  \"raw_trip_energy_error_pct\": " << jnum(d.raw_trip_energy_error_pct) << ",\n";
+  os << "  \"heldout_rmse_calibrated\": " << jnum(d.heldout_rmse_calibrated_j) << ",\n";
+  os << "  \"heldout_energy_error_pct_calibrated\": " << jnum(d.heldout_energy_error_pct_calibrated) << ",\n";
   os << "  \"findings\": [";
   for (std::size_t i = 0; i < d.findings.size(); ++i) {
     const auto& f = d.findings[i];
     // A finding that fitted nothing has no held-out figures: null, not the zeros its fields start at.
-    const auto scored = [&f](double x) { return f.heldout_scored ? num(x) : std::string("null"); };
+    const auto scored = [&f, &jnum](double x) { return f.heldout_scored ? jnum(x) : std::string("null"); };
     os << (i ? "," : "") << "\n    {\"effect\": \"" << f.effect << "\", ";
     if (!f.description.empty()) os << "\"description\": " << json_string(f.description) << ", ";
     os << "\"parameters\": {";
     for (std::size_t k = 0; k < f.parameters.size(); ++k) {
       const auto& p = f.parameters[k];
-      os << (k ? ", " : "") << "\"" << p.name << "\": {\"value\": " << num(p.value) << ", \"ci_low\": " << num(p.ci_low)
-         << ", \"ci_high\": " << num(p.ci_high) << ", \"unit\": \"" << p.unit << "\"";
+      os << (k ? ", " : "") << "\"" << p.name << "\": {\"value\": " << jnum(p.value) << ", \"ci_low\": " << jnum(p.ci_low)
+         << ", \"ci_high\": " << jnum(p.ci_high) << ", \"unit\": \"" << p.unit << "\"";
       if (p.profiled)
         os << ", \"interval\": \"profile\", \"ci_low_open\": " << (p.ci_low_open ? "true" : "false")
            << ", \"ci_high_open\": " << (p.ci_high_open ? "true" : "false");
@@ -72,8 +74,8 @@ std::string diagnosis_json(const Diagnosis& d) {
     os << "], \"separating_tests\": [";
     for (std::size_t k = 0; k < f.separating_tests.size(); ++k)
       os << (k ? ", " : "") << json_string(f.separating_tests[k]);
-    os << "], \"delta_bic\": " << num(f.delta_bic)
-       << ", \"energy_share_pct\": " << (std::isnan(f.energy_share_pct) ? "null" : num(f.energy_share_pct))
+    os << "], \"delta_bic\": " << jnum(f.delta_bic)
+       << ", \"energy_share_pct\": " << jnum(f.energy_share_pct)
        << ", \"heldout_rmse_before\": " << scored(f.heldout_rmse_before_j)
        << ", \"heldout_rmse_after\": " << scored(f.heldout_rmse_after_j)
        << ", \"heldout_energy_error_pct_before\": " << scored(f.heldout_energy_error_pct_before)
@@ -81,9 +83,9 @@ std::string diagnosis_json(const Diagnosis& d) {
        << ", \"heldout_lag1_autocorrelation_before\": " << scored(f.heldout_lag1_autocorrelation_before)
        << ", \"heldout_lag1_autocorrelation_after\": " << scored(f.heldout_lag1_autocorrelation_after);
     if (f.road_profile) {
-      auto array = [&os](const char* key, const std::vector<double>& v) {
+      auto array = [&os, &jnum](const char* key, const std::vector<double>& v) {
         os << "\"" << key << "\": [";
-        for (std::size_t k = 0; k < v.size(); ++k) os << (k ? ", " : "") << num(v[k]);
+        for (std::size_t k = 0; k < v.size(); ++k) os << (k ? ", " : "") << jnum(v[k]);
         os << "]";
       };
       os << ", \"road_profile\": {";
@@ -102,13 +104,13 @@ std::string diagnosis_json(const Diagnosis& d) {
   for (std::size_t i = 0; i < d.located.size(); ++i) {
     const auto& l = d.located[i];
     os << (i ? "," : "") << "\n    {\"regime\": \"" << l.regime << "\", \"samples\": " << l.samples << ", \"mean_residual_w\": "
-       << num(l.mean_w) << ", \"ci_low_w\": " << num(l.ci_low_w) << ", \"ci_high_w\": " << num(l.ci_high_w) << "}";
+       << jnum(l.mean_w) << ", \"ci_low_w\": " << jnum(l.ci_low_w) << ", \"ci_high_w\": " << jnum(l.ci_high_w) << "}";
   }
   os << (d.located.empty() ? "" : "\n  ") << "],\n  \"detection_limits\": [";
   for (std::size_t i = 0; i < d.detection_limits.size(); ++i) {
     const auto& l = d.detection_limits[i];
     os << (i ? "," : "") << "\n    {\"effect\": \"" << l.effect << "\", \"parameter\": \"" << l.parameter
-       << "\", \"smallest_detectable\": " << num(l.smallest_detectable) << ", \"unit\": \"" << l.unit
+       << "\", \"smallest_detectable\": " << jnum(l.smallest_detectable) << ", \"unit\": \"" << l.unit
        << "\", \"within_bounds\": " << (l.within_bounds ? "true" : "false") << "}";
   }
   os << (d.detection_limits.empty() ? "" : "\n  ") << "]\n}\n";

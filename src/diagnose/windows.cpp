@@ -8,6 +8,8 @@
 namespace rollsim::diag {
 namespace {
 
+constexpr double kMinDiagnosedDistance_m = 100.0;
+
 // Median of the non-zero steps of a quantised signal (its quantum), 0 if it never changes.
 double quantum_of(const std::vector<double>& x) {
   std::vector<double> steps;
@@ -38,30 +40,57 @@ double soc_window_s(const std::vector<Recording>& recordings, double capacity_j,
   return window_s;
 }
 
-// Cuts every recording into windows of `window_s` (a last one of at least half a window kept) and measures them.
+// Cuts every recording into windows of `window_s` (a last one of at least half a window kept) and measures them. No
+// window spans a gap in time longer than kReportedGap_s: what happened in it was not recorded, on either side.
 void cut_windows(Observations& o, const std::vector<Recording>& recordings) {
   o.windows.clear();
   std::vector<double> meas;
   for (std::size_t ri = 0; ri < recordings.size(); ++ri) {
     const Recording& r = recordings[ri];
+    const auto close = [&](std::size_t begin, std::size_t end) {
+      if (r.time_s[end] - r.time_s[begin] < 0.5 * o.window_s) return;
+      o.windows.push_back({ri, begin, end});
+      double e = 0.0;
+      if (o.channel == ChannelKind::soc) {
+        if (o.soc_capacity_j <= 0.0) throw InputError(r.source, "SOC recorded but the vehicle has no battery");
+        e = ((*r.soc_fraction)[begin] - (*r.soc_fraction)[end]) * o.soc_capacity_j;
+      } else {
+        for (std::size_t k = begin; k < end; ++k) e += o.measured_w[ri][k] * o.dt_s[ri][k];
+      }
+      meas.push_back(e);
+    };
     std::size_t begin = 0;
     for (std::size_t i = 1; i < r.time_s.size(); ++i) {
-      if (r.time_s[i] - r.time_s[begin] < o.window_s && i + 1 != r.time_s.size()) continue;
-      if (r.time_s[i] - r.time_s[begin] >= 0.5 * o.window_s) {
-        o.windows.push_back({ri, begin, i});
-        double e = 0.0;
-        if (o.channel == ChannelKind::soc) {
-          if (o.soc_capacity_j <= 0.0) throw InputError(r.source, "SOC recorded but the vehicle has no battery");
-          e = ((*r.soc_fraction)[begin] - (*r.soc_fraction)[i]) * o.soc_capacity_j;
-        } else {
-          for (std::size_t k = begin; k < i; ++k) e += o.measured_w[ri][k] * o.dt_s[ri][k];
-        }
-        meas.push_back(e);
+      if (r.time_s[i] - r.time_s[i - 1] > kReportedGap_s) {
+        close(begin, i - 1);
+        begin = i;
+        continue;
       }
+      if (r.time_s[i] - r.time_s[begin] < o.window_s && i + 1 != r.time_s.size()) continue;
+      close(begin, i);
       begin = i;
     }
   }
   o.measured_j = Eigen::Map<Eigen::VectorXd>(meas.data(), static_cast<Eigen::Index>(meas.size()));
+}
+
+// A recording the diagnosis cannot read energy from: the car never moves, or its energy channel never changes (a
+// dead or stuck logger channel, which would otherwise read as the model being infinitely wrong).
+void check_informative(const Recording& r, const std::vector<double>& measured_w, ChannelKind kind) {
+  double distance_m = 0.0;
+  for (std::size_t i = 0; i + 1 < r.time_s.size(); ++i) distance_m += r.speed_mps[i] * (r.time_s[i + 1] - r.time_s[i]);
+  if (distance_m < kMinDiagnosedDistance_m) {
+    throw InputError(r.source, "the car covers " + fixed(distance_m, 0) + " m in the recording; at least " +
+                                   fixed(kMinDiagnosedDistance_m, 0) + " m of driving is needed to diagnose it");
+  }
+  const std::vector<double>& x = kind == ChannelKind::soc ? *r.soc_fraction : measured_w;
+  const auto [lo, hi] = std::minmax_element(x.begin(), x.end());
+  if (*lo == *hi) {
+    const double shown = kind == ChannelKind::soc ? 100.0 * *lo : *lo;
+    throw InputError(r.source, "its " + to_string(kind) + " channel never changes (" + significant(shown, 6) +
+                                   (kind == ChannelKind::soc ? " %" : " W") + " throughout) while the car covers " +
+                                   fixed(distance_m / 1e3, 2) + " km: a dead or stuck channel carries no energy to compare");
+  }
 }
 
 }  // namespace
@@ -98,6 +127,7 @@ Observations build_windows(const Vehicle& vehicle, const std::vector<Recording>&
     const Recording& r = recordings[ri];
     ChannelKind kind{};
     o.measured_w.push_back(measured_power_w(vehicle, r, kind));
+    check_informative(r, o.measured_w.back(), kind);
     if (ri > 0 && kind != o.channel) throw InputError(r.source, "all recordings must carry the same energy channel");
     o.channel = kind;
     std::vector<double> dt(r.time_s.size() - 1);

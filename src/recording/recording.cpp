@@ -329,7 +329,7 @@ Recording load_recording(const std::string& path, const ColumnMapping& mapping) 
     }
     if (count) {
       rec.repairs.push_back(std::to_string(count) + " gap(s) in time longer than " + format_value(kReportedGap_s) +
-                            " s kept, not bridged: " + listed + (count > 10 ? "; ..." : ""));
+                            " s kept, not bridged (no energy window spans one): " + listed + (count > 10 ? "; ..." : ""));
     }
   }
 
