@@ -361,7 +361,7 @@ py::dict api_sensitivity(py::object tyre, py::object vehicle, py::object cycle, 
 
 py::dict api_validate(const std::string& list, py::object threads) {
   const unsigned n = threads.is_none() ? 0u
-                                       : static_cast<unsigned>(parse_option_number(number_text(threads), "threads",
+                                       : static_cast<unsigned>(parse_option_count(number_text(threads), "threads",
                                                                                    Range::closed(1, 1024)));
   const auto rows = validate::read_epa_test_car_list(list);
   validate::Validation v;

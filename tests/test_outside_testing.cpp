@@ -102,5 +102,84 @@ TEST_F(OutsideTesting, DiagnosisJsonHasNoNonFiniteNumbers) {
   EXPECT_TRUE(has(text, "null")) << text;
 }
 
+// An output given as a symlink or a device was replaced by a plain file (as root, --output /dev/null would have
+// replaced the system's /dev/null). A symlink's target is written now, and a device is written in place. (Tested
+// through links in the test's folder, never on /dev itself: a regression would replace the test machine's nodes.)
+TEST_F(OutsideTesting, OutputThroughASymlinkOrToADeviceKeepsTheNode) {
+  const std::string sweep = "sweep --tyre 175-70R14 --param pressure --from 1.5 --to 3.5 --steps 3 --output ";
+  const fs::path real = dir_ / "real.csv";
+  std::ofstream(real) << "old\n";
+  const fs::path link = dir_ / "link.csv";
+  fs::create_symlink("real.csv", link);
+  CmdResult r = run_rollsim(sweep + "'" + link.string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(fs::is_symlink(link));
+  EXPECT_TRUE(has(slurp(real), "pressure_bar,load_n")) << slurp(real);
+
+  const fs::path to_stdout = dir_ / "stdout_link";
+  fs::create_symlink("/proc/self/fd/1", to_stdout);
+  r = run_rollsim(sweep + "'" + to_stdout.string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(has(r.out, "pressure_bar,load_n")) << r.out;
+  EXPECT_TRUE(fs::is_symlink(to_stdout));
+}
+
+// An output that is one of the command's inputs destroyed it; two outputs on one file left one of them behind.
+TEST_F(OutsideTesting, AnOutputThatIsAnInputOrAnotherOutputIsRefusedBeforeComputing) {
+  const std::string cycle = write("c_in.csv", "time_s,speed_kmh\n0,0\n10,50\n30,50\n40,0\n");
+  CmdResult r = run_rollsim("simulate --vehicle ev --cycle '" + cycle + "' --trace '" + cycle + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, "--trace '" + cycle + "': is the same file as the input")) << r.err;
+  EXPECT_EQ(slurp(cycle), "time_s,speed_kmh\n0,0\n10,50\n30,50\n40,0\n");
+
+  const std::string points = write("m.csv", "pressure_kpa,load_n,speed_kmh,rrc\n210,4000,80,0.009\n");
+  r = run_rollsim("tyre fit --size '205/55 R16 91V' --measured '" + points + "' --output '" + points + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, "--output '" + points + "': is the same file as the input")) << r.err;
+
+  const fs::path svg = dir_ / "s.svg";
+  r = run_rollsim("sweep --tyre 175-70R14 --param pressure --from 1.5 --to 3.5 --steps 3 --output '" + svg.string() +
+                  "' --plot '" + svg.string() + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, "is the same file as --output")) << r.err;
+  EXPECT_FALSE(fs::exists(svg));
+}
+
+// tyre fit's --output made missing folders and was checked only after the fit; the other commands refuse.
+TEST_F(OutsideTesting, TyreFitChecksItsOutputFirstAndMakesNoFolders) {
+  const fs::path out = dir_ / "no" / "such" / "t.yaml";
+  const CmdResult r = run_rollsim("tyre fit --size '205/55 R16 91V' --point 0.009 --output '" + out.string() + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, "does not exist")) << r.err;
+  EXPECT_EQ(r.out, "");
+  EXPECT_FALSE(fs::exists(dir_ / "no"));
+}
+
+// Options ignored without a word, fractions taken as counts, NaN taken as the default, parse errors with CLI11's
+// own exit codes (105-109) where every other bad input exits 2.
+TEST_F(OutsideTesting, OptionsAreCheckedWholly) {
+  CmdResult r = run_rollsim("tyre fit --evaluate-j2452 ../shared/data/tyres/j2452_michelin_part.csv --label B");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, "--label: not allowed with --evaluate-j2452")) << r.err;
+  r = run_rollsim("validate --epa-test-car-list ../shared/data/vehicles/epa_test_car_list_2022_part.csv --threads 2.5");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, "--threads: '2.5' is not a whole number")) << r.err;
+  r = run_rollsim("diagnose --vehicle camry_2018 --preset anl_d3 --recording '" + kCamryUdds + "' --window-s nan");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, "--window-s: NaN is not allowed")) << r.err;
+  r = run_rollsim("simulate --vehicle ev --bogus");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_EQ(run_rollsim("simulate --help").exit_code, 0);
+}
+
+// The same recording twice was accepted, and each fold was predicted from its own copy (held-out error 0.06 %).
+TEST_F(OutsideTesting, ARecordingGivenTwiceIsRefused) {
+  const std::string copy = write("copy.csv", slurp(kCamryUdds));
+  const CmdResult r = run_rollsim("diagnose --vehicle camry_2018 --preset anl_d3 --recording '" + kCamryUdds +
+                                  "' --recording '" + copy + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, copy + ": holds the same samples (time, speed, energy channel) as " + kCamryUdds)) << r.err;
+}
+
 }  // namespace
 }  // namespace rollsim::test

@@ -97,7 +97,7 @@ void run_compare(const CompareOptionsText& o, const ProcessGroup& group) {
   selection::CompareOptions copt;
   copt.diameter_tolerance_pct = selection::parse_diameter_tolerance_pct(o.diameter_tolerance_pct);
   copt.replay = o.replay;
-  if (!o.threads.empty()) copt.threads = static_cast<unsigned>(parse_option_number(o.threads, "--threads", Range::closed(1, 1024)));
+  if (!o.threads.empty()) copt.threads = static_cast<unsigned>(parse_option_count(o.threads, "--threads", Range::closed(1, 1024)));
   copt.map_cases = group.mapper();
 
   // Candidates: --tyre files, then every *.yaml of the catalogue; a broken file is named and skipped.

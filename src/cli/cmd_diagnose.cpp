@@ -22,9 +22,11 @@ namespace {
 struct DiagnoseCliOptions {
   std::string vehicle, tyre, preset, json, write_vehicle, report, fleet;
   std::vector<std::string> recordings, columns, scales, engine_start;
-  double window_s = 0.0;  // 0: the library default
+  std::string window_s;  // empty: the library default
   bool road_profile = true;
 };
+
+double window_s_of(const std::string& text) { return parse_option_number(text, "--window-s", Range::closed(5.0, 3600.0)); }
 
 void run_diagnose(const DiagnoseCliOptions& o) {
   const std::string vehicle_path = resolve_data_file(o.vehicle, "vehicles", ".yaml", "--vehicle");
@@ -33,8 +35,11 @@ void run_diagnose(const DiagnoseCliOptions& o) {
   if (!o.tyre.empty()) fit_tyres(v, load_tyre_file(tyre_path));
   // Every destination is checked before the diagnosis, and all are written together after it.
   if (!o.report.empty()) check_report_dir(o.report);
-  if (!o.json.empty()) check_output_file(o.json, "--json");
-  if (!o.write_vehicle.empty()) check_output_file(o.write_vehicle, "--write-vehicle");
+  std::vector<std::string> inputs{vehicle_path, tyre_path};
+  inputs.insert(inputs.end(), o.recordings.begin(), o.recordings.end());
+  check_outputs_distinct({{o.json, "--json"}, {o.write_vehicle, "--write-vehicle"}});
+  if (!o.json.empty()) check_output_file(o.json, "--json", inputs);
+  if (!o.write_vehicle.empty()) check_output_file(o.write_vehicle, "--write-vehicle", inputs);
   // Column mapping: a preset, then the vehicle file's own logger mapping, then the command line's options.
   YamlMap vehicle_file = YamlMap::load_file(vehicle_path);
   ColumnMapping mapping = assemble_mapping(o.preset, vehicle_file, o.columns, o.scales);
@@ -44,7 +49,7 @@ void run_diagnose(const DiagnoseCliOptions& o) {
   for (const auto& r : recs)
     for (const auto& rep : r.repairs) (rep.rfind("warning:", 0) == 0 ? std::cerr : std::cout) << r.source << ": " << rep << "\n";
   DiagnoseOptions dopt;
-  if (o.window_s > 0.0) dopt.window_s = o.window_s;
+  if (!o.window_s.empty()) dopt.window_s = window_s_of(o.window_s);
   dopt.infer_road_profile = o.road_profile;
   if (o.engine_start.size() > recs.size())
     throw InputError("--engine-start", std::to_string(o.engine_start.size()) + " start states given for " +
@@ -82,10 +87,10 @@ void run_fleet(const DiagnoseCliOptions& o, const ProcessGroup& group) {
     if (given) throw InputError(option, "not allowed with --fleet: the manifest names each group's files and mapping");
   }
   FleetOptions fo;
-  if (o.window_s > 0.0) fo.diagnose.window_s = o.window_s;
+  if (!o.window_s.empty()) fo.diagnose.window_s = window_s_of(o.window_s);
   fo.diagnose.infer_road_profile = o.road_profile;
   fo.map_cases = group.mapper();
-  if (!o.json.empty()) check_output_file(o.json, "--json");
+  if (!o.json.empty()) check_output_file(o.json, "--json", {o.fleet});
   const FleetResult r = diagnose_fleet(read_fleet_manifest(o.fleet), fo);
   std::cout << fleet_text(r);
   if (o.json.empty()) return;
@@ -111,8 +116,9 @@ void register_diagnose_command(CLI::App& app, const ProcessGroup& group) {
   sub->add_option("--scale", o->scales, "CANONICAL=FACTOR scale (repeatable)")->type_name("C=F");
   sub->add_option("--json", o->json, "Write the diagnosis as JSON (with --fleet: one line per diagnosis and per effect)")
       ->type_name("FILE");
-  sub->add_option("--window-s", o->window_s, "Energy window length [s] (default 60; SOC channels lengthen it by the quantum)")
-      ->check(CLI::Range(5.0, 3600.0));
+  sub->add_option("--window-s", o->window_s, "Energy window length [s], 5-3600 (default 60; SOC channels lengthen it by "
+                                             "the quantum)")
+      ->type_name("S");
   sub->add_flag("--road-profile,!--no-road-profile", o->road_profile, "Where elevation is not recorded, try an elevation "
                 "profile along the route as an explanation (default on; named only with a descent steeper than the rolling "
                 "resistance; README)");

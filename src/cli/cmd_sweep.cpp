@@ -128,21 +128,25 @@ void run_sweep(const SweepOptionsText& o, const ProcessGroup& group) {
   selection::SweepOptions so = selection::sweep_options_from_request(o.request);
   so.replay = o.replay;
   so.map_cases = group.mapper();
+  const std::string tyre_path = resolve_data_file(o.tyre, "tyres", ".yaml", "--tyre");
+  const std::string vehicle_path = o.vehicle.empty() ? "" : resolve_data_file(o.vehicle, "vehicles", ".yaml", "--vehicle");
+  const std::vector<std::string> inputs{tyre_path, vehicle_path, o.cycle};
   // Every destination is checked before the sweep, and all are written after it (nothing is left behind).
-  if (!o.output.empty()) check_output_file(o.output, "--output");
+  check_outputs_distinct({{o.output, "--output"}, {o.plot, "--plot"}});
+  if (!o.output.empty()) check_output_file(o.output, "--output", inputs);
   if (!o.plot.empty()) {
     const std::string ext = std::filesystem::path(o.plot).extension().string();
     if (ext != ".svg" && ext != ".png") throw InputError("--plot " + o.plot, "must end in .svg or .png");
-    check_output_file(o.plot, "--plot");
+    check_output_file(o.plot, "--plot", inputs);
     if (report::find_gnuplot().empty()) throw InputError("--plot " + o.plot, gnuplot_missing);
   }
 
-  const TyreSpec tyre = load_tyre_file(resolve_data_file(o.tyre, "tyres", ".yaml", "--tyre"));
+  const TyreSpec tyre = load_tyre_file(tyre_path);
   Progress progress(!o.json);
   so.progress = [&progress](std::size_t d, std::size_t t) { progress(d, t); };
   selection::SweepResult r;
   if (!o.vehicle.empty()) {
-    const Vehicle v = load_vehicle_file(resolve_data_file(o.vehicle, "vehicles", ".yaml", "--vehicle"));
+    const Vehicle v = load_vehicle_file(vehicle_path);
     const DriveCycle c = load_cycle(o.cycle, "--cycle");
     r = selection::sweep_vehicle(v, tyre, c, so);
   } else {

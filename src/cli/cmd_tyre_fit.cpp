@@ -225,9 +225,20 @@ void run_fit(const FitOptions& o) {
   if (!o.held_out_j2452.empty() && o.evaluate_j2452.empty()) {
     throw InputError("--held-out-j2452", "needs --evaluate-j2452 FILE: the sets the shared constants are fitted on");
   }
-  if (!o.evaluate_j2452.empty()) return run_evaluate(o.evaluate_j2452, o.held_out_j2452, o.drum_radius_m, o.json);
+  if (!o.evaluate_j2452.empty()) {
+    for (const auto& [given, option] : {std::pair{!o.size.empty(), "--size"}, {!o.points.empty(), "--point"},
+                                        {!o.measured.empty(), "--measured"}, {!o.j2452.empty(), "--j2452"},
+                                        {!o.label.empty(), "--label"}, {!o.output.empty(), "--output"},
+                                        {!o.free.empty(), "--free"}, {!o.pressure_bar.empty(), "--pressure-bar"},
+                                        {!o.name.empty(), "--name"}}) {
+      if (given) throw InputError(option, "not allowed with --evaluate-j2452, which judges the model on the file's sets and "
+                                          "fits no tyre of its own");
+    }
+    return run_evaluate(o.evaluate_j2452, o.held_out_j2452, o.drum_radius_m, o.json);
+  }
   if (o.size.empty()) throw InputError("--size", "missing: the tyre's size designation, e.g. \"205/55 R16 91V\"");
   if (o.output.empty()) throw InputError("--output", "missing: the tyre file to write, e.g. --output my-tyre.yaml");
+  check_output_file(o.output, "--output", {o.measured});
   TyreFitInputs in;
   in.size = parse_tyre_size(o.size, "--size");
   const TyreSize& size = in.size;

@@ -142,7 +142,7 @@ void plot(const validate::Validation& v, const std::string& file) {
 void run_validate(const ValidateOptionsText& o, const ProcessGroup& group) {
   if (o.list.empty()) throw InputError("--epa-test-car-list", "missing: give the EPA Test Car List CSV");
   unsigned threads = 0;
-  if (!o.threads.empty()) threads = static_cast<unsigned>(parse_option_number(o.threads, "--threads", Range::closed(1, 1024)));
+  if (!o.threads.empty()) threads = static_cast<unsigned>(parse_option_count(o.threads, "--threads", Range::closed(1, 1024)));
   const auto rows = validate::read_epa_test_car_list(o.list);
   const auto v = validate::validate_epa_list(rows, threads, group.mapper());
   if (!o.plot.empty() && group.is_root()) plot(v, o.plot);

@@ -56,7 +56,10 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // --help and --version answer with exit 0; every other parse error is bad input, exit 2 like the rest (CLI11's
+    // own codes, 105-109, would tell a script nothing more).
+    const int code = app.exit(e);
+    return code == 0 ? 0 : 2;
   } catch (const rollsim::InputError& e) {
     return report(group, e, true, 2);
   } catch (const rollsim::ModelDomainError& e) {

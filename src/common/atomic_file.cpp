@@ -27,26 +27,85 @@ bool writable_dir(const fs::path& dir) {
   return fs::is_directory(dir, ec) && ::access(dir.c_str(), W_OK | X_OK) == 0;
 }
 
+// Where an output's content lands. A symlink is followed: its target is replaced and the link stays a link. A
+// device, pipe or socket, and anything under /dev or /proc (/dev/stdout, /proc/self/fd/1), is written in place
+// (appended), since a rename would replace the node itself with a plain file.
+struct Destination {
+  fs::path path;
+  bool in_place = false;
+};
+
+Destination destination_of(const std::string& path) {
+  std::error_code ec;
+  const fs::file_status target = fs::status(path, ec);  // follows symlinks
+  if (fs::exists(target) && !fs::is_regular_file(target)) return {path, true};
+  const auto system_node = [](const fs::path& p) {
+    std::error_code e;
+    const std::string a = fs::absolute(p, e).lexically_normal().string();
+    return a.rfind("/dev/", 0) == 0 || a.rfind("/proc/", 0) == 0;
+  };
+  if (system_node(path)) return {path, true};
+  if (!fs::is_symlink(fs::symlink_status(path, ec))) return {path, false};
+  if (const fs::path named = fs::read_symlink(path, ec); !ec && named.is_absolute() && system_node(named)) return {path, true};
+  if (const fs::path resolved = fs::canonical(path, ec); !ec) return {resolved, false};
+  const fs::path named = fs::read_symlink(path, ec);  // a dangling link: create the file it names
+  if (ec) return {path, false};
+  return {named.is_absolute() ? named : folder_of(path) / named, false};
+}
+
+// One file under two names (either may not exist yet).
+bool same_file(const fs::path& a, const fs::path& b) {
+  std::error_code ec;
+  if (fs::equivalent(a, b, ec)) return true;
+  const fs::path ca = fs::weakly_canonical(a, ec);
+  if (ec) return false;
+  const fs::path cb = fs::weakly_canonical(b, ec);
+  return !ec && ca == cb;
+}
+
 // The temporary sits in the target's folder so that the rename cannot cross file systems.
-fs::path temporary_for(const std::string& path) {
-  const fs::path target(path);
+fs::path temporary_for(const fs::path& target) {
   // Appended, not "." + string&&: GCC 12 warns falsely (-Wrestrict) on the latter once it is inlined.
   std::string name = ".";
   name += target.filename().string();
   name += ".tmp" + std::to_string(::getpid());
-  return folder_of(path) / name;
+  return folder_of(target.string()) / name;
 }
 
 }  // namespace
 
-void check_output_file(const std::string& path, const std::string& option) {
+void check_output_file(const std::string& path, const std::string& option, const std::vector<std::string>& inputs) {
   std::error_code ec;
   if (path.empty()) throw InputError(option, "an empty file name");
   if (fs::is_directory(path, ec)) throw InputError(where(option, path), "is a folder; give a file name");
-  if (!fs::exists(folder_of(path), ec))
-    throw InputError(where(option, path), "cannot write there: folder '" + folder_of(path).string() + "' does not exist");
-  if (!writable_dir(folder_of(path)))
-    throw InputError(where(option, path), "cannot write there: folder '" + folder_of(path).string() + "' is not a writable folder");
+  for (const auto& in : inputs) {
+    if (!in.empty() && fs::equivalent(path, in, ec)) {
+      throw InputError(where(option, path), "is the same file as the input '" + in +
+                                                "', which writing it would destroy; give another file name");
+    }
+  }
+  const Destination d = destination_of(path);
+  if (d.in_place) {
+    if (::access(d.path.c_str(), W_OK) != 0) throw InputError(where(option, path), "cannot write there: " + std::string(std::strerror(errno)));
+    return;
+  }
+  const fs::path folder = folder_of(d.path.string());
+  if (!fs::exists(folder, ec))
+    throw InputError(where(option, path), "cannot write there: folder '" + folder.string() + "' does not exist");
+  if (!writable_dir(folder))
+    throw InputError(where(option, path), "cannot write there: folder '" + folder.string() + "' is not a writable folder");
+}
+
+void check_outputs_distinct(const std::vector<std::pair<std::string, std::string>>& path_and_option) {
+  for (std::size_t j = 0; j < path_and_option.size(); ++j) {
+    for (std::size_t i = 0; i < j; ++i) {
+      const auto& [a, a_option] = path_and_option[i];
+      const auto& [b, b_option] = path_and_option[j];
+      if (!a.empty() && !b.empty() && same_file(destination_of(a).path, destination_of(b).path)) {
+        throw InputError(where(b_option, b), "is the same file as " + where(a_option, a) + "; give each output its own file");
+      }
+    }
+  }
 }
 
 void check_output_dir(const std::string& dir, const std::string& option) {
@@ -61,32 +120,45 @@ void check_output_dir(const std::string& dir, const std::string& option) {
 }
 
 void write_files_atomically(const std::vector<OutputFile>& files) {
-  std::vector<fs::path> written;
+  std::vector<std::pair<std::string, std::string>> named;
+  for (const auto& f : files) named.emplace_back(f.path, f.option);
+  check_outputs_distinct(named);
+  std::vector<Destination> dest;
+  for (const auto& f : files) dest.push_back(destination_of(f.path));
+  std::vector<fs::path> temporaries(files.size());
   auto discard = [&] {
     std::error_code ec;
-    for (const auto& t : written) fs::remove(t, ec);
+    for (const auto& t : temporaries)
+      if (!t.empty()) fs::remove(t, ec);
   };
-  for (const auto& f : files) {
-    std::error_code ec;
-    fs::create_directories(folder_of(f.path), ec);
-    const fs::path tmp = temporary_for(f.path);
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+  auto put = [&](const OutputFile& f, const fs::path& at, bool in_place) {
+    std::ofstream out(at, std::ios::binary | (in_place ? std::ios::app : std::ios::trunc));
     if (!out) {
       const std::string why = std::strerror(errno);
       discard();
       throw InputError(where(f.option, f.path), "cannot write there: " + why + "; nothing was written");
     }
-    written.push_back(tmp);
     out << f.content;
     out.flush();
     if (!out) {
       discard();
       throw InputError(where(f.option, f.path), "writing failed (disk full?); nothing was written");
     }
-  }
+  };
   for (std::size_t i = 0; i < files.size(); ++i) {
+    if (dest[i].in_place) continue;
     std::error_code ec;
-    fs::rename(written[i], files[i].path, ec);
+    fs::create_directories(folder_of(dest[i].path.string()), ec);
+    temporaries[i] = temporary_for(dest[i].path);
+    put(files[i], temporaries[i], false);
+  }
+  // Devices and pipes last before the renames: a failure there still leaves no regular file written.
+  for (std::size_t i = 0; i < files.size(); ++i)
+    if (dest[i].in_place) put(files[i], dest[i].path, true);
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    if (dest[i].in_place) continue;
+    std::error_code ec;
+    fs::rename(temporaries[i], dest[i].path, ec);
     if (ec) {
       discard();
       throw InputError(where(files[i].option, files[i].path), "cannot replace the file: " + ec.message());

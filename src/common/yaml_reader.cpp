@@ -256,6 +256,12 @@ double parse_option_number(const std::string& text, const std::string& option, R
   return checked_number(v, option, range);
 }
 
+int parse_option_count(const std::string& text, const std::string& option, Range range) {
+  const double v = parse_option_number(text, option, range);
+  if (v != std::floor(v)) throw InputError(option, "'" + text + "' is not a whole number; " + range.describe());
+  return static_cast<int>(v);
+}
+
 double checked_number(double v, const std::string& where, Range range) {
   if (!range.contains(v)) throw InputError(where, format_value(v) + " is not allowed: " + range.describe_for(v));
   return v;

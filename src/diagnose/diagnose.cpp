@@ -248,6 +248,20 @@ DriveCycle cycle_of_recording(const Recording& r, double engine_off_min_s, Engin
 Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordings, const DiagnoseOptions& opt) {
   using namespace diag;
   if (recordings.empty()) throw InputError("--recording", "at least one recording is needed");
+  // Held out by recording, a copy would be predicted from itself and the held-out score would mean nothing.
+  for (std::size_t j = 1; j < recordings.size(); ++j) {
+    for (std::size_t i = 0; i < j; ++i) {
+      const Recording& a = recordings[i];
+      const Recording& b = recordings[j];
+      if (a.time_s == b.time_s && a.speed_mps == b.speed_mps && a.battery_power_w == b.battery_power_w &&
+          a.battery_current_a == b.battery_current_a && a.soc_fraction == b.soc_fraction &&
+          a.fuel_rate_m3ps == b.fuel_rate_m3ps && a.ambient_temp_k == b.ambient_temp_k) {
+        throw InputError(b.source, "holds the same samples (time, speed, energy channel) as " + a.source +
+                                                   "; give each recording once: held out by recording, a copy would be "
+                                                   "scored against itself");
+      }
+    }
+  }
   Diagnosis out;
   std::vector<DriveCycle> cycles = cycles_of(recordings, opt, out.notes);
   const Observations obs = build_windows(vehicle, recordings, opt.window_s, opt, out.notes);

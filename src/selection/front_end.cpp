@@ -153,16 +153,14 @@ SweepOptions sweep_options_from_request(const SweepRequest& o) {
     a.from = parse_option_number(o.from[i], "--from", Range{});
     a.to = parse_option_number(o.to[i], "--to", Range{});
     if (i < o.steps.size()) {
-      const double n = parse_option_number(o.steps[i], "--steps", Range::closed(-1e9, 1e6));
-      if (n != std::floor(n)) throw InputError("--steps", format_value(n) + " is not allowed: must be a whole number >= 2");
-      a.steps = static_cast<int>(n);
+      a.steps = parse_option_count(o.steps[i], "--steps", Range::closed(2, 1e6));
     }
     check_axis(a, opt);
     so.axes.push_back(a);
   }
   if (!o.load_n.empty()) so.load_n = parse_option_number(o.load_n, "--load-n", Range::open_low(0.0, 1e6));
   so.speed_kmh = parse_option_number(o.speed_kmh, "--speed-kmh", Range::closed(0.0, 500.0));
-  if (!o.threads.empty()) so.threads = static_cast<unsigned>(parse_option_number(o.threads, "--threads", Range::closed(1, 1024)));
+  if (!o.threads.empty()) so.threads = static_cast<unsigned>(parse_option_count(o.threads, "--threads", Range::closed(1, 1024)));
   return so;
 }
 

@@ -5,13 +5,18 @@
 #include <functional>
 #include <ostream>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace rollsim {
 
-/// Checks, before any computation, that `path` can be written: it is not a folder, and its folder exists
-/// and is writable. Throws InputError naming `option` and the path otherwise.
-void check_output_file(const std::string& path, const std::string& option);
+/// Checks, before any computation, that `path` can be written: it is not a folder, not one of the command's
+/// `inputs` (the same file under any name), and its folder exists and is writable (a symlink's target's folder; a
+/// device or pipe must be writable itself). Throws InputError naming `option` and the path otherwise.
+void check_output_file(const std::string& path, const std::string& option, const std::vector<std::string>& inputs = {});
+
+/// Checks that no two of a command's outputs (path, option) are one file. Throws InputError naming both.
+void check_outputs_distinct(const std::vector<std::pair<std::string, std::string>>& path_and_option);
 
 /// Checks that `dir` is a writable folder, or can be created as one (its nearest existing parent is a
 /// writable folder). Creates nothing. Throws InputError naming `option` and the folder otherwise.
@@ -24,8 +29,8 @@ struct OutputFile {
   std::string content;
 };
 
-/// Writes every file to a temporary beside its target (creating missing folders), and only when all were
-/// written renames them into place. Any failure removes the temporaries and throws InputError naming the
+/// Writes every file to a temporary beside its target (creating missing folders; a symlink's target is the
+/// target, and a device or pipe is written in place), and only when all were written renames them into place. Any failure removes the temporaries and throws InputError naming the
 /// option and path: no output is left half-written, and none is written when another could not be.
 void write_files_atomically(const std::vector<OutputFile>& files);
 

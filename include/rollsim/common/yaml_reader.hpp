@@ -38,6 +38,9 @@ double checked_number(double v, const std::string& where, Range range);
 /// throws InputError naming `option`, the text or value, and what is allowed (strtod alone would accept "nan").
 double parse_option_number(const std::string& text, const std::string& option, Range range);
 
+/// A whole number given as text (a count: threads, steps), as parse_option_number and also refusing a fraction.
+int parse_option_count(const std::string& text, const std::string& option, Range range);
+
 /// A view on one YAML mapping of a file, remembering its path ("vehicle.yaml: body.mass_kg") so that every
 /// error names file and key. Keys read are recorded; finish() rejects any key that was never asked for,
 /// which catches misspellings ("presure_bar") instead of silently using a default.
