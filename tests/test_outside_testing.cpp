@@ -181,5 +181,69 @@ TEST_F(OutsideTesting, ARecordingGivenTwiceIsRefused) {
   EXPECT_TRUE(has(r.err, copy + ": holds the same samples (time, speed, energy channel) as " + kCamryUdds)) << r.err;
 }
 
+// A cycle where the car never moves printed "NaN kWh/10 km" and still ranked the tyres.
+TEST_F(OutsideTesting, SelectionOnACycleThatCoversNoDistanceIsRefused) {
+  const std::string still = write("still.csv", "time_s,speed_kmh\n0,0\n10,0\n20,0\n");
+  for (const std::string& cmd : {"compare --vehicle ev --tyre 175-70R14 --cycle '" + still + "'",
+                                 "sweep --tyre nominal --vehicle ev --param pressure --from 2.1 --to 3.1 --steps 2 --cycle '" +
+                                     still + "'",
+                                 "sensitivity --vehicle ev --cycle '" + still + "'"}) {
+    const CmdResult r = run_rollsim(cmd);
+    EXPECT_EQ(r.exit_code, 2) << cmd << "\n" << r.out;
+    EXPECT_TRUE(has(r.err, "cycle 'still': covers no distance")) << cmd << "\n" << r.err;
+  }
+}
+
+// Rounding: samples written 1 ms apart, the allowed minimum, were refused (0.009 - 0.008 < 0.001 in binary); an
+// EPA row's 9 l displacement, the allowed maximum, was skipped as 9.000000000000002 l.
+TEST_F(OutsideTesting, AllowedLimitsWrittenInDecimalAreInside) {
+  const std::string cycle = write("c1ms.csv", "time_s,speed_kmh\n0,0\n0.008,0\n0.009,0\n10,10\n20,0\n");
+  const CmdResult r = run_rollsim("simulate --vehicle ev --cycle '" + cycle + "'");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+
+  std::ifstream in(std::string(ROLLSIM_SHARED_DIR) + "/data/vehicles/epa_test_car_list_2022_part.csv");
+  std::string header, row;
+  std::getline(in, header);
+  std::getline(in, row);  // Aston Martin DBS, FTP-75: displacement 5.200 l, N/V 23.0
+  const auto with = [&](const std::string& from, const std::string& to) {
+    std::string edited = row;
+    const auto at = edited.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at != std::string::npos) edited.replace(at, from.size(), to);
+    return write("list.csv", header + "\n" + edited + "\n");
+  };
+  const std::string nine = with(",5.200,", ",9,");  // Test Veh Displacement (L)
+  CmdResult v = run_rollsim("validate --epa-test-car-list '" + nine + "' --json");
+  EXPECT_EQ(v.exit_code, 0) << v.err;
+  EXPECT_TRUE(has(v.out, "\"predicted\"")) << v.out;
+  // An engine turning 15000 rpm at 60 mph in top gear was simulated (2.1 mpg against 17.7); it is a skipped field now.
+  const std::string fast = with(",23.0,1,Not eqipped", ",250,1,Not eqipped");  // N/V Ratio
+  v = run_rollsim("validate --epa-test-car-list '" + fast + "' --json");
+  EXPECT_EQ(v.exit_code, 0) << v.err;
+  EXPECT_TRUE(has(v.out, "N/V ratio of an engine's top gear [rpm/mph] = 250")) << v.out;
+}
+
+// A measured-points CSV with a column twice: the first copy won without a word (cycle CSVs refused it).
+TEST_F(OutsideTesting, ACsvColumnGivenTwiceIsRefusedEverywhere) {
+  const std::string points = write("dup.csv", "pressure_kpa,load_n,speed_kmh,rrc,rrc\n210,4000,80,0.0085,0.009\n");
+  const CmdResult r = run_rollsim("tyre fit --size '205/55 R16 91V' --measured '" + points + "' --output '" +
+                                  (dir_ / "o.yaml").string() + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, points + ": line 1: column 'rrc' appears twice")) << r.err;
+}
+
+// A battery that cannot carry even the auxiliaries and the machine's no-load loss: simulate fell behind without
+// a word, and the replay stopped with a message naming no file or key.
+TEST_F(OutsideTesting, ABatteryThatCannotCarryTheNoLoadDrawIsNamedAtLoad) {
+  std::string ev = slurp(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/ev.yaml");
+  const std::string key = "internal_resistance_ohm: 0.10";
+  ASSERT_NE(ev.find(key), std::string::npos);
+  ev.replace(ev.find(key), key.size(), "internal_resistance_ohm: 10");
+  const std::string file = write("ev_r10.yaml", ev);
+  const CmdResult r = run_rollsim("simulate --vehicle '" + file + "' --replay");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, file + ": key 'powertrain.battery.internal_resistance_ohm': 10 ohm is not allowed")) << r.err;
+}
+
 }  // namespace
 }  // namespace rollsim::test

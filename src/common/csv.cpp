@@ -41,10 +41,14 @@ std::optional<double> parse_number(const std::string& text) {
 }
 
 std::optional<std::size_t> CsvTable::column(const std::string& name) const {
+  std::optional<std::size_t> found;
   for (std::size_t i = 0; i < header.size(); ++i) {
-    if (header[i] == name) return i;
+    if (header[i] != name) continue;
+    // Two columns of one name: which one a reader took would be a silent guess.
+    if (found) throw InputError(file + ": line " + std::to_string(header_line), "column '" + name + "' appears twice");
+    found = i;
   }
-  return std::nullopt;
+  return found;
 }
 
 std::string CsvTable::columns_list() const {

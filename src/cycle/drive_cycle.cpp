@@ -223,7 +223,8 @@ DriveCycle cycle_from_table(const CsvTable& table, const std::string& name) {
                            std::to_string(table.row_line[r - 1]) + ": time must be strictly increasing");
     }
     const double dt = r > 0 ? c.time_s[r] - c.time_s[r - 1] : 0.0;
-    if (r > 0 && !(dt >= kMinCycleTimeStep_s && dt <= kMaxCycleTimeStep_s)) {
+    // A relative tolerance, so that times written 1 ms apart (0.008, 0.009: 0.00099999999999999 in binary) pass.
+    if (r > 0 && !(dt >= kMinCycleTimeStep_s * (1.0 - 1e-9) && dt <= kMaxCycleTimeStep_s)) {
       throw InputError(table.where(r, *col_t),
                        format_value(c.time_s[r]) + " s is " + format_value(dt) + " s after the sample on line " +
                            std::to_string(table.row_line[r - 1]) + "; allowed: 0.001 to 86400 s between samples");

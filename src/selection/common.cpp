@@ -34,6 +34,12 @@ EnergyFigure run_model(const VehicleModel& model, const DriveCycle& cycle, bool 
   return energy_figure(replay ? simulate_replay(model, cycle) : simulate_forward(model, cycle));
 }
 
+void require_distance(const DriveCycle& cycle) {
+  if (cycle.distance_m() > 0.0) return;
+  throw InputError("cycle '" + cycle.name + "'", "covers no distance (its speed is 0 throughout): energy per distance is "
+                                                 "undefined, so no tyre can be ranked, swept or differentiated on it");
+}
+
 std::string run_mode_label(bool replay) { return replay ? "kinematic replay" : "forward simulation"; }
 
 }  // namespace rollsim::selection

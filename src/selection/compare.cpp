@@ -103,6 +103,7 @@ Comparison compare_tyres(const Vehicle& vehicle, const std::vector<TyreSpec>& ca
   if (!vehicle.front_tyre) {
     throw InputError(vehicle.source, "the car has no tyres of its own (coast-down road load): nothing to compare with");
   }
+  require_distance(cycle);
   const TyreSpec& own = *vehicle.front_tyre;
   Comparison cmp;
   cmp.vehicle = vehicle.name;

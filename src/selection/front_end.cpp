@@ -10,6 +10,7 @@
 #include "rollsim/common/units.hpp"
 #include "rollsim/common/yaml_reader.hpp"
 #include "rollsim/report/simulation_report.hpp"
+#include "rollsim/selection/common.hpp"
 
 namespace rollsim::selection {
 
@@ -97,6 +98,7 @@ Sensitivity sensitivity_of(const std::optional<Vehicle>& vehicle, const std::opt
   else if (vehicle && vehicle->front_tyre) tyre = *vehicle->front_tyre;
   else if (vehicle) throw InputError("--tyre", "missing: the car has no tyre model (coast-down road load); give --tyre");
   else throw InputError("--tyre", "missing: give a tyre and/or --vehicle");
+  if (vehicle) require_distance(cycle);
   double at_n = 0.0;
   if (load_n) {
     at_n = *load_n;

@@ -221,6 +221,7 @@ SweepResult sweep_tyre(const TyreSpec& tyre, const SweepOptions& o) {
 SweepResult sweep_vehicle(const Vehicle& vehicle, const TyreSpec& tyre, const DriveCycle& cycle,
                           const SweepOptions& o) {
   check_options(tyre, o);
+  require_distance(cycle);
   for (const auto& a : o.axes) {
     if (a.param != SweepParam::Pressure && a.param != SweepParam::Diameter && a.param != SweepParam::Width) {
       throw InputError("--param " + sweep_param_key(a.param),

@@ -261,8 +261,13 @@ SkipReason check_configuration(const EpaTestRow& r, std::string& detail) {
   const double nv = nv_rpm_per_mph(r);
   if (nv < 12.0 || nv > 250.0) return absurd(detail, "N/V ratio [rpm/mph]", nv, "12-250");
   if (!liquid(r.fuel)) return SkipReason::none;
+  // An engine's top gear: 80 rpm/mph is 4800 rpm at 60 mph (the list's engines reach 51); an electric machine's
+  // single reduction runs faster (up to 191 in the list).
+  if (nv > 80.0) return absurd(detail, "N/V ratio of an engine's top gear [rpm/mph]", nv, "12-80");
   if (!r.displacement_m3) return missing(detail, "Test Veh Displacement (L)");
-  if (*r.displacement_m3 < 0.6e-3 || *r.displacement_m3 > 9e-3) return absurd(detail, "displacement [l]", *r.displacement_m3 * 1e3, "0.6-9 l");
+  // In litres, as the list gives it, so that its 0.6 and 9 are inside (9e-3 m^3 x 1e3 is 9.000000000000002).
+  const double litres = std::round(*r.displacement_m3 * 1e3 * 1e9) / 1e9;
+  if (litres < 0.6 || litres > 9.0) return absurd(detail, "displacement [l]", litres, "0.6-9 l");
   if (r.transmission == EpaTransmission::other) {
     detail = "Tested Transmission Type '" + r.transmission_text + "' (automatic, CVT, manual or automated manual)";
     return SkipReason::absurd_field;

@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include "rollsim/common/error.hpp"
+#include "rollsim/common/format.hpp"
 #include "rollsim/common/units.hpp"
 #include "rollsim/common/yaml_reader.hpp"
 #include "rollsim/tyre/tyre_model.hpp"
@@ -62,6 +63,24 @@ CoastdownParams read_coastdown(YamlMap m) {
   return c;
 }
 
+// A battery gives at most Voc^2 / 4R. One that cannot carry the auxiliaries and the machine's no-load loss at its
+// top speed leaves no drive the car could follow there, not even coasting (a replay had no power flow to report).
+void check_battery_carries_no_load(const ElectricPowertrainParams& p, const std::string& resistance_key) {
+  const double r = p.battery.internal_resistance_ohm;
+  if (r <= 0.0) return;
+  const auto& l = p.motor.losses;
+  const double w = p.motor.max_speed_radps;
+  const double no_load_w = l.efficiency.empty() ? l.iron_w_s_per_rad * w + l.windage_w_s3_per_rad3 * w * w * w + l.constant_w : 0.0;
+  const double needed_w = p.aux_power_w + no_load_w;
+  const double voc = p.battery.open_circuit_voltage_v;
+  if (voc * voc / (4.0 * r) > needed_w) return;
+  throw InputError(resistance_key, format_value(r) + " ohm is not allowed: at " + format_value(voc) +
+                                       " V the battery gives at most Voc^2/4R = " + fixed(voc * voc / (4.0 * r) / 1e3, 2) +
+                                       " kW, not even the auxiliaries and the machine's no-load loss at its top speed (" +
+                                       fixed(needed_w / 1e3, 2) + " kW); allowed: below " +
+                                       significant(voc * voc / (4.0 * needed_w), 3) + " ohm");
+}
+
 ElectricPowertrainParams read_electric(YamlMap& pt) {
   ElectricPowertrainParams p;
   {
@@ -82,10 +101,12 @@ ElectricPowertrainParams read_electric(YamlMap& pt) {
     p.reduction.efficiency = m.number("efficiency", Range::efficiency());
     m.finish();
   }
+  std::string resistance_key;
   {
     YamlMap m = pt.map("battery");
     p.battery.open_circuit_voltage_v = m.number("open_circuit_voltage_v", Range::open_low(0.0, 2000.0));
     p.battery.internal_resistance_ohm = m.number("internal_resistance_ohm", Range::closed(0.0, 100.0));
+    resistance_key = m.where("internal_resistance_ohm");
     p.battery.usable_capacity_j = units::kwh_to_j(m.number("usable_capacity_kwh", Range::open_low(0.0, 1e4)));
     p.battery.initial_soc = m.number_or("initial_soc_pct", 100.0, Range::closed(0.0, 100.0)) / 100.0;
     m.finish();
@@ -101,6 +122,7 @@ ElectricPowertrainParams read_electric(YamlMap& pt) {
     m.finish();
   }
   p.aux_power_w = pt.number_or("aux_power_w", 0.0, Range::closed(0.0, 1e5));
+  check_battery_carries_no_load(p, resistance_key);
   return p;
 }
 

@@ -18,7 +18,8 @@ struct CsvTable {
   std::vector<std::vector<std::string>> rows;  ///< each row has exactly header.size() cells
   std::vector<std::size_t> row_line;           ///< 1-based line where each row starts
 
-  /// Index of the column named exactly `name` (after trimming), if present.
+  /// Index of the column named exactly `name` (after trimming), if present; throws InputError when two columns
+  /// carry that name.
   std::optional<std::size_t> column(const std::string& name) const;
   /// "a, b, c": the header, quoted, for "found columns: ..." in error messages.
   std::string columns_list() const;

@@ -33,6 +33,10 @@ EnergyFigure run_forward(const Vehicle& vehicle, const DriveCycle& cycle);
 /// Runs an assembled car over `cycle`: forward (driver + CVODE), or as a kinematic replay when `replay`.
 EnergyFigure run_model(const VehicleModel& model, const DriveCycle& cycle, bool replay);
 
+/// Throws InputError naming the cycle when it covers no distance: every figure tyre selection ranks, sweeps or
+/// differentiates is per distance, and would be NaN.
+void require_distance(const DriveCycle& cycle);
+
 /// "forward simulation" or "kinematic replay", for the tables' titles.
 std::string run_mode_label(bool replay);
 
