@@ -245,5 +245,40 @@ TEST_F(OutsideTesting, ABatteryThatCannotCarryTheNoLoadDrawIsNamedAtLoad) {
   EXPECT_TRUE(has(r.err, file + ": key 'powertrain.battery.internal_resistance_ohm': 10 ohm is not allowed")) << r.err;
 }
 
+// A car with different front and rear tyres: compare's "own" row was the front tyre on all four wheels, not the
+// car as built (1.6470 against simulate's 1.6514 kWh/10 km), and sensitivity took the front tyre alone.
+TEST_F(OutsideTesting, SelectionRefusesACarWithTwoTyreSetsItWouldMisrepresent) {
+  std::string ev = slurp(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/ev.yaml");
+  const std::string all = "  all: nominal.yaml";
+  ASSERT_NE(ev.find(all), std::string::npos);
+  ev.replace(ev.find(all), all.size(), "  front: nominal.yaml\n  rear: 175-70R14.yaml\n ");
+  const std::string mixed = write("mixed.yaml", ev);
+  ASSERT_EQ(run_rollsim("simulate --vehicle '" + mixed + "'").exit_code, 0);
+  CmdResult r = run_rollsim("compare --vehicle '" + mixed + "' --tyre 175-70R14");
+  EXPECT_EQ(r.exit_code, 2) << r.out;
+  EXPECT_TRUE(has(r.err, mixed + ": has different front and rear tyres ('nominal', '175-70R14'); compare fits")) << r.err;
+  r = run_rollsim("sensitivity --vehicle '" + mixed + "'");
+  EXPECT_EQ(r.exit_code, 2) << r.out;
+  EXPECT_TRUE(has(r.err, "without --tyre, sensitivity fits one tyre")) << r.err;
+  EXPECT_EQ(run_rollsim("sensitivity --vehicle '" + mixed + "' --tyre nominal").exit_code, 0);
+}
+
+// A car's sweep printed its tyre at 80 % of the tyre's rating (4825 N) beside the car's figure, where the car puts
+// 3999 N on its heavier wheels; compare and sensitivity take the car's load.
+TEST_F(OutsideTesting, ACarsSweepShowsItsTyreAtTheCarsWheelLoad) {
+  const CmdResult s = run_rollsim("sensitivity --vehicle ev --json");
+  ASSERT_EQ(s.exit_code, 0) << s.err;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(s.out, m, std::regex(R"("load_n": ([0-9.]+))")));
+  const double car_load_n = std::stod(m[1].str());
+  const CmdResult w = run_rollsim("sweep --tyre nominal --vehicle ev --param pressure --from 2.1 --to 3.1 --steps 2");
+  ASSERT_EQ(w.exit_code, 0) << w.err;
+  const std::vector<std::string> rows = lines(w.out);
+  ASSERT_GE(rows.size(), 2u);
+  EXPECT_EQ(rows[0].rfind("pressure_bar,load_n,", 0), 0u) << rows[0];
+  const std::string second = rows[1].substr(rows[1].find(',') + 1);
+  EXPECT_NEAR(std::stod(second.substr(0, second.find(','))), car_load_n, 1e-6) << rows[1];
+}
+
 }  // namespace
 }  // namespace rollsim::test

@@ -40,6 +40,16 @@ void require_distance(const DriveCycle& cycle) {
                                                  "undefined, so no tyre can be ranked, swept or differentiated on it");
 }
 
+void require_one_tyre_set(const Vehicle& vehicle, const std::string& what) {
+  if (!vehicle.front_tyre || !vehicle.rear_tyre) return;
+  const TyreSpec& f = *vehicle.front_tyre;
+  const TyreSpec& r = *vehicle.rear_tyre;
+  if (f.source == r.source && f.name == r.name) return;
+  throw InputError(vehicle.source, "has different front and rear tyres ('" + f.name + "', '" + r.name + "'); " + what +
+                                       " fits one tyre on all four wheels, so the car's own figure would not be the car "
+                                       "as built");
+}
+
 std::string run_mode_label(bool replay) { return replay ? "kinematic replay" : "forward simulation"; }
 
 }  // namespace rollsim::selection

@@ -104,6 +104,7 @@ Comparison compare_tyres(const Vehicle& vehicle, const std::vector<TyreSpec>& ca
     throw InputError(vehicle.source, "the car has no tyres of its own (coast-down road load): nothing to compare with");
   }
   require_distance(cycle);
+  require_one_tyre_set(vehicle, "compare");
   const TyreSpec& own = *vehicle.front_tyre;
   Comparison cmp;
   cmp.vehicle = vehicle.name;

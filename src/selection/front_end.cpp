@@ -95,7 +95,10 @@ Sensitivity sensitivity_of(const std::optional<Vehicle>& vehicle, const std::opt
                            const DriveCycle& cycle, std::optional<double> load_n, double speed_mps) {
   TyreSpec tyre;
   if (tyre_given) tyre = *tyre_given;
-  else if (vehicle && vehicle->front_tyre) tyre = *vehicle->front_tyre;
+  else if (vehicle && vehicle->front_tyre) {
+    require_one_tyre_set(*vehicle, "without --tyre, sensitivity");
+    tyre = *vehicle->front_tyre;
+  }
   else if (vehicle) throw InputError("--tyre", "missing: the car has no tyre model (coast-down road load); give --tyre");
   else throw InputError("--tyre", "missing: give a tyre and/or --vehicle");
   if (vehicle) require_distance(cycle);

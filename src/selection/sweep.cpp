@@ -2,6 +2,7 @@
 #include "rollsim/selection/sweep.hpp"
 
 
+#include <algorithm>
 #include <cmath>
 #include <exception>
 #include <sstream>
@@ -219,7 +220,14 @@ SweepResult sweep_tyre(const TyreSpec& tyre, const SweepOptions& o) {
 }
 
 SweepResult sweep_vehicle(const Vehicle& vehicle, const TyreSpec& tyre, const DriveCycle& cycle,
-                          const SweepOptions& o) {
+                          const SweepOptions& given) {
+  // The tyre's own columns at the car's heavier static wheel load, as compare and sensitivity take it, unless a
+  // load is given: beside the car's figure, a tyre at another load would be another operating point.
+  SweepOptions o = given;
+  if (!o.load_n) {
+    const AxleWheelLoads w = wheel_loads(vehicle.body, 0.0);
+    o.load_n = std::max(w.front_n, w.rear_n);
+  }
   check_options(tyre, o);
   require_distance(cycle);
   for (const auto& a : o.axes) {

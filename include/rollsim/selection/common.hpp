@@ -37,6 +37,10 @@ EnergyFigure run_model(const VehicleModel& model, const DriveCycle& cycle, bool 
 /// differentiates is per distance, and would be NaN.
 void require_distance(const DriveCycle& cycle);
 
+/// Throws InputError naming the car and `what` it would do when its front and rear tyres differ: selection fits one
+/// tyre on all four wheels, so the car's own figure would not be the car as built.
+void require_one_tyre_set(const Vehicle& vehicle, const std::string& what);
+
 /// "forward simulation" or "kinematic replay", for the tables' titles.
 std::string run_mode_label(bool replay);
 
