@@ -115,3 +115,27 @@ TEST(Fleet, AManifestWithoutTheRecordingColumnIsRefusedAtItsHeader) {
     EXPECT_NE(std::string(e.what()).find("nocol.csv: line 1: missing column 'recording'"), std::string::npos) << e.what();
   }
 }
+
+// The summary's median was of whichever first parameter the first diagnosis in the manifest reported: two
+// unexplained findings leading with different figures gave a different line in each order (outside testing).
+TEST(Fleet, TheSummaryDoesNotDependOnTheManifestsOrder) {
+  auto entry = [](const std::string& group, std::vector<FleetFinding> findings) {
+    FleetEntry e;
+    e.group = group;
+    e.findings = std::move(findings);
+    return e;
+  };
+  const FleetEntry a = entry("a", {{"unexplained", "opposite_extra_resistance_ohm", "ohm", -19.757, 0.0}});
+  const FleetEntry b = entry("b", {{"unexplained", "residual_to_noise_variance_ratio", "1", 5.383, 0.0}});
+  const FleetEntry c = entry("c", {{"unexplained", "residual_to_noise_variance_ratio", "1", 2.0, 0.0}});
+  const auto ab = summarise_fleet({a, b, c});
+  const auto ba = summarise_fleet({c, b, a});
+  ASSERT_EQ(ab.size(), 1u);
+  ASSERT_EQ(ba.size(), 1u);
+  EXPECT_EQ(ab[0].groups, 3u);
+  // Two of the three report the variance ratio first: its median is the fleet's figure, in either order.
+  EXPECT_EQ(ab[0].parameter, "residual_to_noise_variance_ratio");
+  EXPECT_EQ(ba[0].parameter, ab[0].parameter);
+  EXPECT_DOUBLE_EQ(ab[0].median_value, (5.383 + 2.0) / 2.0);
+  EXPECT_DOUBLE_EQ(ba[0].median_value, ab[0].median_value);
+}

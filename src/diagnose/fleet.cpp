@@ -138,9 +138,14 @@ FleetEntry from_bytes(std::string_view in) {
   return e;
 }
 
-std::vector<FleetEffect> summarise(const std::vector<FleetEntry>& entries) {
+}  // namespace
+
+// Per effect: how many diagnoses found it, and the median of the parameter most of them report first (ties: the
+// name first in order), so that the summary does not depend on the manifest's order when the first parameter
+// differs between diagnoses (an unexplained finding's first figure depends on what it found).
+std::vector<FleetEffect> summarise_fleet(const std::vector<FleetEntry>& entries) {
   std::map<std::string, FleetEffect> by_id;
-  std::map<std::string, std::vector<double>> sizes;
+  std::map<std::string, std::map<std::string, std::vector<const FleetFinding*>>> by_parameter;
   for (const auto& e : entries) {
     std::vector<std::string> seen;  // an effect found twice in one diagnosis counts once
     for (const auto& f : e.findings) {
@@ -149,25 +154,27 @@ std::vector<FleetEffect> summarise(const std::vector<FleetEntry>& entries) {
       FleetEffect& s = by_id[f.effect];
       s.effect = f.effect;
       ++s.groups;
-      if (f.parameter.empty()) continue;
-      if (s.parameter.empty()) {
-        s.parameter = f.parameter;
-        s.unit = f.unit;
-      }
-      if (f.parameter == s.parameter) sizes[f.effect].push_back(f.value);
+      if (!f.parameter.empty()) by_parameter[f.effect][f.parameter].push_back(&f);
     }
   }
   std::vector<FleetEffect> out;
   for (auto& [id, s] : by_id) {
     s.share_pct = 100.0 * static_cast<double>(s.groups) / static_cast<double>(entries.size());
-    s.median_value = median(sizes[id]);
+    const std::vector<const FleetFinding*>* most = nullptr;
+    for (const auto& [name, found] : by_parameter[id])
+      if (!most || found.size() > most->size()) most = &found;
+    if (most) {
+      s.parameter = most->front()->parameter;
+      s.unit = most->front()->unit;
+      std::vector<double> values;
+      for (const FleetFinding* f : *most) values.push_back(f->value);
+      s.median_value = median(values);
+    }
     out.push_back(s);
   }
   std::stable_sort(out.begin(), out.end(), [](const FleetEffect& a, const FleetEffect& b) { return a.groups > b.groups; });
   return out;
 }
-
-}  // namespace
 
 FleetResult diagnose_fleet(const FleetManifest& m, const FleetOptions& o) {
   // Each group is read on the rank that diagnoses it; its manifest line names it if that fails.
@@ -183,7 +190,7 @@ FleetResult diagnose_fleet(const FleetManifest& m, const FleetOptions& o) {
   FleetResult r;
   r.manifest = m.file;
   for (const auto& bytes : map_cases(o.map_cases, m.groups.size(), o.threads, body, {})) r.entries.push_back(from_bytes(bytes));
-  r.effects = summarise(r.entries);
+  r.effects = summarise_fleet(r.entries);
   return r;
 }
 
@@ -202,7 +209,7 @@ std::string fleet_text(const FleetResult& r) {
     }
     t.add_row({e.group, e.vehicle, std::to_string(e.recordings), e.channel, e.verdict, found.empty() ? "-" : found});
   }
-  out << t.render() << "\neffects across the fleet (diagnoses that found each; median of its first parameter):\n";
+  out << t.render() << "\neffects across the fleet (diagnoses that found each; median of the first parameter most of them report):\n";
   report::TextTable s({"effect", "diagnoses", "share [%]", "parameter", "median", "unit"});
   for (std::size_t c : {0u, 3u, 5u}) s.set_left_aligned(c);
   for (const auto& f : r.effects) {

@@ -56,8 +56,12 @@ struct FleetEffect {
   std::string effect, parameter, unit;
   std::size_t groups = 0;
   double share_pct = 0.0;    ///< of all diagnoses
-  double median_value = 0.0;  ///< of its first parameter, in `unit`
+  double median_value = 0.0;  ///< of `parameter`: the first parameter most of its diagnoses report, in `unit`
 };
+
+/// The fleet summary of `entries`, most frequent effect first (ties: by id). It does not depend on the entries'
+/// order.
+std::vector<FleetEffect> summarise_fleet(const std::vector<FleetEntry>& entries);
 
 struct FleetResult {
   std::string manifest;
