@@ -280,5 +280,17 @@ TEST_F(OutsideTesting, ACarsSweepShowsItsTyreAtTheCarsWheelLoad) {
   EXPECT_NEAR(std::stod(second.substr(0, second.find(','))), car_load_n, 1e-6) << rows[1];
 }
 
+// A constant the points cannot see was reported "fitted" with a zero-width 95 % interval: the speed loss' load
+// exponent once the speed loss itself fitted below 0 and was held there.
+TEST_F(OutsideTesting, ATyreFitConstantThePointsCannotSeeIsNotReportedFitted) {
+  const CmdResult r = run_rollsim(
+      "tyre fit --size '205/55 R16 91V' --point 210,4000,20,0.012 --point 210,4000,80,0.009 --point 210,4000,140,0.008 "
+      "--point 210,6000,80,0.0085 --free rrc_ref,speed_loss_rrc_per_hz2,speed_loss_load_exponent --json --output '" +
+      (dir_ / "f.yaml").string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(has(r.err, "speed_loss_load_exponent is not determined by these points")) << r.err;
+  EXPECT_TRUE(has(r.out, R"("key": "speed_loss_load_exponent", "free": false)")) << r.out;
+}
+
 }  // namespace
 }  // namespace rollsim::test

@@ -106,8 +106,11 @@ double model_rrc(const TyreState& t, const RrcPoint& p) {
   return k.k0 + p.speed_mps * (k.k1_s_per_m + p.speed_mps * k.k2_s2_per_m2);
 }
 
-// One least-squares pass over the given free parameters; fills values, intervals and residuals.
-TyreFit fit_once(const TyreState& start, const FitRequest& r, const std::vector<HysteresisParam>& free) {
+// One least-squares pass over the given free parameters; fills values, intervals and residuals. `flat` gets the free
+// parameters the residuals do not move with at the solution (a zero Jacobian column): the points say nothing of
+// them, and the pseudo-inverse would give them a zero-width interval.
+TyreFit fit_once(const TyreState& start, const FitRequest& r, const std::vector<HysteresisParam>& free,
+                 std::vector<HysteresisParam>& flat) {
   const int m = static_cast<int>(r.points.size());
   const int n = static_cast<int>(free.size());
   auto apply = [&](const Eigen::VectorXd& x) {
@@ -134,6 +137,10 @@ TyreFit fit_once(const TyreState& start, const FitRequest& r, const std::vector<
   fit.sigma_relative = fit.sigma_from_residuals ? std::sqrt(ssr / fit.degrees_of_freedom) : r.assumed_relative_uncertainty;
   // Covariance of the scaled parameters; a pseudo-inverse keeps a degenerate direction from producing NaN.
   const Eigen::MatrixXd jtj = ls.jacobian.transpose() * ls.jacobian;
+  const double widest = ls.jacobian.colwise().norm().maxCoeff();
+  flat.clear();
+  for (int k = 0; k < n; ++k)
+    if (!(ls.jacobian.col(k).norm() > 1e-12 * widest)) flat.push_back(free[k]);
   const Eigen::MatrixXd cov =
       fit.sigma_relative * fit.sigma_relative * jtj.completeOrthogonalDecomposition().pseudoInverse();
   for (int k = 0; k < n; ++k) {
@@ -280,9 +287,9 @@ TyreFit fit_hysteresis(const TyreState& start_in, const FitRequest& r) {
   // A slope or speed loss cannot be negative (RRC would reach 0 at some speed), nor the deflection exponent (a
   // tyre losing less the more it deflects would lose more when pumped up; every measured set loses less, J2452
   // pressure exponents -0.26 to -0.59): one that fits below 0 is held at 0 and the rest refitted.
-  std::vector<HysteresisParam> at_bound;
+  std::vector<HysteresisParam> at_bound, undetermined, flat;
   while (true) {
-    TyreFit fit = fit_once(start, r, free);
+    TyreFit fit = fit_once(start, r, free, flat);
     bool changed = false;
     for (const auto& e : fit.params) {
       const bool nonneg = e.param == HysteresisParam::FrequencySlope || e.param == HysteresisParam::SpeedLoss ||
@@ -294,7 +301,25 @@ TyreFit fit_hysteresis(const TyreState& start_in, const FitRequest& r) {
         changed = true;
       }
     }
+    // A constant the points cannot see (e.g. the speed loss' load exponent once the speed loss is held at 0) keeps
+    // its shared value, and the fit says so, rather than reporting it as fitted with a zero-width interval.
     if (!changed) {
+      for (auto p : flat) {
+        if (p == HysteresisParam::RrcRef) continue;  // the level always moves the fit
+        free.erase(std::find(free.begin(), free.end(), p));
+        undetermined.push_back(p);
+        changed = true;
+      }
+    }
+    if (!changed) {
+      for (auto p : undetermined) {
+        fit.warnings.push_back(std::string(hysteresis_param_key(p)) + " is not determined by these points (the fit does "
+                               "not change with it" + (p == HysteresisParam::SpeedLossLoadExponent &&
+                                                               hysteresis_param_value(start.hysteresis, HysteresisParam::SpeedLoss) == 0.0
+                                                           ? ": it scales speed_loss_rrc_per_hz2, which is 0"
+                                                           : "") +
+                               "); it keeps the shared value");
+      }
       for (auto p : at_bound) {
         fit.params.push_back({p, 0.0, 0.0, 0.0, 0.0, true});
         fit.held.erase(std::find(fit.held.begin(), fit.held.end(), p));
