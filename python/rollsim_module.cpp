@@ -42,21 +42,38 @@ void warn(const std::string& text) {
   if (PyErr_WarnEx(PyExc_UserWarning, text.c_str(), 1) != 0) throw py::error_already_set();
 }
 
-// A Python number as the text the command line would have been given (shortest round-trip form: exact).
-std::string number_text(py::handle x) {
-  if (x.is_none()) return "";
-  return format_value(x.cast<double>());
+// A keyword argument as T, or the named error a command-line user would get for a malformed option.
+template <class T>
+T arg_as(py::handle x, const std::string& where, const std::string& expected) {
+  try {
+    return x.cast<T>();
+  } catch (const py::cast_error&) {
+    throw InputError(where, "expected " + expected);
+  } catch (const py::type_error&) {  // a Python type wrapper (py::sequence, py::dict) given another type
+    throw InputError(where, "expected " + expected);
+  }
 }
 
+// A Python number as the text the command line would have been given (shortest round-trip form: exact).
+std::string number_text(py::handle x, const std::string& where) {
+  if (x.is_none()) return "";
+  return format_value(arg_as<double>(x, where, "a number"));
+}
+
+constexpr const char* kNameOrDict = "a shipped name or a file path (str), or a dict with the file's keys";
+
 // A file or shipped name (str), or a Python dict with the keys of the YAML file.
+std::string vehicle_path(py::handle v) {
+  return resolve_data_file(arg_as<std::string>(v, "vehicle", kNameOrDict), "vehicles", ".yaml", "--vehicle");
+}
 Vehicle vehicle_from(py::handle v) {
   if (py::isinstance<py::dict>(v)) return load_vehicle_text(to_json(v), "vehicle dict");
-  return load_vehicle_file(resolve_data_file(v.cast<std::string>(), "vehicles", ".yaml", "--vehicle"));
+  return load_vehicle_file(vehicle_path(v));
 }
 std::optional<TyreSpec> tyre_from(py::handle t) {
   if (t.is_none()) return std::nullopt;
   if (py::isinstance<py::dict>(t)) return load_tyre_text(to_json(t), "tyre dict");
-  return load_tyre_file(resolve_data_file(t.cast<std::string>(), "tyres", ".yaml", "--tyre"));
+  return load_tyre_file(resolve_data_file(arg_as<std::string>(t, "tyre", kNameOrDict), "tyres", ".yaml", "--tyre"));
 }
 
 // A shipped name or CSV path; a dict of arrays named like the CSV columns (time_s, speed_kmh or speed_mps,
@@ -69,11 +86,12 @@ DriveCycle cycle_from(py::handle c) {
   std::vector<py::array_t<double>> columns;
   if (py::isinstance<py::dict>(c)) {
     for (auto item : c.cast<py::dict>()) {
-      table.header.push_back(item.first.cast<std::string>());
+      table.header.push_back(arg_as<std::string>(item.first, "cycle", "column names (str) as dict keys"));
       columns.push_back(py::array_t<double, py::array::forcecast>::ensure(item.second));
     }
   } else {
-    const py::sequence pair = c.cast<py::sequence>();
+    const py::sequence pair = arg_as<py::sequence>(c, "cycle", "a shipped name or CSV path (str), a dict of arrays, or "
+                                                              "a pair (time_s, speed_kmh)");
     if (pair.size() != 2) throw InputError("cycle", "a pair (time_s, speed_kmh) of arrays is expected, or a dict of columns");
     table.header = {"time_s", "speed_kmh"};
     for (auto a : pair) columns.push_back(py::array_t<double, py::array::forcecast>::ensure(a));
@@ -109,13 +127,13 @@ py::object api_tyre(py::object file, py::object size, py::object outer_radius_m,
                 py::object load_n, py::object load_pct, py::object speed_kmh) {
   TyreRequest req;
   if (py::isinstance<py::dict>(file)) req.file_text = to_json(file);
-  else if (!file.is_none()) req.file = file.cast<std::string>();
-  if (!size.is_none()) req.size = size.cast<std::string>();
-  req.outer_radius_m = number_text(outer_radius_m);
-  req.width_m = number_text(width_m);
-  req.pressure_bar = number_text(pressure_bar);
-  req.load_n = number_text(load_n);
-  req.load_pct = number_text(load_pct);
+  else if (!file.is_none()) req.file = arg_as<std::string>(file, "tyre", kNameOrDict);
+  if (!size.is_none()) req.size = arg_as<std::string>(size, "size", "a size designation (str)");
+  req.outer_radius_m = number_text(outer_radius_m, "outer_radius_m");
+  req.width_m = number_text(width_m, "width_m");
+  req.pressure_bar = number_text(pressure_bar, "pressure_bar");
+  req.load_n = number_text(load_n, "load_n");
+  req.load_pct = number_text(load_pct, "load_pct");
   const TyreSpec spec = build_requested_tyre(req);
   const TyreLoadChoice load = choose_requested_load(req, spec);
   const auto speeds = py::array_t<double, py::array::forcecast>::ensure(speed_kmh);
@@ -161,7 +179,8 @@ py::list api_compare(py::object vehicle, std::vector<std::string> tyres, py::obj
   selection::CompareOptions copt;
   copt.diameter_tolerance_pct = selection::parse_diameter_tolerance_pct(format_value(diameter_tolerance_pct));
   const selection::CandidateList list =
-      selection::load_candidates(tyres, !catalogue.is_none(), catalogue.is_none() ? "" : catalogue.cast<std::string>());
+      selection::load_candidates(tyres, !catalogue.is_none(),
+                                 catalogue.is_none() ? "" : arg_as<std::string>(catalogue, "catalogue", "a folder path (str)"));
   for (const auto& b : list.broken) warn("skipped broken catalogue file: " + b);
   const Vehicle v = vehicle_from(vehicle);
   const DriveCycle c = cycle_from(cycle);
@@ -181,14 +200,14 @@ py::list api_sweep(py::object tyre, std::vector<py::tuple> axes, py::object load
   selection::SweepRequest req;
   for (const auto& a : axes) {
     if (a.size() < 3 || a.size() > 4) throw InputError("axes", "each axis is (param, from, to) or (param, from, to, steps)");
-    req.params.push_back(a[0].cast<std::string>());
-    req.from.push_back(number_text(a[1]));
-    req.to.push_back(number_text(a[2]));
-    if (a.size() == 4) req.steps.push_back(number_text(a[3]));
+    req.params.push_back(arg_as<std::string>(a[0], "axes", "(param, from, to[, steps]) with param a name (str)"));
+    req.from.push_back(number_text(a[1], "axes (from)"));
+    req.to.push_back(number_text(a[2], "axes (to)"));
+    if (a.size() == 4) req.steps.push_back(number_text(a[3], "axes (steps)"));
   }
-  req.load_n = number_text(load_n);
+  req.load_n = number_text(load_n, "load_n");
   req.speed_kmh = format_value(speed_kmh);
-  req.threads = number_text(threads);
+  req.threads = number_text(threads, "threads");
   const selection::SweepOptions so = selection::sweep_options_from_request(req);
   const TyreSpec t = *tyre_from(tyre);
   selection::SweepResult r;
@@ -215,12 +234,18 @@ py::object api_diagnose(py::object vehicle, std::vector<std::string> recordings,
                     std::string preset, py::object tyre) {
   YamlMap vehicle_file = py::isinstance<py::dict>(vehicle)
                              ? YamlMap::load_text(to_json(vehicle), "vehicle dict")
-                             : YamlMap::load_file(resolve_data_file(vehicle.cast<std::string>(), "vehicles", ".yaml", "--vehicle"));
+                             : YamlMap::load_file(vehicle_path(vehicle));
   Vehicle v = load_vehicle(vehicle_file);
   if (const auto t = tyre_from(tyre)) fit_tyres(v, *t);
   std::vector<std::string> column_options, scale_options;
-  for (auto item : columns) column_options.push_back(item.first.cast<std::string>() + "=" + item.second.cast<std::string>());
-  for (auto item : scales) scale_options.push_back(item.first.cast<std::string>() + "=" + number_text(item.second));
+  for (auto item : columns) {
+    column_options.push_back(arg_as<std::string>(item.first, "columns", "a dict of canonical name (str) to source column (str)") +
+                             "=" + arg_as<std::string>(item.second, "columns", "a dict of canonical name (str) to source column (str)"));
+  }
+  for (auto item : scales) {
+    const std::string key = arg_as<std::string>(item.first, "scales", "a dict of canonical name (str) to factor (number)");
+    scale_options.push_back(key + "=" + number_text(item.second, "scales['" + key + "']"));
+  }
   ColumnMapping mapping = assemble_mapping(preset, vehicle_file, column_options, scale_options, "columns", "scales");
   mapping.how_to_map = "with columns={'CANONICAL': SOURCE}";
   std::vector<Recording> recs;
@@ -255,16 +280,6 @@ py::dict api_engine_map(py::dict engine, py::object speed_rpm, py::object torque
   out["fuel_power_w"] = fuel(speeds, torques);
   out["max_torque_nm"] = full_load(speeds);
   return out;
-}
-
-// A keyword argument as T, or the named error a command-line user would get for a malformed option.
-template <class T>
-T arg_as(py::handle x, const std::string& where, const std::string& expected) {
-  try {
-    return x.cast<T>();
-  } catch (const py::cast_error&) {
-    throw InputError(where, "expected " + expected);
-  }
 }
 
 // A measured point: (pressure_kpa, load_n, speed_kmh, rrc), or an RRC alone at the size's ISO 28580 conditions.
@@ -336,7 +351,8 @@ py::dict api_tyre_fit(const std::string& size, py::object points, py::object lab
   out["residuals"] = residuals;
   out["tyre"] = py::module_::import("yaml").attr("safe_load")(yaml.str());
   if (!output.is_none()) {
-    write_file_atomically(output.cast<std::string>(), "output", [&](std::ostream& o) { o << yaml.str(); });
+    write_file_atomically(arg_as<std::string>(output, "output", "a file path (str)"), "output",
+                          [&](std::ostream& o) { o << yaml.str(); });
   }
   return out;
 }
@@ -348,7 +364,7 @@ py::dict api_sensitivity(py::object tyre, py::object vehicle, py::object cycle, 
   if (!vehicle.is_none()) v = vehicle_from(vehicle);
   const std::optional<TyreSpec> t = tyre_from(tyre);
   std::optional<double> at_n;
-  if (!load_n.is_none()) at_n = parse_option_number(number_text(load_n), "--load-n", Range::open_low(0.0, 1e6));
+  if (!load_n.is_none()) at_n = parse_option_number(number_text(load_n, "load_n"), "--load-n", Range::open_low(0.0, 1e6));
   const DriveCycle c = v ? cycle_from(cycle) : DriveCycle{};
   selection::Sensitivity s;
   {
@@ -361,7 +377,7 @@ py::dict api_sensitivity(py::object tyre, py::object vehicle, py::object cycle, 
 
 py::dict api_validate(const std::string& list, py::object threads) {
   const unsigned n = threads.is_none() ? 0u
-                                       : static_cast<unsigned>(parse_option_count(number_text(threads), "threads",
+                                       : static_cast<unsigned>(parse_option_count(number_text(threads, "threads"), "threads",
                                                                                    Range::closed(1, 1024)));
   const auto rows = validate::read_epa_test_car_list(list);
   validate::Validation v;

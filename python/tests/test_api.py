@@ -337,6 +337,26 @@ class InputErrors(unittest.TestCase):
         with self.assertRaisesRegex(rollsim.InputError, "speed_kmh"):
             rollsim.simulate(cycle={"time_s": [0, 1, 2], "speed_kmh": [0, 5]})
 
+    def test_wrong_types_name_the_argument(self):
+        # Session 16's outside testing: these raised RuntimeError "Unable to cast Python instance to C++ type" (or a
+        # TypeError about 'sequence') naming no argument.
+        recording = os.path.join(SHARED, "data", "recordings", "anl_d3_2018_toyota_camry", "61811012_test_data.csv")
+        cases = [
+            ("vehicle: expected", lambda: rollsim.simulate(vehicle=None)),
+            ("cycle: expected", lambda: rollsim.simulate(cycle=None)),
+            ("tyre: expected", lambda: rollsim.diagnose(vehicle="camry_2018", recordings=[recording], preset="anl_d3", tyre=3)),
+            (r"scales\['speed_kmh'\]: expected a number",
+             lambda: rollsim.diagnose(vehicle="camry_2018", recordings=[recording], preset="anl_d3", scales={"speed_kmh": "1.6"})),
+            ("columns: expected", lambda: rollsim.diagnose(vehicle="camry_2018", recordings=[recording], preset="anl_d3",
+                                                           columns={"longitude": None})),
+            ("threads: expected a number", lambda: rollsim.sweep("175-70R14", [("pressure", 1, 2)], threads="2")),
+            ("threads: '2.5' is not a whole number", lambda: rollsim.sweep("175-70R14", [("pressure", 1, 2)], threads=2.5)),
+        ]
+        for expected, call in cases:
+            with self.subTest(expected=expected):
+                with self.assertRaisesRegex(rollsim.InputError, expected):
+                    call()
+
 
 if __name__ == "__main__":
     unittest.main()
