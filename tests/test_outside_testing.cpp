@@ -292,5 +292,35 @@ TEST_F(OutsideTesting, ATyreFitConstantThePointsCannotSeeIsNotReportedFitted) {
   EXPECT_TRUE(has(r.out, R"("key": "speed_loss_load_exponent", "free": false)")) << r.out;
 }
 
+// A sweep took values a tyre file and `rollsim tyre` refuse (30 bar, 600 km/h, a 2 m wide tyre, 400 % load), and
+// options it then ignored without a word.
+TEST_F(OutsideTesting, SweepRefusesWhatTheTyreRefusesAndWhatItWouldIgnore) {
+  const std::string sweep = "sweep --tyre 175-70R14 --steps 3 --param ";
+  const std::vector<std::pair<std::string, std::string>> cases{
+      {"pressure --from 25 --to 30", "--param pressure: --to 30 bar is not allowed: pressure must be <= 20"},
+      {"speed --from 100 --to 600", "--param speed: --to 600 kmh is not allowed: speed must be <= 500"},
+      {"width --from 100 --to 2000", "--param width: --to 2000 mm is not allowed: width must be <= 1000"},
+      {"load-pct --from 50 --to 400", "--param load-pct: --to 400 pct is not allowed: load-pct must be <= 300"},
+      {"load --from 1000 --to 3000 --load-n 4000", "--load-n: not allowed with --param load"},
+      {"pressure --from 1.5 --to 3.5 --cycle wltc", "--cycle: needs --vehicle"}};
+  for (const auto& [args, message] : cases) {
+    const CmdResult r = run_rollsim(sweep + args);
+    EXPECT_EQ(r.exit_code, 2) << args;
+    EXPECT_TRUE(has(r.err, message)) << args << "\n" << r.err;
+  }
+  const CmdResult s = run_rollsim("sensitivity --tyre 175-70R14 --cycle wltc");
+  EXPECT_EQ(s.exit_code, 2);
+  EXPECT_TRUE(has(s.err, "--cycle: needs --vehicle")) << s.err;
+}
+
+// A device given as an input file was "not found"; it is there, and not a file.
+TEST_F(OutsideTesting, ADeviceAsAnInputIsNamedAsSuch) {
+  for (const std::string& args : {std::string("simulate --vehicle /dev/zero"), std::string("simulate --vehicle ev --cycle /dev/zero")}) {
+    const CmdResult r = run_rollsim(args);
+    EXPECT_EQ(r.exit_code, 2) << args;
+    EXPECT_TRUE(has(r.err, "'/dev/zero': is not a regular file")) << args << "\n" << r.err;
+  }
+}
+
 }  // namespace
 }  // namespace rollsim::test

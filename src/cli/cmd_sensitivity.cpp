@@ -16,7 +16,7 @@ namespace rollsim::cli {
 namespace {
 
 struct SensitivityOptionsText {
-  std::string tyre, vehicle, cycle = "nedc", load_n, speed_kmh = "80";
+  std::string tyre, vehicle, cycle, load_n, speed_kmh = "80";  // cycle: empty for nedc
   bool json = false;
 };
 
@@ -33,6 +33,7 @@ std::string value_text(const selection::SensitivityRow& r) {
 
 void run_sensitivity(const SensitivityOptionsText& o) {
   if (o.tyre.empty() && o.vehicle.empty()) throw InputError("--tyre", "missing: give a tyre and/or --vehicle");
+  if (!o.cycle.empty() && o.vehicle.empty()) throw InputError("--cycle", "needs --vehicle: a tyre alone drives no cycle");
   const double speed_mps =
       units::kmh_to_mps(parse_option_number(o.speed_kmh, "--speed-kmh", Range::open_low(0.0, 500.0)));
   std::optional<Vehicle> vehicle;
@@ -41,7 +42,7 @@ void run_sensitivity(const SensitivityOptionsText& o) {
   if (!o.tyre.empty()) tyre = load_tyre_file(resolve_data_file(o.tyre, "tyres", ".yaml", "--tyre"));
   std::optional<double> load_n;
   if (!o.load_n.empty()) load_n = parse_option_number(o.load_n, "--load-n", Range::open_low(0.0, 1e6));
-  const DriveCycle cycle = vehicle ? load_cycle(o.cycle, "--cycle") : DriveCycle{};
+  const DriveCycle cycle = vehicle ? load_cycle(o.cycle.empty() ? "nedc" : o.cycle, "--cycle") : DriveCycle{};
   const selection::Sensitivity s = selection::sensitivity_of(vehicle, tyre, cycle, load_n, speed_mps);
 
   if (o.json) {

@@ -27,7 +27,7 @@ namespace rollsim::cli {
 namespace {
 
 struct SweepOptionsText {
-  std::string tyre, vehicle, cycle = "nedc";
+  std::string tyre, vehicle, cycle;  // cycle: empty for nedc
   selection::SweepRequest request;
   std::string output, plot;
   bool base100 = false, json = false, replay = false;
@@ -125,12 +125,14 @@ std::string render_plot(const selection::SweepResult& r, const std::string& tyre
 void run_sweep(const SweepOptionsText& o, const ProcessGroup& group) {
   if (o.tyre.empty()) throw InputError("--tyre", "missing: give the tyre to sweep, e.g. --tyre 175-70R14");
   if (o.replay && o.vehicle.empty()) throw InputError("--replay", "needs --vehicle: a tyre alone is not simulated");
+  if (!o.cycle.empty() && o.vehicle.empty()) throw InputError("--cycle", "needs --vehicle: a tyre alone drives no cycle");
+  const std::string cycle = o.cycle.empty() ? "nedc" : o.cycle;
   selection::SweepOptions so = selection::sweep_options_from_request(o.request);
   so.replay = o.replay;
   so.map_cases = group.mapper();
   const std::string tyre_path = resolve_data_file(o.tyre, "tyres", ".yaml", "--tyre");
   const std::string vehicle_path = o.vehicle.empty() ? "" : resolve_data_file(o.vehicle, "vehicles", ".yaml", "--vehicle");
-  const std::vector<std::string> inputs{tyre_path, vehicle_path, o.cycle};
+  const std::vector<std::string> inputs{tyre_path, vehicle_path, cycle};
   // Every destination is checked before the sweep, and all are written after it (nothing is left behind).
   check_outputs_distinct({{o.output, "--output"}, {o.plot, "--plot"}});
   if (!o.output.empty()) check_output_file(o.output, "--output", inputs);
@@ -147,7 +149,7 @@ void run_sweep(const SweepOptionsText& o, const ProcessGroup& group) {
   selection::SweepResult r;
   if (!o.vehicle.empty()) {
     const Vehicle v = load_vehicle_file(vehicle_path);
-    const DriveCycle c = load_cycle(o.cycle, "--cycle");
+    const DriveCycle c = load_cycle(cycle, "--cycle");
     r = selection::sweep_vehicle(v, tyre, c, so);
   } else {
     r = selection::sweep_tyre(tyre, so);

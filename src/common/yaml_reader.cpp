@@ -243,6 +243,10 @@ std::string resolve_data_file(const std::string& name, const std::string& shippe
   }
   // A folder given by name: say so rather than "not found".
   if (is_folder_path(fs::path(name))) throw InputError(option + " '" + name + "'", "is a folder; a file is expected here");
+  std::error_code ec;
+  if (fs::exists(fs::path(name), ec)) {
+    throw InputError(option + " '" + name + "'", "is not a regular file (a device, pipe or socket?)");
+  }
   throw InputError(option + " '" + name + "'",
                    "file not found (looked in the current folder and in " + shipped.string() + ")");
 }

@@ -114,6 +114,10 @@ DriveCycle load_cycle(const std::string& name_or_path, const std::string& option
   }
   namespace fs = std::filesystem;
   if (is_folder_path(name_or_path)) throw InputError(option + " '" + name_or_path + "'", "is a folder; a file is expected here");
+  std::error_code ec;
+  if (!is_regular_file_path(name_or_path) && fs::exists(fs::path(name_or_path), ec)) {
+    throw InputError(option + " '" + name_or_path + "'", "is not a regular file (a device, pipe or socket?)");
+  }
   if (!is_regular_file_path(name_or_path)) {
     std::string list;
     for (std::size_t i = 0; i < names.size(); ++i) list += (i ? ", " : "") + names[i];

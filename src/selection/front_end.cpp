@@ -164,6 +164,11 @@ SweepOptions sweep_options_from_request(const SweepRequest& o) {
     so.axes.push_back(a);
   }
   if (!o.load_n.empty()) so.load_n = parse_option_number(o.load_n, "--load-n", Range::open_low(0.0, 1e6));
+  for (const auto& a : so.axes) {
+    if (so.load_n && (a.param == SweepParam::Load || a.param == SweepParam::LoadPct)) {
+      throw InputError("--load-n", "not allowed with --param " + sweep_param_key(a.param) + ", which sets the load");
+    }
+  }
   so.speed_kmh = parse_option_number(o.speed_kmh, "--speed-kmh", Range::closed(0.0, 500.0));
   if (!o.threads.empty()) so.threads = static_cast<unsigned>(parse_option_count(o.threads, "--threads", Range::closed(1, 1024)));
   return so;

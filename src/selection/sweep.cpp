@@ -51,6 +51,23 @@ std::string sweep_param_unit(SweepParam p) {
   return "";
 }
 
+namespace {
+
+// The largest value a tyre file or `rollsim tyre` accepts for each quantity, in the sweep's units.
+double sweep_param_max(SweepParam p) {
+  switch (p) {
+    case SweepParam::Pressure: return 20.0;     // pressure_bar, --pressure-bar
+    case SweepParam::Diameter: return 3000.0;   // outer_radius_m 1.5
+    case SweepParam::Width: return 1000.0;      // section_width_m 1.0
+    case SweepParam::Load: return 1e6;          // --load-n
+    case SweepParam::LoadPct: return 300.0;     // --load-pct
+    case SweepParam::Speed: return 500.0;       // --speed-kmh
+  }
+  return 0.0;
+}
+
+}  // namespace
+
 std::vector<double> SweepAxis::values() const {
   std::vector<double> v;
   for (int i = 0; i < steps; ++i) v.push_back(i + 1 == steps ? to : from + (to - from) * i / (steps - 1));
@@ -67,12 +84,19 @@ void check_axis(const SweepAxis& a, const std::string& option) {
     throw InputError(option, "reversed range: --from " + format_value(a.from) + " is above --to " +
                                  format_value(a.to) + " (sweeps run upwards; swap them)");
   }
-  // Lower limits of each quantity's physical meaning; the upper ones are the model's domain, found as we go.
-  // A speed of 0 is a valid point (RRC 0); every other quantity must be positive.
+  // Lower limits of each quantity's physical meaning; upper ones those a tyre file and `rollsim tyre` take, within
+  // which the model's own domain is found as we go. A speed of 0 is a valid point (RRC 0); every other quantity
+  // must be positive.
   const bool open = a.param != SweepParam::Speed;
   if (open ? !(a.from > 0.0) : !(a.from >= 0.0)) {
     throw InputError(option, "--from " + format_value(a.from) + " " + sweep_param_unit(a.param) + " is not allowed: " +
                                  sweep_param_key(a.param) + (open ? " must be > 0" : " must be >= 0"));
+  }
+  const double most = sweep_param_max(a.param);
+  if (a.to > most) {
+    throw InputError(option, "--to " + format_value(a.to) + " " + sweep_param_unit(a.param) + " is not allowed: " +
+                                 sweep_param_key(a.param) + " must be <= " + format_value(most) + " (as a tyre file or "
+                                 "rollsim tyre takes it)");
   }
 }
 
