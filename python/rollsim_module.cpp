@@ -238,9 +238,10 @@ py::object api_diagnose(py::object vehicle, std::vector<std::string> recordings,
   Vehicle v = load_vehicle(vehicle_file);
   if (const auto t = tyre_from(tyre)) fit_tyres(v, *t);
   std::vector<std::string> column_options, scale_options;
+  const std::string column_pairs = "a dict of canonical name (str) to source column (str)";
   for (auto item : columns) {
-    column_options.push_back(arg_as<std::string>(item.first, "columns", "a dict of canonical name (str) to source column (str)") +
-                             "=" + arg_as<std::string>(item.second, "columns", "a dict of canonical name (str) to source column (str)"));
+    column_options.push_back(arg_as<std::string>(item.first, "columns", column_pairs) + "=" +
+                             arg_as<std::string>(item.second, "columns", column_pairs));
   }
   for (auto item : scales) {
     const std::string key = arg_as<std::string>(item.first, "scales", "a dict of canonical name (str) to factor (number)");

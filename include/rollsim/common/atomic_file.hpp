@@ -30,7 +30,8 @@ struct OutputFile {
 };
 
 /// Writes every file to a temporary beside its target (creating missing folders; a symlink's target is the
-/// target, and a device or pipe is written in place), and only when all were written renames them into place. Any failure removes the temporaries and throws InputError naming the
+/// target, and a device or pipe is written in place), and only when all were written renames them into place.
+/// Any failure removes the temporaries and throws InputError naming the
 /// option and path: no output is left half-written, and none is written when another could not be.
 void write_files_atomically(const std::vector<OutputFile>& files);
 

@@ -43,7 +43,8 @@ void check_axis(const SweepAxis& axis, const std::string& option);
 
 struct SweepOptions {
   std::vector<SweepAxis> axes;         ///< one or two
-  std::optional<double> load_n;        ///< fixed load; default 80 % of the tyre's maximum load (with a car: its heavier static wheel load)
+  /// Fixed load; default 80 % of the tyre's maximum load, with a car its heavier static wheel load.
+  std::optional<double> load_n;
   double speed_kmh = 80.0;             ///< fixed speed
   unsigned threads = 0;                ///< vehicle sweeps: 0 = every core
   bool replay = false;                 ///< vehicle sweeps: kinematic replay instead of the forward simulation
