@@ -221,6 +221,19 @@ TEST_F(OutsideTesting, AllowedLimitsWrittenInDecimalAreInside) {
   v = run_rollsim("validate --epa-test-car-list '" + fast + "' --json");
   EXPECT_EQ(v.exit_code, 0) << v.err;
   EXPECT_TRUE(has(v.out, "N/V ratio of an engine's top gear [rpm/mph] = 250")) << v.out;
+  // A skip says what is wrong: a negative gear count read as "empty or not a number", and an absurd measured result
+  // as a hybrid (the hybrid rule compared it with the car's other result).
+  v = run_rollsim("validate --epa-test-car-list '" + with(",8,Y,", ",-1,Y,") + "' --json");
+  EXPECT_TRUE(has(v.out, "# of Gears of a stepped transmission = -1 (allowed 2-10)")) << v.out;
+  std::string hwfet;
+  std::getline(in, hwfet);  // the same car's HWFET: 30.6 mpg
+  std::string ftp_row = row;
+  ftp_row.replace(ftp_row.find(",17.7,MPG,"), 10, ",0.5,MPG,");
+  hwfet.replace(hwfet.find(",30.6,MPG,"), 10, ",0.5,MPG,");
+  v = run_rollsim("validate --epa-test-car-list '" + write("both.csv", header + "\n" + ftp_row + "\n" + hwfet + "\n") +
+                  "' --json");
+  EXPECT_EQ(lines(v.out).size(), 2u) << v.out;
+  for (const auto& l : lines(v.out)) EXPECT_TRUE(has(l, "measured result outside any car of its kind: 0.5 mpg")) << l;
 }
 
 // A measured-points CSV with a column twice: the first copy won without a word (cycle CSVs refused it).

@@ -57,6 +57,9 @@ Cycles shipped_cycles() {
   return c;
 }
 
+// A measured result a car on petrol, diesel or E85 can have, in mpg.
+bool plausible_liquid_mpg(double mpg) { return mpg >= 5.0 && mpg <= 100.0; }
+
 // ---- hybrids: the list does not flag them, so three rules (README) ----
 std::string vehicle_key(const EpaTestRow& r) { return lower_ascii(r.make) + "|" + lower_ascii(r.model) + "|" + r.vehicle_id; }
 
@@ -98,7 +101,8 @@ std::map<std::string, VehicleFacts> vehicle_facts(const std::vector<EpaTestRow>&
     if (charge_depleting(r.cycle) && liquid(r.fuel)) v.charge_depleting_on_fuel = true;
     if (charge_depleting(r.cycle) && r.fuel == EpaFuel::electricity && r.measured && *r.measured >= kKwhPer100MiBelow)
       v.electric_result_in_mpge = true;
-    if (!r.measured || *r.measured <= 0.0 || *r.measured > 150.0 || !liquid(r.fuel)) continue;
+    // Only results in a liquid-fuel car's plausible range inform the hybrid rule: an absurd one is skipped as such.
+    if (!r.measured || !plausible_liquid_mpg(*r.measured) || !liquid(r.fuel)) continue;
     if (r.cycle == EpaCycle::ftp75) v.ftp_mpg = *r.measured;
     if (r.cycle == EpaCycle::hwfet) v.hwfet_mpg = *r.measured;
   }
@@ -148,7 +152,7 @@ void classify(const EpaTestRow& r, const std::map<std::string, VehicleFacts>& fa
     o.measured_from_kwh_per_100mi = true;
   }
   const bool plausible = r.fuel == EpaFuel::electricity ? o.measured >= 60.0 && o.measured <= 250.0
-                                                        : o.measured >= 5.0 && o.measured <= 100.0;
+                                                        : plausible_liquid_mpg(o.measured);
   if (!plausible) return skip(SkipReason::absurd_measured_result, format_value(*r.measured) + " " + o.unit);
   std::string detail;
   if (const SkipReason why = check_car_fields(r, detail); why != SkipReason::none) return skip(why, detail);
