@@ -224,7 +224,7 @@ py::list api_sweep(py::object tyre, std::vector<py::tuple> axes, py::object load
     warn(*r.stopped + " (the " + std::to_string(r.points.size()) + " valid points of " +
          std::to_string(r.planned_points) + " are returned)");
   }
-  if (const std::string w = selection::sweep_trace_warning(r); !w.empty()) warn(w);
+  for (const std::string& w : selection::sweep_warnings(r)) warn(w);
   py::list out;
   for (const auto& j : selection::sweep_json(r)) out.append(from_json(j.str()));
   return out;

@@ -321,6 +321,11 @@ TEST_F(OutsideTesting, SweepRefusesWhatTheTyreRefusesAndWhatItWouldIgnore) {
     EXPECT_EQ(r.exit_code, 2) << args;
     EXPECT_TRUE(has(r.err, message)) << args << "\n" << r.err;
   }
+  // A load above the tyre's rating: `rollsim tyre` warned, a sweep did not.
+  const CmdResult over = run_rollsim(sweep + "load --from 3000 --to 12000");
+  EXPECT_EQ(over.exit_code, 0) << over.err;
+  EXPECT_TRUE(has(over.err, "warning: at 2 of 3 points the load (up to 12000 N) is above the tyre's rated maximum 4903 N"))
+      << over.err;
   const CmdResult s = run_rollsim("sensitivity --tyre 175-70R14 --cycle wltc");
   EXPECT_EQ(s.exit_code, 2);
   EXPECT_TRUE(has(s.err, "--cycle: needs --vehicle")) << s.err;

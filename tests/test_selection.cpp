@@ -233,7 +233,8 @@ TEST(SelectionCompare, AFigureOfACarThatFellBehindTheCycleSaysSo) {
   const SweepResult swept = sweep_vehicle(ev, tyre("nominal"), cruise_at(200.0), one_axis(SweepParam::Pressure, 2.0, 3.0, 2));
   ASSERT_EQ(swept.points.size(), 2u);
   for (const auto& p : swept.points) EXPECT_FALSE(p.trace.followed);
-  EXPECT_TRUE(has(sweep_trace_warning(swept), "at 2 of 2 points")) << sweep_trace_warning(swept);
+  ASSERT_EQ(sweep_warnings(swept).size(), 1u);
+  EXPECT_TRUE(has(sweep_warnings(swept)[0], "at 2 of 2 points (followed_trace no)")) << sweep_warnings(swept)[0];
   EXPECT_TRUE(has(sweep_csv(swept), ",no\n"));
   EXPECT_FALSE(vehicle_sensitivity(ev, tyre("nominal"), cruise_at(200.0), 4000.0, 80 / 3.6).followed_trace);
   EXPECT_TRUE(vehicle_sensitivity(ev, tyre("nominal"), load_cycle("nedc"), 4000.0, 80 / 3.6).followed_trace);

@@ -169,7 +169,8 @@ void run_sweep(const SweepOptionsText& o, const ProcessGroup& group) {
   // Under MPI every rank holds the whole result; only rank 0 writes it.
   if (group.is_root()) write_files_atomically(files);
   if (o.output.empty()) std::cout << table;
-  if (const std::string w = selection::sweep_trace_warning(r); !w.empty() && group.is_root()) std::cerr << "warning: " << w << "\n";
+  if (group.is_root())
+    for (const std::string& w : selection::sweep_warnings(r)) std::cerr << "warning: " << w << "\n";
   if (r.stopped) {
     throw InputError("--param", *r.stopped + " (the " + std::to_string(r.points.size()) + " valid points of " +
                                     std::to_string(r.planned_points) + " were written)");

@@ -222,6 +222,7 @@ SweepResult sweep_tyre(const TyreSpec& tyre, const SweepOptions& o) {
   check_options(tyre, o);
   SweepResult r;
   r.axes = o.axes;
+  r.max_load_n = tyre.max_load_n;
   const auto pts = grid(o.axes, kMaxTyreSweepPoints, "a tyre sweep");
   r.planned_points = pts.size();
   r.points.reserve(pts.size());
@@ -264,6 +265,7 @@ SweepResult sweep_vehicle(const Vehicle& vehicle, const TyreSpec& tyre, const Dr
   SweepResult r;
   r.axes = o.axes;
   r.vehicle = true;
+  r.max_load_n = tyre.max_load_n;
   r.energy_unit = energy_unit(vehicle);
   const auto pts = grid(o.axes, kMaxVehicleSweepPoints, "a sweep with a car (one simulation per point)");
   r.planned_points = pts.size();
@@ -330,7 +332,19 @@ std::vector<std::pair<std::string, double>> sweep_point_columns(const SweepResul
   return out;
 }
 
-std::string sweep_trace_warning(const SweepResult& r) {
+std::vector<std::string> sweep_warnings(const SweepResult& r) {
+  std::vector<std::string> out;
+  std::size_t over = 0;
+  double heaviest_n = 0.0;
+  for (const auto& p : r.points) {
+    over += r.max_load_n > 0.0 && p.load_n > r.max_load_n ? 1 : 0;
+    heaviest_n = std::max(heaviest_n, p.load_n);
+  }
+  if (over > 0) {
+    out.push_back("at " + std::to_string(over) + " of " + std::to_string(r.points.size()) + " points the load (up to " +
+                  fixed(heaviest_n, 0) + " N) is above the tyre's rated maximum " + fixed(r.max_load_n, 0) +
+                  " N; results there are outside the tyre's rating");
+  }
   std::size_t behind = 0;
   TraceFollowing worst;
   for (const auto& p : r.points) {
@@ -338,9 +352,11 @@ std::string sweep_trace_warning(const SweepResult& r) {
     worst.followed = worst.followed && p.trace.followed;
     worst.max_deficit_mps = std::max(worst.max_deficit_mps, p.trace.max_deficit_mps);
   }
-  if (behind == 0) return {};
-  return "at " + std::to_string(behind) + " of " + std::to_string(r.points.size()) +
-         " points (followed_trace no): " + report::shortfall_caveat(worst);
+  if (behind > 0) {
+    out.push_back("at " + std::to_string(behind) + " of " + std::to_string(r.points.size()) +
+                  " points (followed_trace no): " + report::shortfall_caveat(worst));
+  }
+  return out;
 }
 
 std::string sweep_csv(const SweepResult& r) {

@@ -71,11 +71,13 @@ struct SweepResult {
   std::size_t planned_points = 0;
   /// Set when the sweep left the model's domain: the point where it stopped and why.
   std::optional<std::string> stopped;
+  double max_load_n = 0.0;             ///< the tyre's rated maximum load; 0 when unknown
 };
 
-/// Vehicle sweeps: a warning naming how many points could not follow the cycle and what their figures measured
-/// instead (report::shortfall_caveat), or empty.
-std::string sweep_trace_warning(const SweepResult& result);
+/// The sweep's warnings, each one line without a "warning:" prefix: points above the tyre's rated load, and
+/// (vehicle sweeps) how many points could not follow the cycle and what their figures measured instead
+/// (report::shortfall_caveat).
+std::vector<std::string> sweep_warnings(const SweepResult& result);
 
 /// The tyre with one parameter set (user units); load/speed parameters leave the tyre unchanged.
 TyreSpec with_parameter(const TyreSpec& tyre, SweepParam p, double value);
