@@ -186,8 +186,11 @@ class SelectionApi(unittest.TestCase):
             got = rollsim.sweep("175-70R14", [("load", 2000, 60000, 40)])
         self.assertEqual(got, expected)
         self.assertTrue(0 < len(got) < 40)
-        self.assertEqual(len(caught), 1)
+        # The stop, then the load above the tyre's rating (session 16): both as the command line says them.
+        self.assertEqual(len(caught), 2)
         self.assertIn(str(caught[0].message).split(" (the ")[0], p.stderr)
+        self.assertIn("above the tyre's rated maximum", str(caught[1].message))
+        self.assertIn(str(caught[1].message), p.stderr)
         with warnings.catch_warnings():
             warnings.simplefilter("error")
             with self.assertRaises(UserWarning):
