@@ -126,7 +126,12 @@ ElectricPowertrainParams read_electric(YamlMap& pt) {
   return p;
 }
 
-CombustionPowertrainParams read_combustion(YamlMap& pt) {
+// The road speed at which the engine reaches its rated speed in `ratio` (gear times final drive), on a wheel of
+// `radius_m` (the driven tyre's unloaded radius: its rolling radius is smaller, so the engine is slower here).
+double top_speed_in_gear_mps(double max_speed_radps, double ratio, double radius_m) { return max_speed_radps * radius_m / ratio; }
+
+// `driven_radius_m`: the driven wheels' radius, which with the gearing says where each gear runs out of revs.
+CombustionPowertrainParams read_combustion(YamlMap& pt, double driven_radius_m) {
   CombustionPowertrainParams p;
   {
     YamlMap m = pt.map("engine");
@@ -162,6 +167,14 @@ CombustionPowertrainParams read_combustion(YamlMap& pt) {
         throw InputError(m.where("downshift_speeds_kmh"), "downshift speed " + format_value(down[i]) +
                                                               " km/h must be below the upshift speed " + format_value(up[i]) + " km/h");
       if (i > 0 && up[i] <= up[i - 1]) throw InputError(m.where("upshift_speeds_kmh"), "must increase gear by gear");
+      // A gear held past its top speed would turn the engine beyond its rated speed (this model has no rev limiter).
+      const double top_mps = top_speed_in_gear_mps(p.engine.max_speed_radps, g.ratios[i] * g.final_drive_ratio, driven_radius_m);
+      if (units::kmh_to_mps(up[i]) > top_mps) {
+        throw InputError(m.where("upshift_speeds_kmh"), "upshift from gear " + std::to_string(i + 1) + " at " +
+                                                            format_value(up[i]) + " km/h is past the gear's top speed, " +
+                                                            fixed(units::mps_to_kmh(top_mps), 1) + " km/h at max_speed_rpm on the " +
+                                                            fixed(driven_radius_m, 3) + " m driven wheel: shift up by then");
+      }
       g.upshift_speeds_mps.push_back(units::kmh_to_mps(up[i]));
       g.downshift_speeds_mps.push_back(units::kmh_to_mps(down[i]));
     }
@@ -222,7 +235,8 @@ Vehicle load_vehicle(YamlMap root) {
   if (type == "electric") {
     v.powertrain = read_electric(pt);
   } else if (type == "combustion") {
-    v.powertrain = read_combustion(pt);
+    const std::optional<TyreSpec>& driven = v.body.driven_axle == DrivenAxle::rear ? v.rear_tyre : v.front_tyre;
+    v.powertrain = read_combustion(pt, driven ? driven->state.geometry.outer_radius_m : v.body.wheel_radius_m);
   } else if (type == "engine_map") {
     v.powertrain = read_engine_map_powertrain(pt);
   } else {
