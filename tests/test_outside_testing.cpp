@@ -355,5 +355,41 @@ TEST_F(OutsideTesting, AShiftScheduleTheGearingCannotReachIsNamedAtLoad) {
                                "the gear's top speed, 47.8 km/h at max_speed_rpm")) << r.err;
 }
 
+// regress --update wrote names and paths as plain YAML: "ev nedc #1" came back as "ev nedc" and "ratio: 2" as a
+// file that no longer parsed, with exit 0. A cycle that covers no distance ran (NaN) and --update wrote NaN.
+TEST_F(OutsideTesting, RegressUpdateWritesWhatItReadsBack) {
+  auto one = [](const std::string& name, const std::string& cycle, const std::string& tolerance) {
+    return "  - name: " + name + "\n    vehicle: ev\n    tyre: nominal\n    cycle: " + cycle +
+           "\n    unit: kwh_per_10km\n    expected: 1.64\n    tolerance_pct: " + tolerance + "\n";
+  };
+  const std::string file = write("b.yaml", "cases:\n" + one("\"ev nedc #1\"", "nedc", "0.5") + one("\"ratio: 2\"", "nedc", "0.5"));
+  ASSERT_EQ(run_rollsim("regress '" + file + "' --update").exit_code, 0);
+  const CmdResult r = run_rollsim("regress '" + file + "'");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(has(r.out, "ev nedc #1 ")) << r.out;
+  EXPECT_TRUE(has(r.out, "ratio: 2 ")) << r.out;
+
+  const std::string still = write("still.csv", "time_s,speed_kmh\n0,0\n60,0\n");
+  const std::string s = write("s.yaml", "cases:\n" + one("s", "'" + still + "'", "0.5"));
+  const CmdResult u = run_rollsim("regress '" + s + "' --update");
+  EXPECT_EQ(u.exit_code, 2);
+  EXPECT_TRUE(has(u.err, "covers no distance")) << u.err;
+  EXPECT_TRUE(has(slurp(s), "expected: 1.64")) << slurp(s);
+
+  // --update rounds to 6 significant digits, so a tolerance below 0.001 % would fail right after it.
+  const CmdResult t = run_rollsim("regress '" + write("t.yaml", "cases:\n" + one("t", "nedc", "0.00001")) + "'");
+  EXPECT_EQ(t.exit_code, 2);
+  EXPECT_TRUE(has(t.err, "tolerance_pct")) << t.err;
+}
+
+// A drift is the command's verdict, exit 1; bad input is exit 2 (session 16's parse-error change briefly made a
+// drift exit 2 as well).
+TEST_F(OutsideTesting, ADriftExitsOneAndBadInputTwo) {
+  const std::string file = write("d.yaml", "cases:\n  - name: d\n    vehicle: ev\n    tyre: nominal\n    cycle: nedc\n"
+                                           "    unit: kwh_per_10km\n    expected: 1.7\n    tolerance_pct: 0.5\n");
+  EXPECT_EQ(run_rollsim("regress '" + file + "'").exit_code, 1);
+  EXPECT_EQ(run_rollsim("regress '" + file + "' --bogus").exit_code, 2);
+}
+
 }  // namespace
 }  // namespace rollsim::test

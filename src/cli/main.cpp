@@ -55,6 +55,8 @@ int main(int argc, char** argv) {
   }
   try {
     app.parse(argc, argv);
+  } catch (const CLI::RuntimeError& e) {
+    return e.get_exit_code();  // a command's own verdict (regress: 1 when a figure drifted), not a parse error
   } catch (const CLI::ParseError& e) {
     // --help and --version answer with exit 0; every other parse error is bad input, exit 2 like the rest (CLI11's
     // own codes, 105-109, would tell a script nothing more).

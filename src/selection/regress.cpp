@@ -3,9 +3,12 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <regex>
 #include <sstream>
 
 #include "rollsim/common/error.hpp"
+#include "rollsim/common/json.hpp"
 #include "rollsim/common/yaml_reader.hpp"
 #include "rollsim/cycle/drive_cycle.hpp"
 #include "rollsim/selection/common.hpp"
@@ -42,7 +45,8 @@ Baseline load_baseline(const std::string& path) {
       throw InputError(m.where("unit"), "'" + c.unit + "' is not allowed: must be kwh_per_10km or l_per_100km");
     }
     c.expected = m.number("expected", Range::positive());
-    c.tolerance_pct = m.number("tolerance_pct", Range::open_low(0.0, 100.0));
+    // --update writes `expected` to 6 significant digits (up to 0.0005 % off): a tolerance must hold that rounding.
+    c.tolerance_pct = m.number("tolerance_pct", Range::closed(0.001, 100.0));
     m.finish();
     for (const auto& other : b.cases) {
       if (other.name == c.name) throw InputError(m.where("name"), "case '" + c.name + "' appears twice");
@@ -61,6 +65,7 @@ std::vector<RegressOutcome> run_baseline(const Baseline& b) {
       Vehicle v = load_vehicle_file(resolve_data_file(c.vehicle, "vehicles", ".yaml", "vehicle"));
       fit_tyres(v, load_tyre_file(resolve_data_file(c.tyre, "tyres", ".yaml", "tyre")));
       const DriveCycle cycle = load_cycle(c.cycle, "cycle");
+      require_distance(cycle);
       if (energy_unit(v) != c.unit) {
         throw InputError("unit", "'" + c.unit + "' does not match the car (" + energy_unit(v) + ")");
       }
@@ -83,6 +88,22 @@ std::vector<RegressOutcome> run_baseline(const Baseline& b) {
 
 std::string baseline_value_text(double value) { return significant(value, 6); }
 
+namespace {
+
+// A name or path as YAML reads it back: plain where that is unambiguous, else a double-quoted scalar (JSON's
+// escapes are YAML's), so that "ev nedc #1" keeps its "#1" and "ratio: 2" stays one string.
+std::string yaml_scalar(const std::string& text) {
+  static const std::regex plain(R"([A-Za-z0-9_][A-Za-z0-9_./+-]*)");
+  static const std::regex special(R"((?:true|false|yes|no|on|off|null|y|n))", std::regex::icase);
+  char* end = nullptr;
+  std::strtod(text.c_str(), &end);
+  const bool number = !text.empty() && end == text.c_str() + text.size();
+  if (std::regex_match(text, plain) && !std::regex_match(text, special) && !number) return text;
+  return json_string(text);
+}
+
+}  // namespace
+
 std::string baseline_yaml(const Baseline& b, const std::vector<RegressOutcome>& outcomes) {
   std::ostringstream y;
   y << "# Energy regression baseline for `rollsim regress` (forward simulation). Each case: the car, the tyre fitted\n"
@@ -92,10 +113,10 @@ std::string baseline_yaml(const Baseline& b, const std::vector<RegressOutcome>& 
   for (std::size_t i = 0; i < b.cases.size(); ++i) {
     const RegressCase& c = b.cases[i];
     const double value = i < outcomes.size() ? outcomes[i].actual : c.expected;
-    y << "  - name: " << c.name << "\n"
-      << "    vehicle: " << c.vehicle << "\n"
-      << "    tyre: " << c.tyre << "\n"
-      << "    cycle: " << c.cycle << "\n"
+    y << "  - name: " << yaml_scalar(c.name) << "\n"
+      << "    vehicle: " << yaml_scalar(c.vehicle) << "\n"
+      << "    tyre: " << yaml_scalar(c.tyre) << "\n"
+      << "    cycle: " << yaml_scalar(c.cycle) << "\n"
       << "    unit: " << c.unit << "\n"
       << "    expected: " << baseline_value_text(value) << "\n"
       << "    tolerance_pct: " << significant(c.tolerance_pct, 6) << "\n";
