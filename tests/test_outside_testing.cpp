@@ -391,5 +391,24 @@ TEST_F(OutsideTesting, ADriftExitsOneAndBadInputTwo) {
   EXPECT_EQ(run_rollsim("regress '" + file + "' --bogus").exit_code, 2);
 }
 
+// Downhill from a full battery the state of charge rose past 100 % without a word, and the range read 0 km. No
+// charge limit is modelled; the run says what it booked that a full battery could not take.
+TEST_F(OutsideTesting, ABatteryChargedPastFullIsSaid) {
+  std::string ev = slurp(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/ev.yaml");
+  ev = std::regex_replace(ev, std::regex(R"(initial_soc_pct: [0-9.]+)"), "initial_soc_pct: 100");
+  const std::string car = write("ev_full.yaml", ev);
+  const std::string down = write("down5.csv", "time_s,speed_kmh,grade_pct\n0,0,-5\n10,0,-5\n22,60,-5\n622,60,-5\n"
+                                              "634,0,-5\n644,0,-5\n");
+  for (const std::string mode : {"", " --replay"}) {
+    const CmdResult r = run_rollsim("simulate --vehicle '" + car + "' --cycle '" + down + "'" + mode);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_TRUE(has(r.out, "WARNING: the battery would have charged past full (state of charge up to 100.7 %)")) << r.out;
+    EXPECT_TRUE(has(r.out, "range on the usable battery (21.3 kWh): none to state")) << r.out;
+    const CmdResult j = run_rollsim("simulate --vehicle '" + car + "' --cycle '" + down + "' --json" + mode);
+    EXPECT_TRUE(has(j.out, "\"range_km\": null")) << j.out;
+    EXPECT_TRUE(std::regex_search(j.out, std::regex(R"("max_soc_pct": 100\.7)"))) << j.out;
+  }
+}
+
 }  // namespace
 }  // namespace rollsim::test

@@ -42,6 +42,14 @@ std::vector<std::pair<std::string, double>> energy_terms_kwh(const SimulationRes
 double headline_value(const SimulationResult& r) { return r.fuel ? r.fuel_l_per_100km() : r.aec_kwh_per_10km(); }
 std::string headline_unit(const SimulationResult& r) { return r.fuel ? "l/100 km" : "kWh/10 km"; }
 
+std::string overcharge_caveat(const SimulationResult& r) {
+  if (!r.battery || !(r.battery->max_soc > 1.0 + 1e-9)) return {};
+  return "the battery would have charged past full (state of charge up to " + fixed(r.battery->max_soc * 100.0, 1) +
+         " %): a full battery takes no charge, so at least " +
+         fixed(units::j_to_kwh((r.battery->max_soc - 1.0) * r.battery->usable_j), 3) +
+         " kWh of the regeneration booked would have gone to the friction brakes, and the energy figure is that much low";
+}
+
 std::string summary_text(const SimulationResult& r, bool solver_stats) {
   std::ostringstream o;
   const auto& e = r.energy;
@@ -57,7 +65,7 @@ std::string summary_text(const SimulationResult& r, bool solver_stats) {
     o << "  energy at the battery terminals: " << fixed(r.aec_kwh_per_10km(), 3) << " kWh/10 km = "
       << fixed(r.aec_kwh_per_10km() * 10.0, 2) << " kWh/100 km = " << fixed(r.aec_kwh_per_10km() * 100.0, 1) << " Wh/km\n";
     o << "  range on the usable battery (" << fixed(units::j_to_kwh(r.battery->usable_j), 1) << " kWh): "
-      << fixed(r.range_km(), 0) << " km";
+      << (std::isfinite(r.range_km()) ? fixed(r.range_km(), 0) + " km" : "none to state (the battery ends with more charge)");
     if (!r.battery_empty) {
       o << "; state of charge " << fixed(r.battery->initial_soc * 100, 1) << " % -> " << fixed(r.battery->final_soc * 100, 1) << " %";
     }
@@ -67,6 +75,7 @@ std::string summary_text(const SimulationResult& r, bool solver_stats) {
     o << "  fuel: " << fixed(r.fuel_l_per_100km(), 3) << " l/100 km (" << fixed(r.fuel->volume_m3 * 1e3, 3)
       << " l), CO2 " << fixed(r.co2_g_per_km(), 1) << " g/km\n";
   }
+  if (const std::string w = overcharge_caveat(r); !w.empty()) o << "  WARNING: " << w << "\n";
   if (r.battery && r.battery_empty) {
     o << "  WARNING: the usable battery ran empty at t = " << fixed(r.battery_empty->time_s, 0) << " s, after "
       << fixed(r.battery_empty->distance_m / 1000.0, 3) << " km (state of charge "
@@ -142,6 +151,7 @@ std::string shortfall_caveat(const TraceFollowing& trace) {
 
 std::vector<std::string> run_caveats(const SimulationResult& r) {
   std::vector<std::string> out;
+  if (const std::string w = overcharge_caveat(r); !w.empty()) out.push_back(w);
   if (const TraceFollowing t = r.trace_following(); !t.followed) out.push_back(shortfall_caveat(t));
   if (r.battery && r.battery_empty) {
     out.push_back("the usable battery ran empty after " + fixed(r.battery_empty->distance_m / 1000.0, 3) +
@@ -170,6 +180,7 @@ JsonObject to_json(const SimulationResult& r, const std::string& tyre_label) {
     per_distance("aec_wh_per_km", r.aec_kwh_per_10km() * 100.0);
     per_distance("range_km", r.range_km());
     j.add("final_soc_pct", r.battery->final_soc * 100.0);
+    j.add("max_soc_pct", r.battery->max_soc * 100.0);
     j.add("battery_empty", r.battery_empty.has_value());
     if (r.battery_empty) {
       j.add("battery_empty_at_s", r.battery_empty->time_s).add("battery_empty_at_km", r.battery_empty->distance_m / 1000.0);

@@ -67,7 +67,8 @@ TraceFollowing SimulationResult::trace_following() const {
 double SimulationResult::range_km() const {
   if (!moved()) return std::nan("");
   const double per_m = (energy.battery_terminal_j + energy.battery_loss_j) / distance_m;
-  return battery && per_m > 0.0 ? battery->usable_j / per_m / 1000.0 : 0.0;
+  // A run that ends with more charge than it began (downhill) has no range to speak of: NaN, not 0 km.
+  return battery && per_m > 0.0 ? battery->usable_j / per_m / 1000.0 : std::nan("");
 }
 
 namespace {
@@ -625,6 +626,7 @@ SimulationResult simulate_forward(const VehicleModel& m, const DriveCycle& c, co
   const double drain_w = battery ? max_battery_drain_w(*battery) : 0.0;
   auto charge_left_j = [&](const std::vector<double>& q) { return soc_of(m, all_accumulators(q).data()) * capacity_j; };
   double check_battery_from_s = capacity_j > 0.0 ? t0 + charge_left_j(q0) / drain_w : 1e300;
+  double peak_soc = capacity_j > 0.0 ? charge_left_j(q0) / capacity_j : 0.0;
   auto watch_battery = [&](double t_before, double t_after) {
     if (r.battery_empty || t_after < check_battery_from_s) return;
     const double left_j = charge_left_j(integ.quadratures());
@@ -648,6 +650,7 @@ SimulationResult simulate_forward(const VehicleModel& m, const DriveCycle& c, co
     const bool root = integ.step(t_stop);
     const double t = integ.time();
     watch_battery(t_before, t);
+    if (capacity_j > 0.0) peak_soc = std::max(peak_soc, charge_left_j(integ.quadratures()) / capacity_j);
     // Trace samples this step passed: read from the interpolating polynomial, no extra solver work.
     while (next_sample < c.time_s.size() && c.time_s[next_sample] <= t) {
       const double ts = c.time_s[next_sample];
@@ -694,6 +697,7 @@ SimulationResult simulate_forward(const VehicleModel& m, const DriveCycle& c, co
   auto acc = all_accumulators(integ.quadratures());
   acc[kFriction] += standstill_brake_j;
   finish_result(m, c, integ.state()[kDistance], acc.data(), c.speed_mps.front(), integ.state()[kSpeed], r);
+  if (r.battery) r.battery->max_soc = std::max({r.battery->initial_soc, r.battery->final_soc, peak_soc});
   return r;
 }
 
@@ -820,9 +824,11 @@ SimulationResult simulate_replay(const VehicleModel& m, const DriveCycle& c, con
   const BatteryParams* battery = m.powertrain->battery();
   const double capacity_j = battery ? battery->usable_capacity_j : 0.0, soc0 = battery ? battery->initial_soc : 0.0;
   auto soc_now = [&] { return capacity_j > 0.0 ? soc0 - (acc[kTerminal] + acc[kBatteryLoss]) / capacity_j : 0.0; };
+  double peak_soc = soc0;
   auto watch_battery = [&](double soc_before, double t_a, double t_b, double d_a, double d_b) {
     if (!(capacity_j > 0.0) || r.battery_empty) return;
     const double soc_after = soc_now();
+    peak_soc = std::max(peak_soc, soc_after);
     if (soc_after > 0.0) return;
     const double f = soc_before > 0.0 ? soc_before / (soc_before - soc_after) : 0.0;
     r.battery_empty = BatteryDepletion{t_a + f * (t_b - t_a), d_a + f * (d_b - d_a)};
@@ -930,6 +936,7 @@ SimulationResult simulate_replay(const VehicleModel& m, const DriveCycle& c, con
   book_cruise();
   if (limited) r.shortfalls.push_back(open);
   finish_result(m, c, distance_m, acc.data(), c.speed_mps.front(), c.speed_mps.back(), r);
+  if (r.battery) r.battery->max_soc = std::max({r.battery->initial_soc, r.battery->final_soc, peak_soc});
   return r;
 }
 

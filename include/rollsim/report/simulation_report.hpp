@@ -21,8 +21,12 @@ std::string summary_text(const SimulationResult& r, bool solver_stats);
 /// front end's warning about such a run.
 std::string shortfall_caveat(const TraceFollowing& trace);
 
-/// One line per thing that makes a run's figures differ from the trace's own: the car fell behind it (or, in a
-/// replay, could not deliver it), or the usable battery ran empty; empty when neither. For tables of several runs,
+/// What a run that charged its battery past full booked that a real car could not (no charge limit is modelled),
+/// or empty: the one wording of every front end's warning about such a run.
+std::string overcharge_caveat(const SimulationResult& r);
+
+/// One line per thing that makes a run's figures differ from the trace's own: the battery charged past full, the
+/// car fell behind it (or, in a replay, could not deliver it), or the usable battery ran empty; empty when none. For tables of several runs,
 /// where the summary's own warnings are not printed.
 std::vector<std::string> run_caveats(const SimulationResult& r);
 

@@ -124,6 +124,9 @@ struct BatteryFigures {
   double usable_j = 0.0;     ///< usable capacity
   double initial_soc = 1.0;  ///< fraction of usable capacity
   double final_soc = 1.0;
+  /// The highest state of charge of the run (read at the integrator's steps or the replay's segment ends). Above 1
+  /// the run booked regeneration a full battery could not take (no charge limit is modelled); the report warns.
+  double max_soc = 1.0;
 };
 
 /// What a run burned, when the powertrain has a fuel converter.
@@ -160,7 +163,8 @@ struct SimulationResult {
   double aec_kwh_per_10km() const;
   double fuel_l_per_100km() const;
   double co2_g_per_km() const;
-  /// Distance on the usable battery at this consumption [km] (battery chemical energy, incl. its loss).
+  /// Distance on the usable battery at this consumption [km] (battery chemical energy, incl. its loss); NaN when
+  /// the run did not move or ended with more charge than it began.
   double range_km() const;
   /// The shortfalls summed up: followed when there are none, and the largest deficit among them.
   TraceFollowing trace_following() const;
