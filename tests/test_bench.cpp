@@ -1,6 +1,7 @@
 // Discovery benchmark, CI subset: the null's false-discovery rate, the warm-up's detection, the time-reversed null.
 #include <gtest/gtest.h>
 
+#include "rollsim/common/error.hpp"
 #include "rollsim/discovery/scorecard.hpp"
 
 namespace rollsim {
@@ -59,8 +60,13 @@ TEST(Bench, OnlyKeepsTheRowsAskedFor) {
   BenchOptions o;
   o.seeds = 1;
   o.null_seeds = 1;
+  o.only = {"aux_compressor 150 W"};
+  const auto kept = run_discovery_bench(load_vehicle_file(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/ev.yaml"), o).rows;
+  ASSERT_EQ(kept.size(), 1u);
+  EXPECT_NE(kept[0].label.find("aux_compressor 150 W"), std::string::npos);
+  // Text that matches no row is an error naming the option, not an empty scorecard (outside testing, session 16).
   o.only = {"no row has this label"};
-  EXPECT_TRUE(run_discovery_bench(load_vehicle_file(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/ev.yaml"), o).rows.empty());
+  EXPECT_THROW(run_discovery_bench(load_vehicle_file(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/ev.yaml"), o), InputError);
 }
 
 TEST(Bench, WilsonIntervalBracketsTheRate) {

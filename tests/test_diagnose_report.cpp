@@ -219,7 +219,7 @@ TEST(DiagnoseReport, PageEscapesEveryTextAndDrawsARoadProfileWhereAFindingHasOne
   EXPECT_NE(regimes.find("fuel_rate &amp; \"q\" > 1 % (10)"), std::string::npos);
   // The road profile: its own section and figure, and its SVG file.
   EXPECT_NE(html.find("id=\"road\""), std::string::npos);
-  EXPECT_NE(html.find("id=\"road_profile\""), std::string::npos);
+  EXPECT_NE(html.find("id=\"fig-road_profile\""), std::string::npos);
   EXPECT_TRUE(fs::exists(fs::path(dir) / "road_profile.svg"));
   // Inline SVGs keep their own ids: gnuplot's gpPt0 appears once per figure, prefixed.
   EXPECT_EQ(html.find("id='gpPt0'"), std::string::npos);

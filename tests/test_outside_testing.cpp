@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <regex>
 #include <sstream>
 #include <string>
@@ -408,6 +409,35 @@ TEST_F(OutsideTesting, ABatteryChargedPastFullIsSaid) {
     EXPECT_TRUE(has(j.out, "\"range_km\": null")) << j.out;
     EXPECT_TRUE(std::regex_search(j.out, std::regex(R"("max_soc_pct": 100\.7)"))) << j.out;
   }
+}
+
+// Options that said nothing when they could do nothing: diagnose-bench on a petrol car (every null row a false
+// discovery), --only matching no row (an empty scorecard, exit 0), --engine-start on an electric recording.
+TEST_F(OutsideTesting, OptionsThatCannotApplyAreRefused) {
+  CmdResult r = run_rollsim("diagnose-bench --seeds 1 --null-seeds 2 --vehicle ice");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, "--vehicle 'ice': is not electric")) << r.err;
+  r = run_rollsim("diagnose-bench --seeds 1 --null-seeds 2 --only zzz");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, "--only: matches no row's label")) << r.err;
+  r = run_rollsim("diagnose --vehicle twizy --preset rsk_twizy --recording '" + std::string(ROLLSIM_SHARED_DIR) +
+                  "/data/recordings/rsk_renault_twizy/T1_07_01_2021.csv' --engine-start hot");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, "--engine-start: applies to a combustion engine's start")) << r.err;
+}
+
+// The report's "regimes" heading and figure carried one id: invalid HTML, and #regimes was ambiguous.
+TEST_F(OutsideTesting, TheReportsIdsAreUnique) {
+  const fs::path dir = dir_ / "report";
+  const CmdResult r = run_rollsim("diagnose --vehicle camry_2018 --preset anl_d3 --recording '" + kCamryUdds +
+                                  "' --report '" + dir.string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string html = slurp(dir / "report.html");
+  std::map<std::string, int> seen;
+  const std::regex id(R"#(\sid="([^"]+)")#");
+  for (auto it = std::sregex_iterator(html.begin(), html.end(), id); it != std::sregex_iterator(); ++it) ++seen[(*it)[1].str()];
+  ASSERT_FALSE(seen.empty());
+  for (const auto& [name, count] : seen) EXPECT_EQ(count, 1) << "id \"" << name << "\"";
 }
 
 }  // namespace

@@ -51,6 +51,9 @@ void run_diagnose(const DiagnoseCliOptions& o) {
   DiagnoseOptions dopt;
   if (!o.window_s.empty()) dopt.window_s = window_s_of(o.window_s);
   dopt.infer_road_profile = o.road_profile;
+  if (!o.engine_start.empty() && !v.fuel()) {
+    throw InputError("--engine-start", "applies to a combustion engine's start; '" + o.vehicle + "' burns no fuel");
+  }
   if (o.engine_start.size() > recs.size())
     throw InputError("--engine-start", std::to_string(o.engine_start.size()) + " start states given for " +
                                            std::to_string(recs.size()) + " recordings: give at most one per --recording");

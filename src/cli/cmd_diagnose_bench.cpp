@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "rollsim/common/error.hpp"
 #include "rollsim/common/yaml_reader.hpp"
 #include "rollsim/discovery/scorecard.hpp"
 #include "rollsim/diagnose/diagnose.hpp"
@@ -43,6 +44,11 @@ void register_diagnose_bench_command(CLI::App& app, const ProcessGroup& group) {
       ->type_name("NAME");
   sub->callback([o, &group] {
     const Vehicle v = load_vehicle_file(resolve_data_file(o->vehicle, "vehicles", ".yaml", "--vehicle"));
+    // The rows' concealed effects and their channels (terminal power, SOC) are an electric car's; the fuel-channel
+    // rows bring their own petrol car.
+    if (!v.is_electric()) {
+      throw InputError("--vehicle '" + o->vehicle + "'", "is not electric: the scorecard's rows need an electric car");
+    }
     BenchOptions b = o->bench;
     ColumnMapping mapping = preset_mapping(o->real_trace_preset);
     mapping.how_to_map = "with a --real-trace-preset that names it";

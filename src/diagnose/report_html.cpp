@@ -165,7 +165,7 @@ std::string inline_svg(const HtmlFigure& f) {
 
 void figures(std::ostream& os, const std::vector<HtmlFigure>& figs) {
   for (const auto& f : figs)
-    os << "<figure id=\"" << html_escape(f.id) << "\"><div class=\"scroll\">" << inline_svg(f) << "</div>\n<figcaption>"
+    os << "<figure id=\"fig-" << html_escape(f.id) << "\"><div class=\"scroll\">" << inline_svg(f) << "</div>\n<figcaption>"
        << html_escape(f.caption) << "</figcaption></figure>\n";
 }
 

@@ -227,9 +227,13 @@ std::vector<Case> build_cases(const BenchOptions& o) {
   for (auto& c : cases)  // every multi-trip truth is signed (a colder trip rolls harder)
     if (c.trips && !c.expected.empty()) c.sign = +1;
   if (!o.only.empty()) {
+    std::string labels;  // the first few, to show what a label looks like
+    for (std::size_t k = 0; k < cases.size() && k < 6; ++k) labels += (k ? "; " : "") + cases[k].label;
+    labels += "; ... (" + std::to_string(cases.size()) + " rows)";
     std::erase_if(cases, [&](const Case& c) {
       return std::none_of(o.only.begin(), o.only.end(), [&](const std::string& s) { return c.label.find(s) != std::string::npos; });
     });
+    if (cases.empty()) throw InputError("--only", "matches no row's label; the rows are: " + labels);
   }
   return cases;
 }
