@@ -197,7 +197,7 @@ void register_sweep_command(CLI::App& app, const ProcessGroup& group) {
   sub->add_option("--threads", o->request.threads, "Worker threads for vehicle sweeps (default: every core; under "
                   "mpirun, the node's cores over its ranks)")->type_name("N");
   sub->add_flag("--replay", o->replay, "With --vehicle: kinematic replay of the cycle instead of the forward simulation "
-                "(driver + CVODE); about 10x faster, within 0.05 % of it on the shipped cycles");
+                "(driver + CVODE); about 10x faster, within 0.05 % of it where the car follows the cycle (README)");
   sub->add_option("--output", o->output, "Write the CSV here (atomically) instead of stdout")->type_name("FILE.csv");
   sub->add_option("--plot", o->plot, "Draw RRC against the swept parameter with gnuplot")->type_name("FILE.svg|.png");
   sub->add_flag("--base100", o->base100, "Plot RRC as base 100 at the first point of each line");
