@@ -440,5 +440,19 @@ TEST_F(OutsideTesting, TheReportsIdsAreUnique) {
   for (const auto& [name, count] : seen) EXPECT_EQ(count, 1) << "id \"" << name << "\"";
 }
 
+// A vehicle file whose effects block was spelt "effects :" passed the text check, and the written file then held
+// two effects blocks and did not load; the check also came only after the whole diagnosis.
+TEST_F(OutsideTesting, WriteVehicleRefusesAnEffectsBlockHoweverSpeltAndBeforeDiagnosing) {
+  const std::string car = write("ce.yaml", slurp(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/camry_2018.yaml") +
+                                               "effects :\n  aux_load:\n    power_w: 100\n");
+  const fs::path out = dir_ / "cef.yaml";
+  const CmdResult r = run_rollsim("diagnose --vehicle '" + car + "' --preset anl_d3 --recording '" + kCamryUdds +
+                                  "' --write-vehicle '" + out.string() + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, car + ": already has an effects: block")) << r.err;
+  EXPECT_EQ(r.out, "");  // refused before the diagnosis printed anything
+  EXPECT_FALSE(fs::exists(out));
+}
+
 }  // namespace
 }  // namespace rollsim::test

@@ -42,6 +42,7 @@ void run_diagnose(const DiagnoseCliOptions& o) {
   if (!o.write_vehicle.empty()) check_output_file(o.write_vehicle, "--write-vehicle", inputs);
   // Column mapping: a preset, then the vehicle file's own logger mapping, then the command line's options.
   YamlMap vehicle_file = YamlMap::load_file(vehicle_path);
+  if (!o.write_vehicle.empty()) check_no_effects_block(vehicle_file, vehicle_path);
   ColumnMapping mapping = assemble_mapping(o.preset, vehicle_file, o.columns, o.scales);
   mapping.how_to_map = "with --column CANONICAL=SOURCE";
   std::vector<Recording> recs;

@@ -6,6 +6,7 @@
 
 #include "pipeline.hpp"
 #include "rollsim/common/json.hpp"
+#include "rollsim/common/yaml_reader.hpp"
 #include "rollsim/common/error.hpp"
 
 namespace rollsim {
@@ -190,16 +191,20 @@ std::string diagnosis_text(const Diagnosis& d) {
   return os.str();
 }
 
+void check_no_effects_block(const YamlMap& vehicle_file, const std::string& vehicle_path) {
+  if (vehicle_file.has("effects"))
+    throw InputError(vehicle_path, "already has an effects: block; remove it to write a fitted one (--write-vehicle)");
+}
+
 std::string fitted_vehicle_yaml(const std::string& vehicle_path, const Diagnosis& d) {
   std::ifstream in(vehicle_path);
   if (!in) throw InputError(vehicle_path, "cannot read");
   std::stringstream ss;
   ss << in.rdbuf();
   std::string text = ss.str();
-  // Only files without an effects block are rewritten: merging two blocks would silently drop one.
-  std::istringstream lines(text);
-  for (std::string line; std::getline(lines, line);)
-    if (line.rfind("effects:", 0) == 0) throw InputError(vehicle_path, "already has an effects: block; remove it to write a fitted one");
+  // Only files without an effects block are rewritten: merging two blocks would silently drop one. Asked of the
+  // YAML, not of the text, so that "effects :" or "\"effects\":" is one too.
+  check_no_effects_block(YamlMap::load_text(text, vehicle_path), vehicle_path);
   std::vector<std::pair<std::string, EffectParameters>> eff;
   for (const auto& f : d.findings)
     // unexplained: described, not a module; road_profile: its knots are the diagnosis' output, not parameters

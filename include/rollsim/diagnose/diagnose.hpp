@@ -252,6 +252,9 @@ std::string diagnosis_json(const Diagnosis& d);
 std::string diagnosis_text(const Diagnosis& d);
 
 /// The vehicle file at `vehicle_path` with an `effects:` block holding the findings' fitted effects.
+/// Throws InputError naming the file when the vehicle file already has an effects block (which --write-vehicle
+/// would have to merge with the fitted one); called before the diagnosis, and again when the file is written.
+void check_no_effects_block(const YamlMap& vehicle_file, const std::string& vehicle_path);
 std::string fitted_vehicle_yaml(const std::string& vehicle_path, const Diagnosis& d);
 
 }  // namespace rollsim
