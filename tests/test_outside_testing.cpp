@@ -454,5 +454,46 @@ TEST_F(OutsideTesting, WriteVehicleRefusesAnEffectsBlockHoweverSpeltAndBeforeDia
   EXPECT_FALSE(fs::exists(out));
 }
 
+// Session 16's review of its own mends. Two outputs naming one new file ("./q.svg" and "q.svg") passed the check
+// and one was lost; a shipped cycle given by name, the default cycle and the vehicle's own tyre file were not seen
+// as inputs; compare printed "NaN" for a range; compare and sweep said nothing of a battery charged past full.
+TEST_F(OutsideTesting, TheMendsOwnReviewFindings) {
+  const std::string sweep = "sweep --tyre 175-70R14 --param pressure --from 2 --to 3 --steps 3 ";
+  const fs::path q = dir_ / "q.svg";
+  CmdResult r = run_rollsim(sweep + "--output '" + (dir_ / "." / "q.svg").string() + "' --plot '" + q.string() + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, "is the same file as --output")) << r.err;
+  EXPECT_FALSE(fs::exists(q));
+
+  // A data root of our own, so that a regression cannot overwrite the shipped files.
+  const fs::path root = dir_ / "data";
+  fs::create_directories(root);
+  for (const char* sub : {"cycles", "tyres", "vehicles"})
+    fs::copy(fs::path(ROLLSIM_SOURCE_DIR) / sub, root / sub, fs::copy_options::recursive);
+  const std::string env = "ROLLSIM_DATA_DIR='" + root.string() + "'";
+  for (const std::string& args : {"simulate --vehicle ev --cycle udds --trace '" + (root / "cycles" / "udds.csv").string() + "'",
+                                  "simulate --vehicle ev --trace '" + (root / "cycles" / "nedc.csv").string() + "'",
+                                  "simulate --vehicle ev --trace '" + (root / "tyres" / "nominal.yaml").string() + "'"}) {
+    const std::string before = slurp(args.substr(args.rfind(" '") + 2, args.size() - args.rfind(" '") - 3));
+    r = run_rollsim(args, env);
+    EXPECT_EQ(r.exit_code, 2) << args;
+    EXPECT_TRUE(has(r.err, "is the same file as the input")) << args << "\n" << r.err;
+    EXPECT_EQ(slurp(args.substr(args.rfind(" '") + 2, args.size() - args.rfind(" '") - 3)), before) << args;
+  }
+
+  std::string ev = slurp(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/ev.yaml");
+  ev = std::regex_replace(ev, std::regex(R"(initial_soc_pct: [0-9.]+)"), "initial_soc_pct: 100");
+  const std::string car = write("ev100.yaml", ev);
+  const std::string down = write("down.csv", "time_s,speed_kmh,grade_pct\n0,0,-6\n10,0,-6\n22,50,-6\n590,50,-6\n600,0,-6\n");
+  r = run_rollsim("compare --vehicle '" + car + "' --cycle '" + down + "' --tyre nominal --replay");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_FALSE(has(r.out + r.err, "NaN")) << r.out;
+  EXPECT_TRUE(has(r.out + r.err, "on nominal (own), down: the battery would have charged past full")) << r.out << r.err;
+  r = run_rollsim("sweep --tyre nominal --vehicle '" + car + "' --cycle '" + down +
+                  "' --replay --param pressure --from 2 --to 3 --steps 2");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(has(r.err, "warning: at 2 of 2 points the battery charged past full")) << r.err;
+}
+
 }  // namespace
 }  // namespace rollsim::test

@@ -1,4 +1,5 @@
 // `rollsim compare`: tyre selection for a car: fit checks and a ranking by cycle energy or fuel per cycle.
+#include <cmath>
 #include <algorithm>
 #include <filesystem>
 #include <iostream>
@@ -46,7 +47,7 @@ void print_table(const selection::Comparison& c, bool replay) {
                                    fixed(r.rrc_80 * 1e3, 3), fixed(r.rr_power_80_w, 1),
                                    fixed(r.value, c.shows_range ? 4 : 3),
                                    r.simulated ? signed_fixed(r.diff_pct, 2) : "-"};
-    if (c.shows_range) cells.push_back(r.simulated ? signed_fixed(r.range_change_km, 1) : "-");
+    if (c.shows_range) cells.push_back(r.simulated && std::isfinite(r.range_change_km) ? signed_fixed(r.range_change_km, 1) : "-");
     cells.push_back(r.fit.fits ? "ok (" + signed_fixed(r.fit.diameter_change_pct, 1) + " % dia., load " +
                                      fixed(100.0 * r.fit.wheel_load_n / r.fit.capacity_n, 0) + " %)"
                                : r.fit.reason);
@@ -58,7 +59,9 @@ void print_table(const selection::Comparison& c, bool replay) {
   for (const auto& w : selection::trace_warnings(c)) std::cout << "WARNING: " << w << "\n";
   if (c.shows_range) {
     std::cout << "own tyre: " << fixed(c.own_value, 4) << " " << unit << ", range "
-              << fixed(c.own_range_km, 1) << " km; range column: gained (+) or lost (-) km\n";
+              << (std::isfinite(c.own_range_km) ? fixed(c.own_range_km, 1) + " km" : std::string("none to state (the battery "
+                                                                                                    "ends with more charge)"))
+              << "; range column: gained (+) or lost (-) km\n";
   }
   std::cout << "\n";
 }
@@ -82,8 +85,8 @@ void print_csv(const selection::Comparison& c, bool header) {
               << "," << q(selection::tyre_size_text(r.tyre)) << "," << fixed(units::pa_to_bar(r.tyre.state.pressure_pa), 2)
               << "," << fixed(r.rrc_80, 6) << "," << fixed(r.rr_power_80_w, 2) << ","
               << fixed(r.value, 5) << "," << c.unit << "," << fixed(r.diff_pct, 3) << ","
-              << (c.shows_range ? fixed(r.range_km, 2) : "") << ","
-              << (c.shows_range ? fixed(r.range_change_km, 2) : "") << "," << (r.fit.fits ? "yes" : "no") << ","
+              << (c.shows_range && std::isfinite(r.range_km) ? fixed(r.range_km, 2) : "") << ","
+              << (c.shows_range && std::isfinite(r.range_change_km) ? fixed(r.range_change_km, 2) : "") << "," << (r.fit.fits ? "yes" : "no") << ","
               << q(r.fit.reason) << "," << (r.trace.followed ? "yes" : "no") << ","
               << fixed(units::mps_to_kmh(r.trace.max_deficit_mps), 2) << "\n";
   };

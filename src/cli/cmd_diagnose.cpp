@@ -35,7 +35,8 @@ void run_diagnose(const DiagnoseCliOptions& o) {
   if (!o.tyre.empty()) fit_tyres(v, load_tyre_file(tyre_path));
   // Every destination is checked before the diagnosis, and all are written together after it.
   if (!o.report.empty()) check_report_dir(o.report);
-  std::vector<std::string> inputs{vehicle_path, tyre_path};
+  std::vector<std::string> inputs = vehicle_input_files(v);
+  inputs.push_back(tyre_path);
   inputs.insert(inputs.end(), o.recordings.begin(), o.recordings.end());
   check_outputs_distinct({{o.json, "--json"}, {o.write_vehicle, "--write-vehicle"}});
   if (!o.json.empty()) check_output_file(o.json, "--json", inputs);

@@ -36,17 +36,18 @@ struct Run {
 };
 
 void run_simulate(const SimulateOptions& o) {
-  std::vector<std::string> inputs{resolve_data_file(o.vehicle, "vehicles", ".yaml", "--vehicle")};
-  const Vehicle base = load_vehicle_file(inputs.front());
+  const Vehicle base = load_vehicle_file(resolve_data_file(o.vehicle, "vehicles", ".yaml", "--vehicle"));
+  std::vector<std::string> inputs = vehicle_input_files(base);
   std::vector<std::optional<TyreSpec>> tyre_sets;
   for (const auto& t : o.tyres) {
     inputs.push_back(resolve_data_file(t, "tyres", ".yaml", "--tyre"));
     tyre_sets.emplace_back(load_tyre_file(inputs.back()));
   }
-  inputs.insert(inputs.end(), o.cycles.begin(), o.cycles.end());
+
   if (tyre_sets.empty()) tyre_sets.emplace_back(std::nullopt);
   std::vector<DriveCycle> cycles;
   for (const auto& c : o.cycles.empty() ? std::vector<std::string>{"nedc"} : o.cycles) cycles.push_back(load_cycle(c));
+  for (const auto& c : cycles) inputs.push_back(c.source);
   if (!o.trace_path.empty() && tyre_sets.size() * cycles.size() > 1)
     throw InputError("--trace", "writes the time series of one run; give one --tyre and one --cycle with it");
   if (!o.trace_path.empty()) check_output_file(o.trace_path, "--trace", inputs);

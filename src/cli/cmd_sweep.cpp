@@ -9,6 +9,7 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -130,9 +131,17 @@ void run_sweep(const SweepOptionsText& o, const ProcessGroup& group) {
   selection::SweepOptions so = selection::sweep_options_from_request(o.request);
   so.replay = o.replay;
   so.map_cases = group.mapper();
-  const std::string tyre_path = resolve_data_file(o.tyre, "tyres", ".yaml", "--tyre");
-  const std::string vehicle_path = o.vehicle.empty() ? "" : resolve_data_file(o.vehicle, "vehicles", ".yaml", "--vehicle");
-  const std::vector<std::string> inputs{tyre_path, vehicle_path, cycle};
+  // The inputs are read first (they are small), so that no output can be one of them.
+  const TyreSpec tyre = load_tyre_file(resolve_data_file(o.tyre, "tyres", ".yaml", "--tyre"));
+  std::vector<std::string> inputs{tyre.source};
+  std::optional<Vehicle> vehicle;
+  std::optional<DriveCycle> drive;
+  if (!o.vehicle.empty()) {
+    vehicle = load_vehicle_file(resolve_data_file(o.vehicle, "vehicles", ".yaml", "--vehicle"));
+    drive = load_cycle(cycle, "--cycle");
+    for (const auto& f : vehicle_input_files(*vehicle)) inputs.push_back(f);
+    inputs.push_back(drive->source);
+  }
   // Every destination is checked before the sweep, and all are written after it (nothing is left behind).
   check_outputs_distinct({{o.output, "--output"}, {o.plot, "--plot"}});
   if (!o.output.empty()) check_output_file(o.output, "--output", inputs);
@@ -143,17 +152,10 @@ void run_sweep(const SweepOptionsText& o, const ProcessGroup& group) {
     if (report::find_gnuplot().empty()) throw InputError("--plot " + o.plot, gnuplot_missing);
   }
 
-  const TyreSpec tyre = load_tyre_file(tyre_path);
   Progress progress(!o.json);
   so.progress = [&progress](std::size_t d, std::size_t t) { progress(d, t); };
-  selection::SweepResult r;
-  if (!o.vehicle.empty()) {
-    const Vehicle v = load_vehicle_file(vehicle_path);
-    const DriveCycle c = load_cycle(cycle, "--cycle");
-    r = selection::sweep_vehicle(v, tyre, c, so);
-  } else {
-    r = selection::sweep_tyre(tyre, so);
-  }
+  const selection::SweepResult r =
+      vehicle ? selection::sweep_vehicle(*vehicle, tyre, *drive, so) : selection::sweep_tyre(tyre, so);
 
   std::string table;
   if (o.json) {

@@ -2,6 +2,13 @@
 
 namespace rollsim::cli {
 
+std::vector<std::string> vehicle_input_files(const Vehicle& vehicle) {
+  std::vector<std::string> files{vehicle.source};
+  for (const auto* t : {&vehicle.front_tyre, &vehicle.rear_tyre})
+    if (*t) files.push_back((*t)->source);
+  return files;
+}
+
 void register_commands(CLI::App& app, const ProcessGroup& group) {
   register_tyre_command(app);
   register_diagnose_command(app, group);

@@ -3,7 +3,11 @@
 
 #include <CLI/CLI.hpp>
 
+#include <string>
+#include <vector>
+
 #include "rollsim/common/distribute.hpp"
+#include "rollsim/vehicle/vehicle.hpp"
 
 namespace rollsim::cli {
 
@@ -19,5 +23,8 @@ void register_sweep_command(CLI::App& app, const ProcessGroup& group);
 void register_sensitivity_command(CLI::App& app);
 void register_regress_command(CLI::App& app);
 void register_validate_command(CLI::App& app, const ProcessGroup& group);
+
+/// The files a vehicle was read from (its file and its tyres' files), for an output's check that it is no input.
+std::vector<std::string> vehicle_input_files(const Vehicle& vehicle);
 
 }  // namespace rollsim::cli

@@ -27,39 +27,45 @@ bool writable_dir(const fs::path& dir) {
   return fs::is_directory(dir, ec) && ::access(dir.c_str(), W_OK | X_OK) == 0;
 }
 
-// Where an output's content lands. A symlink is followed: its target is replaced and the link stays a link. A
-// device, pipe or socket, and anything under /dev or /proc (/dev/stdout, /proc/self/fd/1), is written in place
-// (appended), since a rename would replace the node itself with a plain file.
+// Where an output's content lands. A symlink is followed (through a chain, to a file that may not exist yet): its
+// target is replaced and the link stays a link. A device, pipe or socket, and a descriptor's alias (/dev/stdout,
+// /dev/fd/N, /proc/self/fd/N), is written in place (appended), since a rename would replace the node itself with a
+// plain file; a regular file elsewhere under /dev or /proc (/dev/shm) is replaced like any other.
 struct Destination {
   fs::path path;
   bool in_place = false;
 };
 
+bool descriptor_alias(const fs::path& p) {
+  std::error_code ec;
+  const std::string a = fs::absolute(p, ec).lexically_normal().string();
+  if (a == "/dev/stdout" || a == "/dev/stderr" || a.rfind("/dev/fd/", 0) == 0) return true;
+  return a.rfind("/proc/", 0) == 0 && a.find("/fd/") != std::string::npos;
+}
+
 Destination destination_of(const std::string& path) {
   std::error_code ec;
   const fs::file_status target = fs::status(path, ec);  // follows symlinks
   if (fs::exists(target) && !fs::is_regular_file(target)) return {path, true};
-  const auto system_node = [](const fs::path& p) {
-    std::error_code e;
-    const std::string a = fs::absolute(p, e).lexically_normal().string();
-    return a.rfind("/dev/", 0) == 0 || a.rfind("/proc/", 0) == 0;
-  };
-  if (system_node(path)) return {path, true};
-  if (!fs::is_symlink(fs::symlink_status(path, ec))) return {path, false};
-  if (const fs::path named = fs::read_symlink(path, ec); !ec && named.is_absolute() && system_node(named)) return {path, true};
-  if (const fs::path resolved = fs::canonical(path, ec); !ec) return {resolved, false};
-  const fs::path named = fs::read_symlink(path, ec);  // a dangling link: create the file it names
-  if (ec) return {path, false};
-  return {named.is_absolute() ? named : folder_of(path) / named, false};
+  fs::path p = path;
+  for (int hop = 0; hop < 40; ++hop) {  // a symlink chain, as the system follows one
+    if (descriptor_alias(p)) return {path, true};
+    if (!fs::is_symlink(fs::symlink_status(p, ec))) return {p, false};
+    const fs::path named = fs::read_symlink(p, ec);
+    if (ec) return {p, false};
+    p = named.is_absolute() ? named : folder_of(p.string()) / named;
+  }
+  return {p, false};
 }
 
-// One file under two names (either may not exist yet).
+// One file under two names (either may not exist yet): both made absolute first, since weakly_canonical leaves a
+// path relative when none of it exists.
 bool same_file(const fs::path& a, const fs::path& b) {
   std::error_code ec;
   if (fs::equivalent(a, b, ec)) return true;
-  const fs::path ca = fs::weakly_canonical(a, ec);
+  const fs::path ca = fs::weakly_canonical(fs::absolute(a, ec), ec);
   if (ec) return false;
-  const fs::path cb = fs::weakly_canonical(b, ec);
+  const fs::path cb = fs::weakly_canonical(fs::absolute(b, ec), ec);
   return !ec && ca == cb;
 }
 

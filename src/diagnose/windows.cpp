@@ -9,6 +9,8 @@ namespace rollsim::diag {
 namespace {
 
 constexpr double kMinDiagnosedDistance_m = 100.0;
+// One whole percent of a small pack (the Twizy's 6.1 kWh: 61 Wh) lasts under a kilometre; 5 km is several.
+constexpr double kMinStuckSocDistance_m = 5000.0;
 
 // Median of the non-zero steps of a quantised signal (its quantum), 0 if it never changes.
 double quantum_of(const std::vector<double>& x) {
@@ -85,7 +87,9 @@ void check_informative(const Recording& r, const std::vector<double>& measured_w
   }
   const std::vector<double>& x = kind == ChannelKind::soc ? *r.soc_fraction : measured_w;
   const auto [lo, hi] = std::minmax_element(x.begin(), x.end());
-  if (*lo == *hi) {
+  // A coarse SOC (whole percent) may hold still over a short trip; over kMinStuckSocDistance_m it is stuck.
+  const bool long_enough = kind != ChannelKind::soc || distance_m >= kMinStuckSocDistance_m;
+  if (*lo == *hi && long_enough) {
     const double shown = kind == ChannelKind::soc ? 100.0 * *lo : *lo;
     throw InputError(r.source, "its " + to_string(kind) + " channel never changes (" + significant(shown, 6) +
                                    (kind == ChannelKind::soc ? " %" : " W") + " throughout) while the car covers " +

@@ -2,6 +2,7 @@
 #include "rollsim/selection/common.hpp"
 
 #include "rollsim/common/error.hpp"
+#include "rollsim/report/simulation_report.hpp"
 
 namespace rollsim::selection {
 
@@ -22,6 +23,7 @@ EnergyFigure energy_figure(const SimulationResult& r) {
     f.range_km = r.range_km();
   }
   f.trace = r.trace_following();
+  f.overcharge = report::overcharge_caveat(r);
   return f;
 }
 

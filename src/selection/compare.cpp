@@ -69,6 +69,7 @@ std::string simulate_candidate(const Vehicle& vehicle, const VehicleModel& base,
     c.value = e.value;
     c.range_km = e.range_km;
     c.trace = e.trace;
+    c.overcharge = e.overcharge;
     c.simulated = true;
   } catch (const std::exception& e) {
     // An overloaded tyre may have no solution at all; it is reported, not ranked.
@@ -80,6 +81,7 @@ std::string simulate_candidate(const Vehicle& vehicle, const VehicleModel& base,
   for (double x : {c.rrc_80, c.rr_power_80_w, c.value, c.range_km}) put(bytes, x);
   put(bytes, c.simulated);
   put(bytes, c.trace);
+  put(bytes, c.overcharge);
   put(bytes, c.error);
   return bytes;
 }
@@ -92,6 +94,7 @@ CandidateResult evaluated(const Vehicle& vehicle, const TyreSpec& own, const Tyr
   for (double* x : {&c.rrc_80, &c.rr_power_80_w, &c.value, &c.range_km}) take(in, *x);
   take(in, c.simulated);
   take(in, c.trace);
+  take(in, c.overcharge);
   take(in, c.error);
   return c;
 }

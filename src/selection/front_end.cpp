@@ -82,9 +82,10 @@ std::vector<JsonObject> comparison_json(const Comparison& c) {
 std::vector<std::string> trace_warnings(const Comparison& c) {
   std::vector<std::string> out;
   auto check = [&](const CandidateResult& r) {
-    if (!r.simulated || r.trace.followed) return;
-    out.push_back("on " + r.tyre.name + (r.is_own ? " (own)" : "") + ", " + c.cycle + ": " +
-                  report::shortfall_caveat(r.trace));
+    if (!r.simulated) return;
+    const std::string on = "on " + r.tyre.name + (r.is_own ? " (own)" : "") + ", " + c.cycle + ": ";
+    if (!r.overcharge.empty()) out.push_back(on + r.overcharge);
+    if (!r.trace.followed) out.push_back(on + report::shortfall_caveat(r.trace));
   };
   for (const auto& r : c.ranked) check(r);
   for (const auto& r : c.unfit) check(r);

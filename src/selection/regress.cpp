@@ -93,13 +93,16 @@ namespace {
 // A name or path as YAML reads it back: plain where that is unambiguous, else a double-quoted scalar (JSON's
 // escapes are YAML's), so that "ev nedc #1" keeps its "#1" and "ratio: 2" stays one string.
 std::string yaml_scalar(const std::string& text) {
-  static const std::regex plain(R"([A-Za-z0-9_][A-Za-z0-9_./+-]*)");
+  // Starting with a letter: a leading digit can make a date, an octal or 1_000 a number to other YAML readers.
+  static const std::regex plain(R"([A-Za-z_][A-Za-z0-9_./+-]*)");
   static const std::regex special(R"((?:true|false|yes|no|on|off|null|y|n))", std::regex::icase);
   char* end = nullptr;
   std::strtod(text.c_str(), &end);
   const bool number = !text.empty() && end == text.c_str() + text.size();
   if (std::regex_match(text, plain) && !std::regex_match(text, special) && !number) return text;
-  return json_string(text);
+  std::string quoted = json_string(text);
+  for (auto at = quoted.find('\x7f'); at != std::string::npos; at = quoted.find('\x7f', at)) quoted.replace(at, 1, "\\x7f");
+  return quoted;
 }
 
 }  // namespace

@@ -285,6 +285,7 @@ SweepResult sweep_vehicle(const Vehicle& vehicle, const TyreSpec& tyre, const Dr
       const EnergyFigure e = run_model(VehicleModel::with_tyres_of(base, v), cycle, o.replay);
       p.energy = e.value;
       p.trace = e.trace;
+      p.overcharge = e.overcharge;
     } catch (const std::exception& e) {
       error = e.what();
     }
@@ -292,6 +293,7 @@ SweepResult sweep_vehicle(const Vehicle& vehicle, const TyreSpec& tyre, const Dr
     put(bytes, p.rr);
     put(bytes, p.energy);
     put(bytes, p.trace);
+    put(bytes, p.overcharge);
     put(bytes, error);
     return bytes;
   };
@@ -304,6 +306,7 @@ SweepResult sweep_vehicle(const Vehicle& vehicle, const TyreSpec& tyre, const Dr
     take(in, p.rr);
     take(in, p.energy);
     take(in, p.trace);
+    take(in, p.overcharge);
     take(in, error);
     if (!error.empty()) {
       r.stopped = stop_message(o.axes, pts[i], error, r.points);
@@ -344,6 +347,16 @@ std::vector<std::string> sweep_warnings(const SweepResult& r) {
     out.push_back("at " + std::to_string(over) + " of " + std::to_string(r.points.size()) + " points the load (up to " +
                   fixed(heaviest_n, 0) + " N) is above the tyre's rated maximum " + fixed(r.max_load_n, 0) +
                   " N; results there are outside the tyre's rating");
+  }
+  std::size_t overcharged = 0;
+  std::string first_overcharge;
+  for (const auto& p : r.points) {
+    if (p.overcharge.empty()) continue;
+    if (overcharged++ == 0) first_overcharge = p.overcharge;
+  }
+  if (overcharged > 0) {
+    out.push_back("at " + std::to_string(overcharged) + " of " + std::to_string(r.points.size()) +
+                  " points the battery charged past full; at the first: " + first_overcharge);
   }
   std::size_t behind = 0;
   TraceFollowing worst;

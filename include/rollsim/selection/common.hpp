@@ -17,6 +17,8 @@ struct EnergyFigure {
   /// Not followed: the figure is for a slower drive than the cycle's (or, in replay, leaves out the demand the
   /// powertrain could not meet), and figures of runs that differ in this do not compare.
   TraceFollowing trace;
+  /// The battery charged past full (report::overcharge_caveat), or empty: the figure is then too low.
+  std::string overcharge;
 };
 
 /// "l_per_100km" for a car whose powertrain burns fuel, "kwh_per_10km" otherwise.

@@ -45,6 +45,7 @@ struct CandidateResult {
   double range_km = 0.0;          ///< battery-only cars
   double range_change_km = 0.0;   ///< battery-only cars, + = gains range
   TraceFollowing trace;           ///< whether the car kept to the cycle on this tyre (EnergyFigure)
+  std::string overcharge;         ///< the battery charged past full on this tyre (EnergyFigure), or empty
 };
 
 /// One vehicle on one cycle: the fitting tyres ranked best first, then the unfit ones (unranked, same order as given).

@@ -61,6 +61,7 @@ struct SweepPoint {
   RollingResistance rr;                ///< the tyre at (load, speed)
   double energy = 0.0;                 ///< vehicle sweeps: kWh/10 km or l/100 km
   TraceFollowing trace;                ///< vehicle sweeps: whether the car kept to the cycle (EnergyFigure)
+  std::string overcharge;              ///< vehicle sweeps: the battery charged past full (EnergyFigure), or empty
 };
 
 struct SweepResult {
@@ -75,8 +76,8 @@ struct SweepResult {
 };
 
 /// The sweep's warnings, each one line without a "warning:" prefix: points above the tyre's rated load, and
-/// (vehicle sweeps) how many points could not follow the cycle and what their figures measured instead
-/// (report::shortfall_caveat).
+/// (vehicle sweeps) points whose battery charged past full, and how many points could not follow the cycle and
+/// what their figures measured instead (report::shortfall_caveat).
 std::vector<std::string> sweep_warnings(const SweepResult& result);
 
 /// The tyre with one parameter set (user units); load/speed parameters leave the tyre unchanged.
