@@ -39,6 +39,15 @@ std::string camry_edited(Edit edit) {
   return out.str();
 }
 
+// A shipped vehicle file's text with `from` replaced by `to` (`from` must be in it).
+std::string shipped_vehicle_with(const std::string& name, const std::string& from, const std::string& to) {
+  std::string text = slurp(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/" + name);
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << name << ": " << from;
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  return text;
+}
+
 std::string line_starting(const std::string& text, const std::string& head) {
   std::istringstream in(text);
   for (std::string l; std::getline(in, l);)
@@ -47,6 +56,13 @@ std::string line_starting(const std::string& text, const std::string& head) {
 }
 
 class OutsideTesting : public FileFixture {};
+
+// `rollsim args` is refused as bad input (exit 2) with `message` in its error.
+void expect_refused(const std::string& args, const std::string& message) {
+  const CmdResult r = run_rollsim(args);
+  EXPECT_EQ(r.exit_code, 2) << args;
+  EXPECT_TRUE(has(r.err, message)) << args << "\n" << r.err;
+}
 
 // A fuel channel logged as zero throughout read as the model being 10^18 % off, and wrote inf into the JSON.
 TEST_F(OutsideTesting, ADeadEnergyChannelIsRefusedNotScored) {
@@ -159,16 +175,13 @@ TEST_F(OutsideTesting, TyreFitChecksItsOutputFirstAndMakesNoFolders) {
 // Options ignored without a word, fractions taken as counts, NaN taken as the default, parse errors with CLI11's
 // own exit codes (105-109) where every other bad input exits 2.
 TEST_F(OutsideTesting, OptionsAreCheckedWholly) {
-  CmdResult r = run_rollsim("tyre fit --evaluate-j2452 ../shared/data/tyres/j2452_michelin_part.csv --label B");
-  EXPECT_EQ(r.exit_code, 2);
-  EXPECT_TRUE(has(r.err, "--label: not allowed with --evaluate-j2452")) << r.err;
-  r = run_rollsim("validate --epa-test-car-list ../shared/data/vehicles/epa_test_car_list_2022_part.csv --threads 2.5");
-  EXPECT_EQ(r.exit_code, 2);
-  EXPECT_TRUE(has(r.err, "--threads: '2.5' is not a whole number")) << r.err;
-  r = run_rollsim("diagnose --vehicle camry_2018 --preset anl_d3 --recording '" + kCamryUdds + "' --window-s nan");
-  EXPECT_EQ(r.exit_code, 2);
-  EXPECT_TRUE(has(r.err, "--window-s: NaN is not allowed")) << r.err;
-  r = run_rollsim("simulate --vehicle ev --bogus");
+  expect_refused("tyre fit --evaluate-j2452 ../shared/data/tyres/j2452_michelin_part.csv --label B",
+                 "--label: not allowed with --evaluate-j2452");
+  expect_refused("validate --epa-test-car-list ../shared/data/vehicles/epa_test_car_list_2022_part.csv --threads 2.5",
+                 "--threads: '2.5' is not a whole number");
+  expect_refused("diagnose --vehicle camry_2018 --preset anl_d3 --recording '" + kCamryUdds + "' --window-s nan",
+                 "--window-s: NaN is not allowed");
+  const CmdResult r = run_rollsim("simulate --vehicle ev --bogus");
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_EQ(run_rollsim("simulate --help").exit_code, 0);
 }
@@ -249,11 +262,8 @@ TEST_F(OutsideTesting, ACsvColumnGivenTwiceIsRefusedEverywhere) {
 // A battery that cannot carry even the auxiliaries and the machine's no-load loss: simulate fell behind without
 // a word, and the replay stopped with a message naming no file or key.
 TEST_F(OutsideTesting, ABatteryThatCannotCarryTheNoLoadDrawIsNamedAtLoad) {
-  std::string ev = slurp(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/ev.yaml");
-  const std::string key = "internal_resistance_ohm: 0.10";
-  ASSERT_NE(ev.find(key), std::string::npos);
-  ev.replace(ev.find(key), key.size(), "internal_resistance_ohm: 10");
-  const std::string file = write("ev_r10.yaml", ev);
+  const std::string file =
+      write("ev_r10.yaml", shipped_vehicle_with("ev.yaml", "internal_resistance_ohm: 0.10", "internal_resistance_ohm: 10"));
   const CmdResult r = run_rollsim("simulate --vehicle '" + file + "' --replay");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_TRUE(has(r.err, file + ": key 'powertrain.battery.internal_resistance_ohm': 10 ohm is not allowed")) << r.err;
@@ -262,11 +272,8 @@ TEST_F(OutsideTesting, ABatteryThatCannotCarryTheNoLoadDrawIsNamedAtLoad) {
 // A car with different front and rear tyres: compare's "own" row was the front tyre on all four wheels, not the
 // car as built (1.6470 against simulate's 1.6514 kWh/10 km), and sensitivity took the front tyre alone.
 TEST_F(OutsideTesting, SelectionRefusesACarWithTwoTyreSetsItWouldMisrepresent) {
-  std::string ev = slurp(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/ev.yaml");
-  const std::string all = "  all: nominal.yaml";
-  ASSERT_NE(ev.find(all), std::string::npos);
-  ev.replace(ev.find(all), all.size(), "  front: nominal.yaml\n  rear: 175-70R14.yaml\n ");
-  const std::string mixed = write("mixed.yaml", ev);
+  const std::string mixed = write("mixed.yaml", shipped_vehicle_with("ev.yaml", "  all: nominal.yaml",
+                                                                     "  front: nominal.yaml\n  rear: 175-70R14.yaml\n "));
   ASSERT_EQ(run_rollsim("simulate --vehicle '" + mixed + "'").exit_code, 0);
   CmdResult r = run_rollsim("compare --vehicle '" + mixed + "' --tyre 175-70R14");
   EXPECT_EQ(r.exit_code, 2) << r.out;
@@ -395,8 +402,7 @@ TEST_F(OutsideTesting, ADriftExitsOneAndBadInputTwo) {
 // Downhill from a full battery the state of charge rose past 100 % without a word, and the range read 0 km. No
 // charge limit is modelled; the run says what it booked that a full battery could not take.
 TEST_F(OutsideTesting, ABatteryChargedPastFullIsSaid) {
-  std::string ev = slurp(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/ev.yaml");
-  ev = std::regex_replace(ev, std::regex(R"(initial_soc_pct: [0-9.]+)"), "initial_soc_pct: 100");
+  const std::string ev = shipped_vehicle_with("ev.yaml", "initial_soc_pct: 95", "initial_soc_pct: 100");
   const std::string car = write("ev_full.yaml", ev);
   const std::string down = write("down5.csv", "time_s,speed_kmh,grade_pct\n0,0,-5\n10,0,-5\n22,60,-5\n622,60,-5\n"
                                               "634,0,-5\n644,0,-5\n");
@@ -414,16 +420,11 @@ TEST_F(OutsideTesting, ABatteryChargedPastFullIsSaid) {
 // Options that said nothing when they could do nothing: diagnose-bench on a petrol car (every null row a false
 // discovery), --only matching no row (an empty scorecard, exit 0), --engine-start on an electric recording.
 TEST_F(OutsideTesting, OptionsThatCannotApplyAreRefused) {
-  CmdResult r = run_rollsim("diagnose-bench --seeds 1 --null-seeds 2 --vehicle ice");
-  EXPECT_EQ(r.exit_code, 2);
-  EXPECT_TRUE(has(r.err, "--vehicle 'ice': is not electric")) << r.err;
-  r = run_rollsim("diagnose-bench --seeds 1 --null-seeds 2 --only zzz");
-  EXPECT_EQ(r.exit_code, 2);
-  EXPECT_TRUE(has(r.err, "--only: matches no row's label")) << r.err;
-  r = run_rollsim("diagnose --vehicle twizy --preset rsk_twizy --recording '" + std::string(ROLLSIM_SHARED_DIR) +
-                  "/data/recordings/rsk_renault_twizy/T1_07_01_2021.csv' --engine-start hot");
-  EXPECT_EQ(r.exit_code, 2);
-  EXPECT_TRUE(has(r.err, "--engine-start: applies to a combustion engine's start")) << r.err;
+  expect_refused("diagnose-bench --seeds 1 --null-seeds 2 --vehicle ice", "--vehicle 'ice': is not electric");
+  expect_refused("diagnose-bench --seeds 1 --null-seeds 2 --only zzz", "--only: matches no row's label");
+  expect_refused("diagnose --vehicle twizy --preset rsk_twizy --recording '" + std::string(ROLLSIM_SHARED_DIR) +
+                     "/data/recordings/rsk_renault_twizy/T1_07_01_2021.csv' --engine-start hot",
+                 "--engine-start: applies to a combustion engine's start");
 }
 
 // The report's "regimes" heading and figure carried one id: invalid HTML, and #regimes was ambiguous.
@@ -481,8 +482,7 @@ TEST_F(OutsideTesting, TheMendsOwnReviewFindings) {
     EXPECT_EQ(slurp(args.substr(args.rfind(" '") + 2, args.size() - args.rfind(" '") - 3)), before) << args;
   }
 
-  std::string ev = slurp(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/ev.yaml");
-  ev = std::regex_replace(ev, std::regex(R"(initial_soc_pct: [0-9.]+)"), "initial_soc_pct: 100");
+  const std::string ev = shipped_vehicle_with("ev.yaml", "initial_soc_pct: 95", "initial_soc_pct: 100");
   const std::string car = write("ev100.yaml", ev);
   const std::string down = write("down.csv", "time_s,speed_kmh,grade_pct\n0,0,-6\n10,0,-6\n22,50,-6\n590,50,-6\n600,0,-6\n");
   r = run_rollsim("compare --vehicle '" + car + "' --cycle '" + down + "' --tyre nominal --replay");

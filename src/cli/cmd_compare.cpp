@@ -9,6 +9,7 @@
 
 #include "commands.hpp"
 #include "rollsim/common/units.hpp"
+#include "rollsim/report/simulation_report.hpp"
 #include "rollsim/report/table.hpp"
 #include "rollsim/selection/common.hpp"
 #include "rollsim/selection/compare.hpp"
@@ -59,8 +60,7 @@ void print_table(const selection::Comparison& c, bool replay) {
   for (const auto& w : selection::trace_warnings(c)) std::cout << "WARNING: " << w << "\n";
   if (c.shows_range) {
     std::cout << "own tyre: " << fixed(c.own_value, 4) << " " << unit << ", range "
-              << (std::isfinite(c.own_range_km) ? fixed(c.own_range_km, 1) + " km" : std::string("none to state (the battery "
-                                                                                                    "ends with more charge)"))
+              << report::range_text(c.own_range_km, 1)
               << "; range column: gained (+) or lost (-) km\n";
   }
   std::cout << "\n";

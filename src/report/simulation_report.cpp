@@ -42,6 +42,10 @@ std::vector<std::pair<std::string, double>> energy_terms_kwh(const SimulationRes
 double headline_value(const SimulationResult& r) { return r.fuel ? r.fuel_l_per_100km() : r.aec_kwh_per_10km(); }
 std::string headline_unit(const SimulationResult& r) { return r.fuel ? "l/100 km" : "kWh/10 km"; }
 
+std::string range_text(double range_km, int decimals) {
+  return std::isfinite(range_km) ? fixed(range_km, decimals) + " km" : "none to state (the battery ends with more charge)";
+}
+
 std::string overcharge_caveat(const SimulationResult& r) {
   if (!r.battery || !(r.battery->max_soc > 1.0 + 1e-9)) return {};
   return "the battery would have charged past full (state of charge up to " + fixed(r.battery->max_soc * 100.0, 1) +
@@ -65,7 +69,7 @@ std::string summary_text(const SimulationResult& r, bool solver_stats) {
     o << "  energy at the battery terminals: " << fixed(r.aec_kwh_per_10km(), 3) << " kWh/10 km = "
       << fixed(r.aec_kwh_per_10km() * 10.0, 2) << " kWh/100 km = " << fixed(r.aec_kwh_per_10km() * 100.0, 1) << " Wh/km\n";
     o << "  range on the usable battery (" << fixed(units::j_to_kwh(r.battery->usable_j), 1) << " kWh): "
-      << (std::isfinite(r.range_km()) ? fixed(r.range_km(), 0) + " km" : "none to state (the battery ends with more charge)");
+      << range_text(r.range_km(), 0);
     if (!r.battery_empty) {
       o << "; state of charge " << fixed(r.battery->initial_soc * 100, 1) << " % -> " << fixed(r.battery->final_soc * 100, 1) << " %";
     }

@@ -336,39 +336,30 @@ std::vector<std::pair<std::string, double>> sweep_point_columns(const SweepResul
 }
 
 std::vector<std::string> sweep_warnings(const SweepResult& r) {
-  std::vector<std::string> out;
-  std::size_t over = 0;
+  std::size_t over = 0, overcharged = 0, behind = 0;
   double heaviest_n = 0.0;
+  std::string first_overcharge;
+  TraceFollowing worst;
   for (const auto& p : r.points) {
     over += r.max_load_n > 0.0 && p.load_n > r.max_load_n ? 1 : 0;
     heaviest_n = std::max(heaviest_n, p.load_n);
-  }
-  if (over > 0) {
-    out.push_back("at " + std::to_string(over) + " of " + std::to_string(r.points.size()) + " points the load (up to " +
-                  fixed(heaviest_n, 0) + " N) is above the tyre's rated maximum " + fixed(r.max_load_n, 0) +
-                  " N; results there are outside the tyre's rating");
-  }
-  std::size_t overcharged = 0;
-  std::string first_overcharge;
-  for (const auto& p : r.points) {
-    if (p.overcharge.empty()) continue;
-    if (overcharged++ == 0) first_overcharge = p.overcharge;
-  }
-  if (overcharged > 0) {
-    out.push_back("at " + std::to_string(overcharged) + " of " + std::to_string(r.points.size()) +
-                  " points the battery charged past full; at the first: " + first_overcharge);
-  }
-  std::size_t behind = 0;
-  TraceFollowing worst;
-  for (const auto& p : r.points) {
+    if (!p.overcharge.empty() && overcharged++ == 0) first_overcharge = p.overcharge;
     behind += p.trace.followed ? 0 : 1;
     worst.followed = worst.followed && p.trace.followed;
     worst.max_deficit_mps = std::max(worst.max_deficit_mps, p.trace.max_deficit_mps);
   }
-  if (behind > 0) {
-    out.push_back("at " + std::to_string(behind) + " of " + std::to_string(r.points.size()) +
-                  " points (followed_trace no): " + report::shortfall_caveat(worst));
+  const std::string of = " of " + std::to_string(r.points.size()) + " points ";
+  std::vector<std::string> out;
+  if (over > 0) {
+    out.push_back("at " + std::to_string(over) + of + "the load (up to " + fixed(heaviest_n, 0) +
+                  " N) is above the tyre's rated maximum " + fixed(r.max_load_n, 0) +
+                  " N; results there are outside the tyre's rating");
   }
+  if (overcharged > 0) {
+    out.push_back("at " + std::to_string(overcharged) + of + "the battery charged past full; at the first: " +
+                  first_overcharge);
+  }
+  if (behind > 0) out.push_back("at " + std::to_string(behind) + of + "(followed_trace no): " + report::shortfall_caveat(worst));
   return out;
 }
 

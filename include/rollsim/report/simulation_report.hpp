@@ -21,6 +21,10 @@ std::string summary_text(const SimulationResult& r, bool solver_stats);
 /// front end's warning about such a run.
 std::string shortfall_caveat(const TraceFollowing& trace);
 
+/// A range for a table: "N km" to `decimals`, or what to say when it is undefined (NaN: the battery ends with more
+/// charge than it began, or the car did not move).
+std::string range_text(double range_km, int decimals);
+
 /// What a run that charged its battery past full booked that a real car could not (no charge limit is modelled),
 /// or empty: the one wording of every front end's warning about such a run.
 std::string overcharge_caveat(const SimulationResult& r);
