@@ -427,6 +427,18 @@ TEST_F(OutsideTesting, OptionsThatCannotApplyAreRefused) {
                  "--engine-start: applies to a combustion engine's start");
 }
 
+// An option left without its value took the next option as its value: `tyre fit --label --output x.yaml` read
+// "--output" as the label class and then blamed x.yaml as an unexpected argument.
+TEST_F(OutsideTesting, AnOptionIsNeverTakenAsAnothersValue) {
+  const fs::path out = dir_ / "x.yaml";
+  expect_refused("tyre fit --size '205/55 R16 91V' --label --output '" + out.string() + "'",
+                 "--label: needs a value here, and '--output' is an option, not a value");
+  EXPECT_FALSE(fs::exists(out));
+  expect_refused("simulate --vehicle --tyre nominal", "--vehicle: needs a value here, and '--tyre' is an option");
+  const CmdResult ok = run_rollsim("tyre fit --size '205/55 R16 91V' --label C --output '" + out.string() + "'");
+  EXPECT_EQ(ok.exit_code, 0) << ok.err;
+}
+
 // The report's "regimes" heading and figure carried one id: invalid HTML, and #regimes was ambiguous.
 TEST_F(OutsideTesting, TheReportsIdsAreUnique) {
   const fs::path dir = dir_ / "report";

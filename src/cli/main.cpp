@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <iostream>
 #include <optional>
+#include <set>
 #include <string>
 
 #include "commands.hpp"
@@ -19,6 +20,23 @@ int report(const rollsim::ProcessGroup& group, const std::exception& e, bool sam
   if (group.is_root()) std::cerr << "error: " << e.what() << "\n";
   else if (!same_on_every_rank) std::fprintf(stderr, "error (rank %d): %s\n", group.rank(), e.what());
   return code;
+}
+
+// CLI11 2.1 takes the next word as an option's value even when it is another option ("--label --output x.yaml"
+// read "--output" as the label and then blamed x.yaml): an option's own command's option names are refused as values.
+void refuse_option_names_as_values(CLI::App& app) {
+  std::set<std::string> names;
+  for (const CLI::Option* opt : app.get_options())
+    for (const std::string& n : opt->get_lnames()) names.insert("--" + n);
+  for (CLI::Option* opt : app.get_options()) {
+    if (opt->get_type_size_max() == 0) continue;  // a flag takes no value
+    opt->check(CLI::Validator(
+        [names](std::string& value) {
+          return names.count(value) ? "needs a value here, and '" + value + "' is an option, not a value" : std::string();
+        },
+        "", "not an option name"));
+  }
+  for (CLI::App* sub : app.get_subcommands({})) refuse_option_names_as_values(*sub);
 }
 
 }  // namespace
@@ -40,6 +58,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_version_flag("--version", "rollsim 0.1.0");
   rollsim::cli::register_commands(app, group);
+  refuse_option_names_as_values(app);
   // CLI11 answers an unknown first word with "A subcommand is required"; name it and the known ones instead.
   if (argc > 1 && argv[1][0] != '-') {
     std::string known;
