@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 #include "rollsim/common/units.hpp"
 #include "rollsim/diagnose/diagnose.hpp"
@@ -51,32 +52,39 @@ TEST(WindHeading, HeadwindIsTheWindsComponentAgainstTheHeading) {
 }
 
 TEST(WindHeading, SteadyWindOnAWindingRouteIsNamedWithItsBearing) {
+  // Over 20 seeds, since a 95 % interval judged on one seed says little either way. Every seed must name the wind
+  // and its bearing; the interval must be closed, narrower than the half circle and hold the truth on most seeds.
+  // Measured: it holds it on 16 of these 20 (22 of seeds 1-30), short of the nominal 95 %: the README says so.
   const Vehicle v = ev();
-  SyntheticCase c;
-  c.gps = true;
-  c.effects = {{"wind_steady_gps", 4.0}};
-  c.wind_from_deg = 250.0;
-  c.seed = 5;
-  const Diagnosis d = diagnose(v, {generate_case(v, c)});
-  ASSERT_FALSE(d.findings.empty());
-  const Finding& f = d.findings.front();
-  ASSERT_EQ(f.effect, "wind_heading");
-  const double from = f.fitted.at("wind_from_deg");
-  EXPECT_LE(std::min(std::abs(from - 250.0), 360.0 - std::abs(from - 250.0)), 45.0) << from;
-  EXPECT_NEAR(f.fitted.at("wind_speed_mps"), 4.0, 1.5);
-  EXPECT_NE(f.description.find("from"), std::string::npos);
-  // The bearing's profile interval: closed, narrower than the half circle, holding the truth (unwrapped ends).
-  const auto p = std::find_if(f.parameters.begin(), f.parameters.end(), [](const auto& e) { return e.name == "wind_from_deg"; });
-  ASSERT_NE(p, f.parameters.end());
-  EXPECT_TRUE(p->profiled);
-  EXPECT_FALSE(p->ci_low_open || p->ci_high_open) << p->ci_low << " " << p->ci_high;
-  EXPECT_LT(p->ci_high - p->ci_low, 90.0) << p->ci_low << " " << p->ci_high;
-  EXPECT_LE(p->ci_low, p->value);
-  EXPECT_GE(p->ci_high, p->value);
-  const double truth = p->value + std::remainder(250.0 - p->value, 360.0);  // the truth on the interval's turn
-  EXPECT_GE(truth, p->ci_low) << p->ci_low << " " << p->ci_high;
-  EXPECT_LE(truth, p->ci_high) << p->ci_low << " " << p->ci_high;
-  EXPECT_NE(f.description.find("95 % profile interval"), std::string::npos) << f.description;
+  int covered = 0;
+  constexpr unsigned kSeeds = 20;
+  for (unsigned seed = 1; seed <= kSeeds; ++seed) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    SyntheticCase c;
+    c.gps = true;
+    c.effects = {{"wind_steady_gps", 4.0}};
+    c.wind_from_deg = 250.0;
+    c.seed = seed;
+    const Diagnosis d = diagnose(v, {generate_case(v, c)});
+    ASSERT_FALSE(d.findings.empty());
+    const Finding& f = d.findings.front();
+    ASSERT_EQ(f.effect, "wind_heading");
+    const double from = f.fitted.at("wind_from_deg");
+    EXPECT_LE(std::min(std::abs(from - 250.0), 360.0 - std::abs(from - 250.0)), 45.0) << from;
+    EXPECT_NEAR(f.fitted.at("wind_speed_mps"), 4.0, 1.5);
+    EXPECT_NE(f.description.find("from"), std::string::npos);
+    EXPECT_NE(f.description.find("95 % profile interval"), std::string::npos) << f.description;
+    const auto p = std::find_if(f.parameters.begin(), f.parameters.end(), [](const auto& e) { return e.name == "wind_from_deg"; });
+    ASSERT_NE(p, f.parameters.end());
+    EXPECT_TRUE(p->profiled);
+    EXPECT_FALSE(p->ci_low_open || p->ci_high_open) << p->ci_low << " " << p->ci_high;
+    EXPECT_LT(p->ci_high - p->ci_low, 90.0) << p->ci_low << " " << p->ci_high;
+    EXPECT_LE(p->ci_low, p->value);
+    EXPECT_GE(p->ci_high, p->value);
+    const double truth = p->value + std::remainder(250.0 - p->value, 360.0);  // the truth on the interval's turn
+    covered += truth >= p->ci_low && truth <= p->ci_high;
+  }
+  EXPECT_GE(covered, 14) << "of " << kSeeds;
 }
 
 TEST(WindHeading, GustyWindOnAWindingRouteIsNamedWithItsMeanBearing) {
