@@ -439,6 +439,25 @@ TEST_F(OutsideTesting, AnOptionIsNeverTakenAsAnothersValue) {
   EXPECT_EQ(ok.exit_code, 0) << ok.err;
 }
 
+// A baseline's own vehicle, tyre and cycle files, named relative to it, were looked up in the current folder: the
+// baseline worked only from where it was written. They now resolve beside it first, as a fleet manifest's do.
+TEST_F(OutsideTesting, ARegressionBaselinesFilesResolveBesideIt) {
+  write("car.yaml", slurp(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/ev.yaml"));
+  write("tyre.yaml", slurp(std::string(ROLLSIM_SOURCE_DIR) + "/tyres/nominal.yaml"));
+  write("trip.csv", slurp(std::string(ROLLSIM_SOURCE_DIR) + "/cycles/nedc.csv"));
+  const std::string baseline = write("baseline.yaml", "cases:\n  - name: beside\n    vehicle: car.yaml\n    tyre: tyre.yaml\n"
+                                                      "    cycle: trip.csv\n    unit: kwh_per_10km\n    expected: 1.64417\n"
+                                                      "    tolerance_pct: 0.5\n");
+  const CmdResult r = run_rollsim("regress '" + baseline + "'");  // run from the source folder, not the baseline's
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(has(r.out, "the case is within tolerance")) << r.out;
+  // Shipped names still resolve as before where nothing of that name lies beside the baseline.
+  const std::string shipped = write("shipped.yaml", "cases:\n  - name: shipped\n    vehicle: ev\n    tyre: nominal\n"
+                                                    "    cycle: nedc\n    unit: kwh_per_10km\n    expected: 1.64417\n"
+                                                    "    tolerance_pct: 0.5\n");
+  EXPECT_EQ(run_rollsim("regress '" + shipped + "'").exit_code, 0);
+}
+
 // The report's "regimes" heading and figure carried one id: invalid HTML, and #regimes was ambiguous.
 TEST_F(OutsideTesting, TheReportsIdsAreUnique) {
   const fs::path dir = dir_ / "report";

@@ -20,6 +20,13 @@ bool is_folder_path(const std::filesystem::path& path) {
   return std::filesystem::is_directory(path, ec);
 }
 
+std::string path_beside(const std::string& name, const std::string& referring_file) {
+  const std::filesystem::path n(name);
+  if (name.empty() || n.is_absolute()) return name;
+  const std::filesystem::path beside = std::filesystem::path(referring_file).parent_path() / n;
+  return is_regular_file_path(beside) ? beside.string() : name;
+}
+
 std::string read_input_file(const std::string& path, std::uintmax_t max_bytes) {
   namespace fs = std::filesystem;
   std::error_code ec;

@@ -28,12 +28,10 @@ std::vector<std::string> split_list(const std::string& cell) {
 }
 
 // A path relative to the manifest's folder when that file exists there, else as the diagnose command resolves it.
-std::string resolve(const std::string& cell, const std::filesystem::path& dir, const char* shipped, const char* ext,
+std::string resolve(const std::string& cell, const std::string& manifest, const char* shipped, const char* ext,
                     const std::string& where) {
-  const std::filesystem::path beside = dir / cell;
-  if (is_regular_file_path(beside)) return beside.string();
   try {
-    return resolve_data_file(cell, shipped, ext, where);
+    return resolve_data_file(path_beside(cell, manifest), shipped, ext, where);
   } catch (const InputError& e) {
     throw InputError(where, "'" + cell + "' not found (relative to the manifest's folder, or a shipped name)");
   }
@@ -62,8 +60,8 @@ FleetManifest read_fleet_manifest(const std::string& path) {
     auto where = [&](const std::optional<std::size_t>& c) { return t.where(r, *c); };
     if (cell(vehicle).empty()) throw InputError(where(vehicle), "empty: give a vehicle file or shipped name");
     if (cell(recording).empty()) throw InputError(where(recording), "empty: give a recording CSV");
-    const std::string vehicle_path = resolve(cell(vehicle), dir, "vehicles", ".yaml", where(vehicle));
-    const std::string tyre_path = cell(tyre).empty() ? "" : resolve(cell(tyre), dir, "tyres", ".yaml", where(tyre));
+    const std::string vehicle_path = resolve(cell(vehicle), path, "vehicles", ".yaml", where(vehicle));
+    const std::string tyre_path = cell(tyre).empty() ? "" : resolve(cell(tyre), path, "tyres", ".yaml", where(tyre));
     const std::filesystem::path rec = dir / cell(recording);
     if (!is_regular_file_path(rec))
       throw InputError(where(recording), "file '" + rec.string() + "' not found");

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "rollsim/common/error.hpp"
+#include "rollsim/common/input_file.hpp"
 #include "rollsim/common/json.hpp"
 #include "rollsim/common/yaml_reader.hpp"
 #include "rollsim/cycle/drive_cycle.hpp"
@@ -62,9 +63,10 @@ std::vector<RegressOutcome> run_baseline(const Baseline& b) {
   for (const auto& c : b.cases) {
     const std::string where = b.file + ": case '" + c.name + "'";
     try {
-      Vehicle v = load_vehicle_file(resolve_data_file(c.vehicle, "vehicles", ".yaml", "vehicle"));
-      fit_tyres(v, load_tyre_file(resolve_data_file(c.tyre, "tyres", ".yaml", "tyre")));
-      const DriveCycle cycle = load_cycle(c.cycle, "cycle");
+      // A baseline's own files travel with it: names resolve beside the baseline first, as a fleet manifest's do.
+      Vehicle v = load_vehicle_file(resolve_data_file(path_beside(c.vehicle, b.file), "vehicles", ".yaml", "vehicle"));
+      fit_tyres(v, load_tyre_file(resolve_data_file(path_beside(c.tyre, b.file), "tyres", ".yaml", "tyre")));
+      const DriveCycle cycle = load_cycle(path_beside(c.cycle, b.file), "cycle");
       require_distance(cycle);
       if (energy_unit(v) != c.unit) {
         throw InputError("unit", "'" + c.unit + "' does not match the car (" + energy_unit(v) + ")");
