@@ -298,7 +298,7 @@ TEST_F(OutsideTesting, ACarsSweepShowsItsTyreAtTheCarsWheelLoad) {
   ASSERT_GE(rows.size(), 2u);
   EXPECT_EQ(rows[0].rfind("pressure_bar,load_n,", 0), 0u) << rows[0];
   const std::string second = rows[1].substr(rows[1].find(',') + 1);
-  EXPECT_NEAR(std::stod(second.substr(0, second.find(','))), car_load_n, 1e-6) << rows[1];
+  EXPECT_NEAR(std::stod(second.substr(0, second.find(','))), car_load_n, 5e-4) << rows[1];  // the CSV gives 7 significant digits
 }
 
 // A constant the points cannot see was reported "fitted" with a zero-width 95 % interval: the speed loss' load

@@ -345,7 +345,6 @@ std::vector<std::string> sweep_warnings(const SweepResult& r) {
     heaviest_n = std::max(heaviest_n, p.load_n);
     if (!p.overcharge.empty() && overcharged++ == 0) first_overcharge = p.overcharge;
     behind += p.trace.followed ? 0 : 1;
-    worst.followed = worst.followed && p.trace.followed;
     worst.max_deficit_mps = std::max(worst.max_deficit_mps, p.trace.max_deficit_mps);
   }
   const std::string of = " of " + std::to_string(r.points.size()) + " points ";
@@ -372,7 +371,10 @@ std::string sweep_csv(const SweepResult& r) {
   if (r.vehicle) out << "," << r.energy_unit << ",followed_trace";
   out << "\n";
   for (const auto& p : r.points) {
-    for (const auto& [name, value] : sweep_point_columns(r, p)) out << format_value(value) << ",";
+    // Axis values as the user gave them; a derived load or speed (the car's wheel load) to the table's precision.
+    const auto columns = sweep_point_columns(r, p);
+    for (std::size_t i = 0; i < columns.size(); ++i)
+      out << (i < r.axes.size() ? format_value(columns[i].second) : significant(columns[i].second, 7)) << ",";
     out << fixed(p.rr.rrc, 7) << "," << fixed(p.rr.rr_force_n, 4) << "," << fixed(p.rr.rr_power_w, 3) << ","
         << fixed(p.rr.deflection_m, 6);
     if (r.vehicle) out << "," << fixed(p.energy, 5) << "," << (p.trace.followed ? "yes" : "no");
