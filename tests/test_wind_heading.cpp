@@ -53,8 +53,9 @@ TEST(WindHeading, HeadwindIsTheWindsComponentAgainstTheHeading) {
 
 TEST(WindHeading, SteadyWindOnAWindingRouteIsNamedWithItsBearing) {
   // Over 20 seeds, since a 95 % interval judged on one seed says little either way. Every seed must name the wind
-  // and its bearing; the interval must be closed, narrower than the half circle and hold the truth on most seeds.
-  // Measured: it holds it on 16 of these 20 (22 of seeds 1-30), short of the nominal 95 %: the README says so.
+  // and its bearing; the interval must be closed, narrower than the half circle and hold the truth as a 95 % interval
+  // does: 17 or more of 20 (a true 95 % interval falls below that about one time in 60). Measured: 20 of these 20, 29 of
+  // seeds 1-30; with the bearing's signatures mixed from the north and east replays it was 16 of 20.
   const Vehicle v = ev();
   int covered = 0;
   constexpr unsigned kSeeds = 20;
@@ -84,7 +85,7 @@ TEST(WindHeading, SteadyWindOnAWindingRouteIsNamedWithItsBearing) {
     const double truth = p->value + std::remainder(250.0 - p->value, 360.0);  // the truth on the interval's turn
     covered += truth >= p->ci_low && truth <= p->ci_high;
   }
-  EXPECT_GE(covered, 14) << "of " << kSeeds;
+  EXPECT_GE(covered, 17) << "of " << kSeeds;
 }
 
 TEST(WindHeading, GustyWindOnAWindingRouteIsNamedWithItsMeanBearing) {

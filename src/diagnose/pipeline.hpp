@@ -260,13 +260,13 @@ struct ProfileResult {
 ProfileResult profile_time_constant(const Model& m, const TimeProfile& tp, const Eigen::VectorXd& selected_signature,
                                     const Scored& selected_score, double amp_min, double amp_max);
 
-/// wind_heading's bearing: the criterion profiled in 1 deg steps over the half circle centred on the selected
-/// candidate's bearing (the other half is the same wind with the opposite sign), each signature mixed from the north
-/// and east ones (no replay); its best adopted as profile_time_constant's is. The interval is where
-/// n_eff ln(RSS / RSS_min) < 3.84, unwrapped (it may pass 0 or 360 deg), open where it reaches +-90 deg.
-ProfileResult profile_bearing(const Model& m, double selected_deg, const Eigen::VectorXd& north, const Eigen::VectorXd& east,
-                              const Eigen::VectorXd& selected_signature, const Scored& selected_score, double amp_min,
-                              double amp_max);
+/// wind_heading's bearing: the criterion profiled in 1 deg steps over the half circle centred on `centre_deg`, each
+/// signature interpolated between `replayed`, the wind's replayed signatures every `step_deg` from centre - 90 to
+/// centre + 90 deg (per unit of the wind speed's nominal value); its best adopted as profile_time_constant's is,
+/// against the centre's. The interval is where n_eff ln(RSS / RSS_min) < 3.84, unwrapped (it may pass 0 or 360 deg),
+/// open where it reaches +-90 deg.
+ProfileResult profile_bearing(const Model& m, double centre_deg, double step_deg, const std::vector<Eigen::VectorXd>& replayed,
+                              const Scored& centre_score, double amp_min, double amp_max);
 
 struct SelectionContext {
   const Replayer& replayer;

@@ -108,20 +108,26 @@ ProfileResult profile_time_constant(const Model& m, const TimeProfile& tp, const
   return r;
 }
 
-ProfileResult profile_bearing(const Model& m, double selected_deg, const Eigen::VectorXd& north, const Eigen::VectorXd& east,
-                              const Eigen::VectorXd& selected_signature, const Scored& selected_score, double amp_min,
-                              double amp_max) {
+ProfileResult profile_bearing(const Model& m, double centre_deg, double step_deg, const std::vector<Eigen::VectorXd>& replayed,
+                              const Scored& centre_score, double amp_min, double amp_max) {
   constexpr double kStepDeg = 1.0, kHalfDeg = 90.0;
+  const std::size_t last = replayed.size() - 1;
+  if (replayed.size() < 3 || replayed.size() % 2 == 0 || std::abs(static_cast<double>(last) * step_deg - 2.0 * kHalfDeg) > 1e-9)
+    throw InputError("profile_bearing", "needs an odd number of replays spanning the half circle");
   std::vector<double> grid, rss;
   std::vector<Eigen::VectorXd> sigs;
   for (double d = -kHalfDeg; d <= kHalfDeg + 1e-9; d += kStepDeg) {
-    const double th = units::deg_to_rad(selected_deg + d);
-    grid.push_back(selected_deg + d);  // d steps by whole degrees from -90: exactly 0 at the centre
-    sigs.push_back(std::cos(th) * north + std::sin(th) * east);
+    // Between replays the signature is interpolated: it turns smoothly with the bearing, and a replay per degree
+    // would cost 181 of them.
+    const double at = (d + kHalfDeg) / step_deg;
+    const std::size_t k = std::min(static_cast<std::size_t>(at), last - 1);
+    const double f = at - static_cast<double>(k);
+    grid.push_back(centre_deg + d);  // d steps by whole degrees from -90: exactly 0 at the centre
+    sigs.push_back((1.0 - f) * replayed[k] + f * replayed[k + 1]);
     rss.push_back(least_squares(hcat(m.x, sigs.back()), *m.y, m.prior).rss);
   }
-  ProfileResult r{interval_on_grid(grid, rss, m.n_eff, 3.84, false), "wind_from_deg", selected_signature, selected_score, {}};
-  keep_best_if_better(m, grid, sigs[r.interval.best], selected_deg, amp_min, amp_max, r);
+  ProfileResult r{interval_on_grid(grid, rss, m.n_eff, 3.84, false), "wind_from_deg", replayed[last / 2], centre_score, {}};
+  keep_best_if_better(m, grid, sigs[r.interval.best], centre_deg, amp_min, amp_max, r);
   return r;
 }
 

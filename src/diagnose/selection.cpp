@@ -231,6 +231,10 @@ std::vector<Passing> passing_candidates(const SelectionContext& sc, const std::v
   return out;
 }
 
+// The wind's bearing profile replays the wind this often (19 replays over the half circle) and interpolates between:
+// at 5 deg (37 replays) the interval held the truth as often (29 of 30 seeds) and cost 60 % more.
+constexpr double kBearingReplayStep_deg = 10.0;
+
 // aux_load's decay from the trip's start: a winter heater's cabin warms in minutes, a long trip's in up to two hours.
 constexpr double kAuxDecayLow_s = 120.0, kAuxDecayHigh_s = 7680.0;
 
@@ -241,17 +245,27 @@ bool switches_engine_off(const SelectionContext& sc) {
 
 // Each of the effect's shape parameters in turn, the later ones at the earlier ones' values; the first is the
 // finding's profile, the later ones travel as its profiled nuisance parameters.
-std::optional<ProfileResult> refine(const SelectionContext& sc, const std::vector<Candidate>& cands, Candidate& c, const Model& m,
+std::optional<ProfileResult> refine(const SelectionContext& sc, Candidate& c, const Model& m,
                                     Passing& best) {
   if (c.id == EffectId::aux_load) return refine_aux_decay(sc, c, m, best.score, kAuxDecayLow_s, kAuxDecayHigh_s);
   if (c.mixed_bearing) {
-    // The north (0 deg) and east (90 deg) candidates' signatures span every bearing's.
-    const Eigen::VectorXd* axis[2] = {nullptr, nullptr};
-    for (const auto& o : cands)
-      if (o.mixed_bearing && (o.shape.at("wind_from_deg") == 0.0 || o.shape.at("wind_from_deg") == 90.0))
-        axis[o.shape.at("wind_from_deg") == 0.0 ? 0 : 1] = &o.signature;
-    if (!axis[0] || !axis[1]) return std::nullopt;
-    ProfileResult r = profile_bearing(m, c.shape.at("wind_from_deg"), *axis[0], *axis[1], c.signature, best.score, c.min(), c.max());
+    // The candidates' signatures mix the north and east winds' replays, which is exact only to first order in the
+    // wind speed: the headwind's u^2 cos^2 term and the powertrain's losses do not turn with the bearing's cosine and
+    // sine, and on noise-free recordings the mix put the bearing up to 8 deg off. So the profile replays the wind
+    // itself, every kBearingReplayStep_deg over the half circle about the candidate's bearing, turned to where the
+    // wind blows from when the candidate's speed came out negative.
+    const double centre = c.shape.at("wind_from_deg") + (best.score.amplitude() < 0.0 ? 180.0 : 0.0);
+    const double nominal = c.amplitude->nominal;
+    std::vector<EffectList> runs;
+    for (double d = -90.0; d <= 90.0 + 1e-9; d += kBearingReplayStep_deg) {
+      const double from = std::fmod(std::fmod(centre + d, 360.0) + 360.0, 360.0);
+      runs.push_back({make_effect(c.id, {{c.amplitude->name, nominal}, {"wind_from_deg", from}}, sc.ctx)});
+    }
+    std::vector<Eigen::VectorXd> sigs;
+    for (const auto& v : sc.replayer.run(runs, sc.obs, sc.lag_samples)) sigs.push_back((v.window_j - sc.base.window_j) / nominal);
+    Scored centre_score = score_column(m, sigs[sigs.size() / 2]);
+    add_heldout(m, sigs[sigs.size() / 2], centre_score);
+    ProfileResult r = profile_bearing(m, centre, kBearingReplayStep_deg, sigs, centre_score, c.min(), c.max());
     c.shape["wind_from_deg"] = r.interval.value;
     c.signature = r.signature;
     best.score = r.score;
@@ -433,7 +447,7 @@ std::vector<Finding> select_effects(const SelectionContext& sc, const std::vecto
     if (best.wrong_sign) {
       f = wrong_sign_finding(c, best, m.inflate);
     } else {
-      const std::optional<ProfileResult> prof = refine(sc, cands, c, m, best);
+      const std::optional<ProfileResult> prof = refine(sc, c, m, best);
       f = catalogue_finding(sc, c, best, prof, m.inflate);
       add_confounders(f, c, cands, passing, m, sc.opt.collinear_corr);
       add_rrc_level_alternative(f, c, sc, rrc_at_box);

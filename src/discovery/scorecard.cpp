@@ -340,8 +340,11 @@ BenchResult run_discovery_bench(const Vehicle& vehicle, const BenchOptions& opt)
       for (const auto& f : d.findings) {
         const auto from = f.fitted.find("wind_from_deg");
         const auto decay = f.fitted.find("decay_s");
-        o.findings.push_back({f.effect, f.confounded_with, f.parameters.empty() ? 0.0 : f.parameters.front().value,
-                              from == f.fitted.end() ? -1.0 : from->second, decay == f.fitted.end() ? -1.0 : decay->second});
+        FindingSummary fs{f.effect, f.confounded_with, f.parameters.empty() ? 0.0 : f.parameters.front().value,
+                          from == f.fitted.end() ? -1.0 : from->second, 0.0, 0.0, decay == f.fitted.end() ? -1.0 : decay->second};
+        for (const auto& p : f.parameters)
+          if (p.name == "wind_from_deg" && p.profiled) fs.wind_from_low_deg = p.ci_low, fs.wind_from_high_deg = p.ci_high;
+        o.findings.push_back(std::move(fs));
       }
       // The sparse regression sees one trip at a time (its library has no trip-level term): every trip's terms.
       o.sparse.assign(sparse_thresholds().size() + 1, {});
@@ -358,6 +361,8 @@ BenchResult run_discovery_bench(const Vehicle& vehicle, const BenchOptions& opt)
       put(bytes, f.confounded_with);
       put(bytes, f.size);
       put(bytes, f.wind_from_deg);
+      put(bytes, f.wind_from_low_deg);
+      put(bytes, f.wind_from_high_deg);
       put(bytes, f.decay_s);
     }
     put(bytes, o.sparse);
@@ -384,6 +389,8 @@ BenchResult run_discovery_bench(const Vehicle& vehicle, const BenchOptions& opt)
       take(in, f.confounded_with);
       take(in, f.size);
       take(in, f.wind_from_deg);
+      take(in, f.wind_from_low_deg);
+      take(in, f.wind_from_high_deg);
       take(in, f.decay_s);
     }
     take(in, out[k].sparse);
@@ -412,9 +419,13 @@ BenchResult run_discovery_bench(const Vehicle& vehicle, const BenchOptions& opt)
     if (c.synth.gps && has(c.expected, "wind_heading")) {
       row.scores_direction = true;
       const auto& f = r.findings;
-      if (!f.empty() && f.front().effect == "wind_heading" && f.front().confounded_with.empty() &&
-          bearing_error_deg(f.front().wind_from_deg, truth_bearing_deg(c.seed0 + static_cast<unsigned>(tasks[k].s))) <= 45.0)
-        ++row.rollsim_direction_right;
+      const double truth_deg = truth_bearing_deg(c.seed0 + static_cast<unsigned>(tasks[k].s));
+      if (!f.empty() && f.front().effect == "wind_heading" && f.front().confounded_with.empty()) {
+        if (bearing_error_deg(f.front().wind_from_deg, truth_deg) <= 45.0) ++row.rollsim_direction_right;
+        // The interval's ends are unwrapped about the fitted bearing: the truth is taken to the same turn.
+        const double on_turn = f.front().wind_from_deg + std::remainder(truth_deg - f.front().wind_from_deg, 360.0);
+        if (on_turn >= f.front().wind_from_low_deg && on_turn <= f.front().wind_from_high_deg) ++row.rollsim_interval_holds;
+      }
     }
     // Whether an auxiliary load was found decaying: the winter heater's shape, and how often the duty-cycled and
     // steady loads (a decay only on half the cabin_load seeds) are given one.
@@ -519,7 +530,10 @@ std::string bench_text(const BenchResult& r) {
        << std::setw(8) << row.rollsim_unexplained << std::setw(6) << row.rollsim_wrong_sign << std::setw(18) << named.str()
        << std::setw(12) << cell(row.calibration) << std::setw(14) << cell(row.sparse) << "\n";
     if (row.scores_direction)
+    {
       sub_rate_line(os, "named with the wind's bearing within 45 deg", row.rollsim_direction_right, row.rollsim.n());
+      sub_rate_line(os, "named with the bearing's 95 % interval holding the truth", row.rollsim_interval_holds, row.rollsim.n());
+    }
     if (row.scores_decay)
       sub_rate_line(os, "named with a decay from the trip's start (decay_s fitted)", row.rollsim_decay_found, row.rollsim.n());
   }

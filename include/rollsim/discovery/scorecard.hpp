@@ -45,6 +45,7 @@ struct FindingSummary {
   std::vector<std::string> confounded_with;
   double size = 0.0;
   double wind_from_deg = -1.0;  ///< wind_heading's fitted bearing (negative: none)
+  double wind_from_low_deg = 0.0, wind_from_high_deg = 0.0;  ///< its 95 % profile interval (unwrapped ends)
   double decay_s = -1.0;        ///< aux_load's fitted decay from the trip's start (negative: none)
 };
 
@@ -80,6 +81,8 @@ struct BenchRow {
   int rollsim_unexplained = 0;  ///< seeds whose first finding was an unexplained signature
   /// Steady-wind rows (GPS): seeds named with the truth's bearing within 45 deg (of rollsim.named), and the cases.
   int rollsim_direction_right = 0;
+  /// Of those rows' seeds: named, with the bearing's 95 % profile interval holding the truth's bearing.
+  int rollsim_interval_holds = 0;
   bool scores_direction = false;
   /// Winter-heater rows: seeds named aux_load with a decay from the trip's start (of rollsim.named).
   int rollsim_decay_found = 0;
