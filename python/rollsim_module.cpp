@@ -153,10 +153,17 @@ py::object api_tyre(py::object file, py::object size, py::object outer_radius_m,
   return stack(points);
 }
 
+// cycle_from, with what the trace holds that a user should hear of (DriveCycle::notes) as warnings, as the CLI says it.
+DriveCycle noted_cycle_from(py::handle c) {
+  DriveCycle d = cycle_from(c);
+  for (const auto& n : d.notes) warn(n);
+  return d;
+}
+
 py::dict api_simulate(py::object vehicle, py::object tyre, py::object cycle, bool replay, bool trace) {
   const Vehicle base = vehicle_from(vehicle);
   const std::optional<TyreSpec> tyre_set = tyre_from(tyre);
-  const DriveCycle c = cycle_from(cycle);
+  const DriveCycle c = noted_cycle_from(cycle);
   SimulationOptions opt;
   opt.record_trace = trace;
   VehicleRun run;
@@ -183,7 +190,7 @@ py::list api_compare(py::object vehicle, std::vector<std::string> tyres, py::obj
                                  catalogue.is_none() ? "" : arg_as<std::string>(catalogue, "catalogue", "a folder path (str)"));
   for (const auto& b : list.broken) warn("skipped broken catalogue file: " + b);
   const Vehicle v = vehicle_from(vehicle);
-  const DriveCycle c = cycle_from(cycle);
+  const DriveCycle c = noted_cycle_from(cycle);
   selection::Comparison cmp;
   {
     py::gil_scoped_release released;
@@ -213,7 +220,7 @@ py::list api_sweep(py::object tyre, std::vector<py::tuple> axes, py::object load
   selection::SweepResult r;
   if (!vehicle.is_none()) {
     const Vehicle v = vehicle_from(vehicle);
-    const DriveCycle c = cycle_from(cycle);
+    const DriveCycle c = noted_cycle_from(cycle);
     py::gil_scoped_release released;
     r = selection::sweep_vehicle(v, t, c, so);
   } else {
@@ -366,7 +373,7 @@ py::dict api_sensitivity(py::object tyre, py::object vehicle, py::object cycle, 
   const std::optional<TyreSpec> t = tyre_from(tyre);
   std::optional<double> at_n;
   if (!load_n.is_none()) at_n = parse_option_number(number_text(load_n, "load_n"), "--load-n", Range::open_low(0.0, 1e6));
-  const DriveCycle c = v ? cycle_from(cycle) : DriveCycle{};
+  const DriveCycle c = v ? noted_cycle_from(cycle) : DriveCycle{};
   selection::Sensitivity s;
   {
     py::gil_scoped_release released;

@@ -228,23 +228,40 @@ std::string data_root() {
   return ROLLSIM_SOURCE_DIR;
 }
 
+std::optional<std::string> shipped_data_file(const std::string& name, const std::string& shipped_dir, const std::string& extension) {
+  namespace fs = std::filesystem;
+  if (!fs::path(name).is_relative()) return std::nullopt;
+  const fs::path shipped = fs::path(data_root()) / shipped_dir;
+  std::vector<fs::path> candidates{shipped / name};
+  if (!extension.empty()) candidates.push_back(shipped / (name + extension));
+  for (const auto& c : candidates)
+    if (is_regular_file_path(c)) return c.string();
+  return std::nullopt;
+}
+
 std::string resolve_data_file(const std::string& name, const std::string& shipped_dir,
                               const std::string& extension, const std::string& option) {
   namespace fs = std::filesystem;
-  std::vector<fs::path> candidates{fs::path(name)};
-  if (!extension.empty() && fs::path(name).extension() != extension) candidates.emplace_back(name + extension);
-  const fs::path shipped = fs::path(data_root()) / shipped_dir;
-  if (fs::path(name).is_relative()) {
-    candidates.push_back(shipped / name);
-    if (!extension.empty()) candidates.push_back(shipped / (name + extension));
+  const fs::path given(name);
+  // A bare name ("nedc", "155-70R19") names shipped data: a file of that name in the current folder must not
+  // silently stand in for it. A name with a folder or an extension ("my.yaml", "./nedc.csv") is the user's file.
+  const bool bare = !given.has_parent_path() && given.extension().empty();
+  if (bare) {
+    if (auto shipped = shipped_data_file(name, shipped_dir, extension)) return *shipped;
   }
+  std::vector<fs::path> candidates{given};
+  if (!extension.empty() && given.extension() != extension) candidates.emplace_back(name + extension);
   for (const auto& c : candidates) {
     if (is_regular_file_path(c)) return c.string();
   }
+  if (!bare) {
+    if (auto shipped = shipped_data_file(name, shipped_dir, extension)) return *shipped;
+  }
+  const fs::path shipped = fs::path(data_root()) / shipped_dir;
   // A folder given by name: say so rather than "not found".
-  if (is_folder_path(fs::path(name))) throw InputError(option + " '" + name + "'", "is a folder; a file is expected here");
+  if (is_folder_path(given)) throw InputError(option + " '" + name + "'", "is a folder; a file is expected here");
   std::error_code ec;
-  if (fs::exists(fs::path(name), ec)) {
+  if (fs::exists(given, ec)) {
     throw InputError(option + " '" + name + "'", "is not a regular file (a device, pipe or socket?)");
   }
   throw InputError(option + " '" + name + "'",

@@ -7,6 +7,7 @@
 
 #include "rollsim/common/csv.hpp"
 #include "rollsim/common/error.hpp"
+#include "rollsim/common/format.hpp"
 #include "rollsim/common/input_file.hpp"
 #include "rollsim/common/text.hpp"
 #include "rollsim/common/units.hpp"
@@ -159,6 +160,24 @@ void check_engine_off_standing(const CsvTable& table, std::size_t col, const std
   }
 }
 
+// Long intervals between samples where the car moves at either end: the trace drives them as a straight line, which
+// for a logger's dropout is distance that was never driven. Said, not refused: a hand-written trace may mean it.
+std::vector<std::string> moving_gap_notes(const CsvTable& table, const DriveCycle& c) {
+  std::vector<std::string> out;
+  const double total_m = c.distance_m();
+  for (std::size_t r = 1; r < c.time_s.size(); ++r) {
+    const double dt = c.time_s[r] - c.time_s[r - 1];
+    if (!(dt > kNotedMovingGap_s) || (c.speed_mps[r] == 0.0 && c.speed_mps[r - 1] == 0.0)) continue;
+    const double gap_m = 0.5 * (c.speed_mps[r] + c.speed_mps[r - 1]) * dt;
+    out.push_back(table.file + ": lines " + std::to_string(table.row_line[r - 1]) + "-" + std::to_string(table.row_line[r]) +
+                  ": " + fixed(dt, 0) + " s between samples at " + fixed(units::mps_to_kmh(c.speed_mps[r - 1]), 1) +
+                  " and " + fixed(units::mps_to_kmh(c.speed_mps[r]), 1) + " km/h, driven as a straight line between them (" +
+                  fixed(gap_m / 1000.0, 3) + " of the trace's " + fixed(total_m / 1000.0, 3) +
+                  " km); if the log has a gap there, that distance was never driven");
+  }
+  return out;
+}
+
 }  // namespace
 
 DriveCycle cycle_from_table(const CsvTable& table, const std::string& name) {
@@ -259,6 +278,7 @@ DriveCycle cycle_from_table(const CsvTable& table, const std::string& name) {
   }
   if (col_engine) check_engine_off_standing(table, *col_engine, c.speed_mps, off);
   c.set_engine_off(std::move(off));
+  c.notes = moving_gap_notes(table, c);
 
   if (col_elev) {
     // Grade at each sample: elevation difference over the distance travelled across a window that grows

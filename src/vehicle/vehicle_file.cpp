@@ -13,14 +13,13 @@ namespace rollsim {
 
 std::string resolve_tyre_path(const std::string& name, const std::string& vehicle_file, const std::string& where) {
   namespace fs = std::filesystem;
+  // Beside the vehicle file, then shipped: never the current folder, or one vehicle file would give another car
+  // depending on where it is run from.
   const fs::path beside = fs::path(vehicle_file).parent_path() / name;
   for (const fs::path& p : {beside, fs::path(beside.string() + ".yaml")})
     if (is_regular_file_path(p)) return p.string();
-  try {
-    return resolve_data_file(name, "tyres", ".yaml", where);
-  } catch (const InputError&) {
-    throw InputError(where, "tyre file '" + name + "' not found beside the vehicle file or in the shipped tyres/");
-  }
+  if (auto shipped = shipped_data_file(name, "tyres", ".yaml")) return *shipped;
+  throw InputError(where, "tyre file '" + name + "' not found beside the vehicle file or in the shipped tyres/");
 }
 
 std::string portable_vehicle_yaml(const std::string& text, const std::string& vehicle_path, const std::string& tyre_override) {

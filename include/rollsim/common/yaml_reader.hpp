@@ -88,11 +88,16 @@ class YamlMap {
   std::vector<std::string> read_keys_;
 };
 
-/// Resolves a data file named on the command line: the path as given if it exists, else the same name in
-/// the shipped folder `<source dir>/<shipped_dir>/`, with `.yaml`/`.csv` appended if `extension` is given
-/// and missing. Throws InputError naming the option when nothing is found.
+/// Resolves a data file named on the command line, with `.yaml`/`.csv` appended if `extension` is given and missing.
+/// A bare name (no folder, no extension: "nedc", "155-70R19") is the shipped file `<data root>/<shipped_dir>/` first,
+/// then a file in the current folder; any other name is the path as given first, then the shipped file. Throws
+/// InputError naming the option when nothing is found.
 std::string resolve_data_file(const std::string& name, const std::string& shipped_dir,
                               const std::string& extension, const std::string& option);
+
+/// The shipped file `name` (or `name` + `extension`) in `<data root>/<shipped_dir>/`, if there is one.
+std::optional<std::string> shipped_data_file(const std::string& name, const std::string& shipped_dir,
+                                             const std::string& extension);
 
 /// The root folder of shipped data (tyres/, vehicles/, cycles/): ROLLSIM_DATA_DIR if set, else the source dir.
 std::string data_root();

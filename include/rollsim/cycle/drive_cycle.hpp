@@ -28,6 +28,9 @@ struct DriveCycle {
   /// Per sample: the direction of travel over the segment starting here, clockwise from north [rad] (from a
   /// recording's latitude and longitude, or a cycle CSV's heading_deg); empty where the route's heading is unknown.
   std::vector<double> heading_rad;
+  /// What the file holds that a user should hear of, though it is allowed (one line each, no "warning:" prefix):
+  /// a long interval between samples of a moving car, which the linear interpolation drives as if it were there.
+  std::vector<std::string> notes;
 
   bool engine_off_at(std::size_t segment) const { return segment < engine_off.size() && engine_off[segment]; }
   bool any_engine_off() const;
@@ -84,5 +87,8 @@ inline constexpr double kMaxCycleAccel_mps2 = 19.6;
 /// Closest and farthest two samples may be [s]: 1 ms (a 1 kHz logger) and one day (a car parked overnight).
 inline constexpr double kMinCycleTimeStep_s = 1e-3;
 inline constexpr double kMaxCycleTimeStep_s = 86400.0;
+/// A longer interval between two samples of a moving car is noted (DriveCycle::notes): a logger's gap is otherwise
+/// driven as a straight line between its ends, at speed, for as long as it lasts.
+inline constexpr double kNotedMovingGap_s = 30.0;
 
 }  // namespace rollsim
