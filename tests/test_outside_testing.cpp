@@ -526,5 +526,57 @@ TEST_F(OutsideTesting, TheMendsOwnReviewFindings) {
   EXPECT_TRUE(has(r.err, "warning: at 2 of 2 points the battery charged past full")) << r.err;
 }
 
+// Session 17's outside testing of real users' input files (/work/notes/s17-inputs.md): each test below failed on the
+// session's starting binary.
+
+// U2: a semicolon, tab or decimal-comma file was blamed on a misspelt column or on its first decimal's line.
+TEST_F(OutsideTesting, AnotherSeparatorOrADecimalCommaIsNamed) {
+  const std::string semi = write("semi.csv", "time_s;speed_kmh\n0;0\n1;1,5\n2;3\n");
+  expect_refused("simulate --vehicle ev --cycle '" + semi + "'",
+                 semi + ": line 1: the header holds ';' and no comma: the file looks semicolon-separated (perhaps with "
+                        "decimal commas); rollsim reads comma-separated CSV with a decimal point (1.5)");
+  const std::string tabs = write("tabs.csv", "time_s\tspeed_kmh\n0\t0\n1\t3\n");
+  expect_refused("simulate --vehicle ev --cycle '" + tabs + "'", tabs + ": line 1: the header holds tabs and no comma: the file looks tab-separated");
+  const std::string comma = write("comma.csv", "time_s,speed_kmh\n0,0\n1,1,5\n2,3\n");
+  expect_refused("simulate --vehicle ev --cycle '" + comma + "'",
+                 comma + ": line 3: has 3 cells but the header (line 1) has 2 columns: 'time_s', 'speed_kmh'; the numbers "
+                         "look written with decimal commas (1,5): rollsim reads comma-separated CSV with a decimal point (1.5)");
+  const std::string quoted = write("quoted.csv", "time_s,speed_kmh\n0,0\n1,\"1,5\"\n");
+  expect_refused("simulate --vehicle ev --cycle '" + quoted + "'",
+                 "line 3, column 'speed_kmh': '1,5' is not a number; rollsim reads a decimal point (1.5), not a decimal comma");
+  const std::string rec = write("rec.csv", "Time[s];Eng_FuelFlow_Direct_DI[ccps];Dyno_Spd[mph]\n0,0;0,0;0,0\n");
+  expect_refused("diagnose --vehicle camry_2018 --preset anl_d3 --recording '" + rec + "'",
+                 rec + ": line 1: the header holds ';' and no comma: the file looks semicolon-separated");
+}
+
+// U6: Excel's "Unicode text" (UTF-16) was read as UTF-8 and the message showed mojibake.
+TEST_F(OutsideTesting, AUtf16FileIsNamed) {
+  auto utf16 = [](const std::string& ascii, bool bom) {
+    std::string out = bom ? std::string("\xFF\xFE", 2) : std::string();
+    for (char c : ascii) out += std::string(1, c) + std::string(1, '\0');
+    return out;
+  };
+  const std::string text = "time_s,speed_kmh\r\n0,0\r\n1,3\r\n";
+  const std::string with_bom = write("bom.csv", utf16(text, true));
+  expect_refused("simulate --vehicle ev --cycle '" + with_bom + "'",
+                 with_bom + ": the file is UTF-16 (a UTF-16 byte-order mark; Excel's \"Unicode text\"); rollsim reads "
+                            "UTF-8: save it as \"CSV UTF-8 (comma delimited)\"");
+  const std::string no_bom = write("nobom.csv", utf16(text, false));
+  expect_refused("simulate --vehicle ev --cycle '" + no_bom + "'",
+                 no_bom + ": line 1: holds a NUL byte: the file looks UTF-16 (or binary)");
+}
+
+// U7: a '#' line was read as the header or reported as a short row, without the rule.
+TEST_F(OutsideTesting, CommentLinesAreRefusedByName) {
+  const std::string top = write("top.csv", "# WLTC class 3b exported from tool X\ntime_s,speed_kmh\n0,0\n1,3\n");
+  expect_refused("simulate --vehicle ev --cycle '" + top + "'",
+                 top + ": line 1: '# WLTC class 3b exported from tool X' is a comment line; comment lines are not allowed");
+  const std::string end = write("end.csv", "time_s,speed_kmh\n0,0\n1,3\n# end of cycle\n");
+  expect_refused("simulate --vehicle ev --cycle '" + end + "'", end + ": line 4: '# end of cycle' is a comment line");
+  std::string rows = slurp(kCamryUdds) + "# logger stopped\n";
+  const std::string rec = write("rec.csv", rows);
+  expect_refused("diagnose --vehicle camry_2018 --preset anl_d3 --recording '" + rec + "'", "'# logger stopped' is a comment line");
+}
+
 }  // namespace
 }  // namespace rollsim::test

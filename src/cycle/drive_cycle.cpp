@@ -205,7 +205,7 @@ DriveCycle cycle_from_table(const CsvTable& table, const std::string& name) {
     const std::string& cell = table.rows[row][col];
     if (cell.empty()) throw InputError(table.where(row, col), "is empty; expected a number");
     const auto v = parse_number(cell);
-    if (!v) throw InputError(table.where(row, col), "'" + cell + "' is not a number");
+    if (!v) throw InputError(table.where(row, col), not_a_number(cell));
     if (!std::isfinite(*v)) throw InputError(table.where(row, col), "'" + cell + "' is not allowed: must be a finite number");
     return *v;
   };
