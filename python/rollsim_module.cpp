@@ -79,8 +79,13 @@ std::optional<TyreSpec> tyre_from(py::handle t) {
 // A shipped name or CSV path; a dict of arrays named like the CSV columns (time_s, speed_kmh or speed_mps,
 // optional grade_pct or elevation_m, heading_deg, engine_on); or a pair (time_s, speed_kmh). Arrays pass the CSV
 // file's checks, their errors naming the sample index as the "line".
+DriveCycle cycle_arrays(py::handle c);
 DriveCycle cycle_from(py::handle c) {
-  if (py::isinstance<py::str>(c)) return load_cycle(c.cast<std::string>(), "--cycle");
+  const DriveCycle cycle = py::isinstance<py::str>(c) ? load_cycle(c.cast<std::string>(), "--cycle") : cycle_arrays(c);
+  if (const std::string note = ignored_columns_note(cycle); !note.empty()) warn(note);
+  return cycle;
+}
+DriveCycle cycle_arrays(py::handle c) {
   CsvTable table;
   table.file = "cycle arrays (line = sample index)";
   std::vector<py::array_t<double>> columns;

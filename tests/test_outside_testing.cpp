@@ -578,5 +578,41 @@ TEST_F(OutsideTesting, CommentLinesAreRefusedByName) {
   expect_refused("diagnose --vehicle camry_2018 --preset anl_d3 --recording '" + rec + "'", "'# logger stopped' is a comment line");
 }
 
+// I1: a cycle refused the extra columns (phase, gear) and trailing commas that the recording reader accepts. Now
+// every reader drops trailing empty cells, and a cycle ignores other columns, saying so, but not one named like a
+// cycle column (a misspelt grade would drive a flat road).
+TEST_F(OutsideTesting, CyclesIgnoreOtherColumnsAndTrailingCommasLikeRecordings) {
+  fs::create_directories(dir_ / "a");
+  fs::create_directories(dir_ / "b");
+  fs::create_directories(dir_ / "c");
+  const std::string plain = write("a/c.csv", "time_s,speed_kmh\n0,0\n10,36\n50,36\n60,0\n");
+  const std::string extra = write("b/c.csv", "time_s,speed_kmh,phase,gear\n0,0,low,1\n10,36,low,3\n50,36,low,3\n60,0,low,1\n");
+  const std::string trailing = write("c/c.csv", "time_s,speed_kmh,\n0,0,\n10,36\n50,36,,\n60,0,\n");
+  const CmdResult a = run_rollsim("simulate --vehicle ev --cycle '" + plain + "' --json");
+  const CmdResult b = run_rollsim("simulate --vehicle ev --cycle '" + extra + "' --json");
+  const CmdResult c = run_rollsim("simulate --vehicle ev --cycle '" + trailing + "' --json");
+  ASSERT_EQ(a.exit_code, 0) << a.err;
+  ASSERT_EQ(b.exit_code, 0) << b.err;
+  ASSERT_EQ(c.exit_code, 0) << c.err;
+  auto no_source = [](std::string out) { return std::regex_replace(out, std::regex(R"([abc]/c\.csv)"), "c.csv"); };
+  EXPECT_EQ(no_source(b.out), no_source(a.out));
+  EXPECT_EQ(no_source(c.out), no_source(a.out));
+  EXPECT_TRUE(has(b.err, "note: " + extra + ": columns 'phase', 'gear' not read; cycle columns are time_s")) << b.err;
+  EXPECT_FALSE(has(c.err, "note:")) << c.err;
+  const std::string cased = write("cased.csv", "time_s,speed_kmh,Grade_pct\n0,0,5\n1,3,5\n");
+  expect_refused("simulate --vehicle ev --cycle '" + cased + "'",
+                 "unknown column 'Grade_pct' (misspelt?); allowed: time_s, speed_kmh or speed_mps");
+  const std::string unnamed = write("unnamed.csv", "time_s,speed_kmh,\n0,0,\n1,3,7\n");
+  expect_refused("simulate --vehicle ev --cycle '" + unnamed + "'",
+                 unnamed + ": line 3: '7' in column 3, which has no name in the header (line 1)");
+  // A recording whose data rows (not its header) end with a comma was refused as too wide.
+  std::string rec_rows;
+  std::istringstream in(slurp(kCamryUdds));
+  for (std::string line; std::getline(in, line);) rec_rows += line + (rec_rows.empty() ? "\n" : ",\n");
+  const std::string rec = write("rec.csv", rec_rows);
+  const CmdResult r = run_rollsim("diagnose --vehicle camry_2018 --preset anl_d3 --recording '" + rec + "'");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+}
+
 }  // namespace
 }  // namespace rollsim::test

@@ -361,5 +361,29 @@ class InputErrors(unittest.TestCase):
                     call()
 
 
+class Session17Inputs(unittest.TestCase):
+    """Session 17's outside testing of real users' inputs (/work/notes/s17-inputs.md); each failed on the module of the
+    session's start."""
+
+    @classmethod
+    def setUpClass(cls):
+        import yaml
+        with open(REPO / "vehicles" / "ev.yaml") as f:
+            cls.ev = yaml.safe_load(f)
+        cls.short = ([0.0, 10.0, 50.0, 60.0], [0.0, 36.0, 36.0, 0.0])
+
+    def aec(self, **kw):
+        return rollsim.simulate(trace=False, **kw)["summary"]["aec_kwh_per_10km"]
+
+    def test_other_cycle_columns_are_ignored_with_a_warning(self):
+        # I1: as in a cycle CSV, a column that is no cycle column is not read, and said.
+        t, v = self.short
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            got = self.aec(cycle={"time_s": t, "speed_kmh": v, "gear": [1, 3, 3, 1]})
+        self.assertEqual(got, self.aec(cycle=(t, v)))
+        self.assertTrue(any("column 'gear' not read" in str(w.message) for w in caught), [str(w.message) for w in caught])
+
+
 if __name__ == "__main__":
     unittest.main()

@@ -113,7 +113,7 @@ void run_compare(const CompareOptionsText& o, const ProcessGroup& group) {
   for (const auto& vname : o.vehicles) {
     const Vehicle v = load_vehicle_file(resolve_data_file(vname, "vehicles", ".yaml", "--vehicle"));
     for (const auto& cname : cycles) {
-      const DriveCycle cycle = load_cycle(cname, "--cycle");
+      const DriveCycle cycle = load_cycle_noting(cname, "--cycle");
       const auto cmp = selection::compare_tyres(v, candidates, cycle, copt);
       if (o.json) print_json(cmp);
       else if (o.csv) print_csv(cmp, csv_header);

@@ -42,7 +42,7 @@ void run_sensitivity(const SensitivityOptionsText& o) {
   if (!o.tyre.empty()) tyre = load_tyre_file(resolve_data_file(o.tyre, "tyres", ".yaml", "--tyre"));
   std::optional<double> load_n;
   if (!o.load_n.empty()) load_n = parse_option_number(o.load_n, "--load-n", Range::open_low(0.0, 1e6));
-  const DriveCycle cycle = vehicle ? load_cycle(o.cycle.empty() ? "nedc" : o.cycle, "--cycle") : DriveCycle{};
+  const DriveCycle cycle = vehicle ? load_cycle_noting(o.cycle.empty() ? "nedc" : o.cycle, "--cycle") : DriveCycle{};
   const selection::Sensitivity s = selection::sensitivity_of(vehicle, tyre, cycle, load_n, speed_mps);
 
   if (o.json) {

@@ -46,7 +46,7 @@ void run_simulate(const SimulateOptions& o) {
 
   if (tyre_sets.empty()) tyre_sets.emplace_back(std::nullopt);
   std::vector<DriveCycle> cycles;
-  for (const auto& c : o.cycles.empty() ? std::vector<std::string>{"nedc"} : o.cycles) cycles.push_back(load_cycle(c));
+  for (const auto& c : o.cycles.empty() ? std::vector<std::string>{"nedc"} : o.cycles) cycles.push_back(load_cycle_noting(c));
   for (const auto& c : cycles) inputs.push_back(c.source);
   if (!o.trace_path.empty() && tyre_sets.size() * cycles.size() > 1)
     throw InputError("--trace", "writes the time series of one run; give one --tyre and one --cycle with it");

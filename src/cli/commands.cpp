@@ -1,5 +1,7 @@
 #include "commands.hpp"
 
+#include <iostream>
+
 namespace rollsim::cli {
 
 std::vector<std::string> vehicle_input_files(const Vehicle& vehicle) {
@@ -7,6 +9,12 @@ std::vector<std::string> vehicle_input_files(const Vehicle& vehicle) {
   for (const auto* t : {&vehicle.front_tyre, &vehicle.rear_tyre})
     if (*t) files.push_back((*t)->source);
   return files;
+}
+
+DriveCycle load_cycle_noting(const std::string& name_or_path, const std::string& option) {
+  DriveCycle c = load_cycle(name_or_path, option);
+  if (const std::string note = ignored_columns_note(c); !note.empty()) std::cerr << "note: " << note << "\n";
+  return c;
 }
 
 void register_commands(CLI::App& app, const ProcessGroup& group) {

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "rollsim/common/distribute.hpp"
+#include "rollsim/cycle/drive_cycle.hpp"
 #include "rollsim/vehicle/vehicle.hpp"
 
 namespace rollsim::cli {
@@ -26,5 +27,8 @@ void register_validate_command(CLI::App& app, const ProcessGroup& group);
 
 /// The files a vehicle was read from (its file and its tyres' files), for an output's check that it is no input.
 std::vector<std::string> vehicle_input_files(const Vehicle& vehicle);
+
+/// load_cycle, and on stderr a note naming the file's columns that were not read (ignored_columns_note).
+DriveCycle load_cycle_noting(const std::string& name_or_path, const std::string& option = "--cycle");
 
 }  // namespace rollsim::cli

@@ -133,6 +133,12 @@ std::string width_mismatch(const CsvTable& t, const std::vector<std::string>& ce
   return msg;
 }
 
+// A trailing comma (an empty last field, as spreadsheets pad rows) loses nothing: such empty cells past the header's
+// named columns are dropped, in the header and in every row, by every reader alike. A value there is refused.
+void drop_trailing_empty_cells(std::vector<std::string>& cells, std::size_t keep) {
+  while (cells.size() > keep && cells.back().empty()) cells.pop_back();
+}
+
 }  // namespace
 
 CsvTable read_csv(const std::string& path, char delimiter, std::size_t max_rows, const std::string& rows_are) {
@@ -145,6 +151,7 @@ CsvTable read_csv(const std::string& path, char delimiter, std::size_t max_rows,
   std::size_t line = 1;
   std::size_t pos = 0;
   bool have_header = false;
+  std::size_t unnamed_columns = 0;  // empty names after the header's last named column (a trailing comma)
   std::size_t header_start = 0;
   while (pos < text.size()) {
     // Parse one record starting at `pos`; a record may span lines inside quotes.
@@ -209,10 +216,19 @@ CsvTable read_csv(const std::string& path, char delimiter, std::size_t max_rows,
       table.header_line = record_line;
       header_start = record_start;
       have_header = true;
+      const std::size_t width = table.header.size();
+      drop_trailing_empty_cells(table.header, 1);
+      unnamed_columns = width - table.header.size();
       refuse_other_separator(table);
       continue;
     }
     if (starts_comment(text, record_start)) refuse_comment(path, record_line, first_line_of(text, record_start));
+    drop_trailing_empty_cells(cells, table.header.size());
+    if (cells.size() > table.header.size() && cells.size() <= table.header.size() + unnamed_columns) {
+      throw InputError(path + ": line " + std::to_string(record_line),
+                       "'" + cells.back() + "' in column " + std::to_string(cells.size()) +
+                           ", which has no name in the header (line " + std::to_string(table.header_line) + ")");
+    }
     if (cells.size() != table.header.size()) {
       // A '#' header is a comment line that the header's place hid until the rows disagreed with it.
       if (table.header.front().rfind('#', 0) == 0) refuse_comment(path, table.header_line, first_line_of(text, header_start));

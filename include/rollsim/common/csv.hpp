@@ -28,9 +28,10 @@ struct CsvTable {
 };
 
 /// Reads `path`. Supports RFC 4180 quoting ("a,b" and "" inside quotes, line breaks inside quotes), CRLF
-/// line ends and a UTF-8 byte-order mark. Blank lines are skipped. Throws InputError for a missing or unreadable
-/// file, an empty file, a UTF-16 file, a one-cell header holding ';' or a tab (another separator), a comment line
-/// ('#'), an unterminated quote, a row whose cell count differs from the header (saying
+/// line ends and a UTF-8 byte-order mark. Blank lines are skipped, and so are empty cells past the header's last
+/// named column (trailing commas). Throws InputError for a missing or unreadable file, an empty file, a UTF-16
+/// file, a one-cell header holding ';' or a tab (another separator), a comment line ('#'), an unterminated
+/// quote, a value in a column the header leaves unnamed, a row whose cell count differs from the header (saying
 /// when its numbers look written with decimal commas), a file larger than kMaxCsvFileBytes (input_file.hpp) or
 /// more than `max_rows` data rows (named `rows_are`).
 CsvTable read_csv(const std::string& path, char delimiter = ',', std::size_t max_rows = SIZE_MAX,
