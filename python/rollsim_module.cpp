@@ -45,6 +45,10 @@ void warn(const std::string& text) {
 // A keyword argument as T, or the named error a command-line user would get for a malformed option.
 template <class T>
 T arg_as(py::handle x, const std::string& where, const std::string& expected) {
+  // A Python type wrapper's cast converts (py::dict from a list of pairs, or from "camry" with a ValueError): check.
+  if constexpr (std::is_base_of_v<py::object, T>) {
+    if (!py::isinstance<T>(x)) throw InputError(where, "expected " + expected);
+  }
   try {
     return x.cast<T>();
   } catch (const py::cast_error&) {
@@ -52,6 +56,70 @@ T arg_as(py::handle x, const std::string& where, const std::string& expected) {
   } catch (const py::type_error&) {  // a Python type wrapper (py::sequence, py::dict) given another type
     throw InputError(where, "expected " + expected);
   }
+}
+
+// A dict's values as json.dumps takes them: numpy scalars become Python numbers and arrays lists (what a script
+// computes with numpy; json refused them with a TypeError naming no key). Anything else is named by its key path.
+py::object plain(py::handle x, const std::string& what, const std::string& path) {
+  if (x.is_none() || py::isinstance<py::str>(x) || py::isinstance<py::bool_>(x) || py::isinstance<py::int_>(x) ||
+      py::isinstance<py::float_>(x))
+    return py::reinterpret_borrow<py::object>(x);
+  const auto np = py::module_::import("numpy");
+  if (py::isinstance(x, np.attr("generic")) || py::isinstance<py::array>(x)) {
+    if (py::isinstance(x, np.attr("ma").attr("MaskedArray")))
+      throw InputError(what + ": key '" + path + "'", "a masked array is not allowed: give plain numbers");
+    return plain(x.attr("tolist")(), what, path);  // np.float32(2.5) -> 2.5, an array -> a list
+  }
+  if (py::isinstance<py::dict>(x)) {
+    py::dict out;
+    for (auto item : x.cast<py::dict>()) {
+      const bool named = py::isinstance<py::str>(item.first) || py::isinstance<py::int_>(item.first);
+      const std::string key = py::str(item.first).cast<std::string>();
+      const std::string at = path.empty() ? key : path + "." + key;
+      if (!named) throw InputError(what + ": key '" + at + "'", "a key must be text (str)");
+      out[py::str(key)] = plain(item.second, what, at);
+    }
+    return out;
+  }
+  if (py::isinstance<py::list>(x) || py::isinstance<py::tuple>(x)) {
+    py::list out;
+    std::size_t i = 0;
+    for (auto item : x) out.append(plain(item, what, path + "[" + std::to_string(i++) + "]"));
+    return out;
+  }
+  throw InputError(what + ": key '" + path + "'",
+                   "a " + py::str(py::type::of(x).attr("__name__")).cast<std::string>() +
+                       " is not allowed: expected a number, text, a list or a dict (numpy numbers and arrays are taken)");
+}
+// The JSON text of a dict given for a YAML file (`what`: "vehicle dict"), or InputError naming `argument`.
+std::string dict_json(py::handle x, const std::string& what) { return to_json(plain(x, what, "")); }
+
+// A 1-D or scalar array of numbers. numpy's conversion would read a masked array's hidden values and a bool array as
+// 0 and 1, driving both silently.
+py::array_t<double> number_array(py::handle x, const std::string& where) {
+  const auto np = py::module_::import("numpy");
+  if (py::isinstance(x, np.attr("ma").attr("MaskedArray")) && np.attr("ma").attr("count_masked")(x).cast<long>() > 0) {
+    throw InputError(where, "a masked array with " + py::str(np.attr("ma").attr("count_masked")(x)).cast<std::string>() +
+                                " masked value(s) is not allowed: drop or fill them (.filled(), .compressed()) first");
+  }
+  py::object data;
+  try {
+    data = np.attr("ma").attr("getdata")(x);  // a plain array of what was given (of objects for anything else)
+  } catch (const py::error_already_set&) {  // e.g. a ragged list
+    throw InputError(where, "expected a number or an array of numbers");
+  }
+  if (data.attr("dtype").attr("kind").cast<std::string>() == "b")
+    throw InputError(where, "a bool array is not allowed: expected numbers");
+  auto a = py::array_t<double, py::array::forcecast>::ensure(data);
+  if (!a) throw InputError(where, "expected a number or an array of numbers");
+  return a;
+}
+
+// A Python bool (or numpy's); pybind's own conversion takes any number, 2.5 or None, as a truth value.
+bool flag(py::handle x, const std::string& where) {
+  const auto np = py::module_::import("numpy");
+  if (!py::isinstance<py::bool_>(x) && !py::isinstance(x, np.attr("bool_"))) throw InputError(where, "expected True or False");
+  return x.cast<bool>();
 }
 
 // A Python number as the text the command line would have been given (shortest round-trip form: exact).
@@ -67,34 +135,39 @@ std::string vehicle_path(py::handle v) {
   return resolve_data_file(arg_as<std::string>(v, "vehicle", kNameOrDict), "vehicles", ".yaml", "--vehicle");
 }
 Vehicle vehicle_from(py::handle v) {
-  if (py::isinstance<py::dict>(v)) return load_vehicle_text(to_json(v), "vehicle dict");
+  if (py::isinstance<py::dict>(v)) return load_vehicle_text(dict_json(v, "vehicle dict"), "vehicle dict");
   return load_vehicle_file(vehicle_path(v));
 }
 std::optional<TyreSpec> tyre_from(py::handle t) {
   if (t.is_none()) return std::nullopt;
-  if (py::isinstance<py::dict>(t)) return load_tyre_text(to_json(t), "tyre dict");
+  if (py::isinstance<py::dict>(t)) return load_tyre_text(dict_json(t, "tyre dict"), "tyre dict");
   return load_tyre_file(resolve_data_file(arg_as<std::string>(t, "tyre", kNameOrDict), "tyres", ".yaml", "--tyre"));
 }
 
 // A shipped name or CSV path; a dict of arrays named like the CSV columns (time_s, speed_kmh or speed_mps,
 // optional grade_pct or elevation_m, heading_deg, engine_on); or a pair (time_s, speed_kmh). Arrays pass the CSV
 // file's checks, their errors naming the sample index as the "line".
+DriveCycle cycle_arrays(py::handle c);
 DriveCycle cycle_from(py::handle c) {
-  if (py::isinstance<py::str>(c)) return load_cycle(c.cast<std::string>(), "--cycle");
+  const DriveCycle cycle = py::isinstance<py::str>(c) ? load_cycle(c.cast<std::string>(), "--cycle") : cycle_arrays(c);
+  if (const std::string note = ignored_columns_note(cycle); !note.empty()) warn(note);
+  return cycle;
+}
+DriveCycle cycle_arrays(py::handle c) {
   CsvTable table;
   table.file = "cycle arrays (line = sample index)";
   std::vector<py::array_t<double>> columns;
   if (py::isinstance<py::dict>(c)) {
     for (auto item : c.cast<py::dict>()) {
       table.header.push_back(arg_as<std::string>(item.first, "cycle", "column names (str) as dict keys"));
-      columns.push_back(py::array_t<double, py::array::forcecast>::ensure(item.second));
+      columns.push_back(number_array(item.second, "cycle column '" + table.header.back() + "'"));
     }
   } else {
     const py::sequence pair = arg_as<py::sequence>(c, "cycle", "a shipped name or CSV path (str), a dict of arrays, or "
                                                               "a pair (time_s, speed_kmh)");
     if (pair.size() != 2) throw InputError("cycle", "a pair (time_s, speed_kmh) of arrays is expected, or a dict of columns");
     table.header = {"time_s", "speed_kmh"};
-    for (auto a : pair) columns.push_back(py::array_t<double, py::array::forcecast>::ensure(a));
+    for (auto a : pair) columns.push_back(number_array(a, "cycle column '" + table.header[columns.size()] + "'"));
   }
   for (std::size_t k = 0; k < columns.size(); ++k) {
     if (!columns[k] || columns[k].ndim() != 1 || columns[k].size() != columns.front().size())
@@ -126,7 +199,7 @@ py::dict stack(const std::vector<py::dict>& points) {
 py::object api_tyre(py::object file, py::object size, py::object outer_radius_m, py::object width_m, py::object pressure_bar,
                 py::object load_n, py::object load_pct, py::object speed_kmh) {
   TyreRequest req;
-  if (py::isinstance<py::dict>(file)) req.file_text = to_json(file);
+  if (py::isinstance<py::dict>(file)) req.file_text = dict_json(file, "tyre dict");
   else if (!file.is_none()) req.file = arg_as<std::string>(file, "tyre", kNameOrDict);
   if (!size.is_none()) req.size = arg_as<std::string>(size, "size", "a size designation (str)");
   req.outer_radius_m = number_text(outer_radius_m, "outer_radius_m");
@@ -136,8 +209,8 @@ py::object api_tyre(py::object file, py::object size, py::object outer_radius_m,
   req.load_pct = number_text(load_pct, "load_pct");
   const TyreSpec spec = build_requested_tyre(req);
   const TyreLoadChoice load = choose_requested_load(req, spec);
-  const auto speeds = py::array_t<double, py::array::forcecast>::ensure(speed_kmh);
-  if (!speeds || speeds.ndim() > 1) throw InputError("--speed-kmh", "must be a number or a 1-D array of numbers");
+  const auto speeds = number_array(speed_kmh, "--speed-kmh");
+  if (speeds.ndim() > 1) throw InputError("--speed-kmh", "must be a number or a 1-D array of numbers");
   std::vector<py::dict> points;
   for (py::ssize_t i = 0; i < speeds.size(); ++i) {
     const double v_kmh = parse_requested_speed_kmh(format_value(speeds.data()[i]));
@@ -160,7 +233,8 @@ DriveCycle noted_cycle_from(py::handle c) {
   return d;
 }
 
-py::dict api_simulate(py::object vehicle, py::object tyre, py::object cycle, bool replay, bool trace) {
+py::dict api_simulate(py::object vehicle, py::object tyre, py::object cycle, py::object replay_arg, py::object trace_arg) {
+  const bool replay = flag(replay_arg, "replay"), trace = flag(trace_arg, "trace");
   const Vehicle base = vehicle_from(vehicle);
   const std::optional<TyreSpec> tyre_set = tyre_from(tyre);
   const DriveCycle c = noted_cycle_from(cycle);
@@ -181,10 +255,12 @@ py::dict api_simulate(py::object vehicle, py::object tyre, py::object cycle, boo
   return out;
 }
 
-py::list api_compare(py::object vehicle, std::vector<std::string> tyres, py::object cycle, py::object catalogue,
-                 double diameter_tolerance_pct) {
+py::list api_compare(py::object vehicle, py::object tyre_names, py::object cycle, py::object catalogue,
+                 py::object diameter_tolerance_pct) {
+  const auto tyres = arg_as<std::vector<std::string>>(tyre_names, "tyres", "a list of tyre files or shipped names (str)");
   selection::CompareOptions copt;
-  copt.diameter_tolerance_pct = selection::parse_diameter_tolerance_pct(format_value(diameter_tolerance_pct));
+  copt.diameter_tolerance_pct =
+      selection::parse_diameter_tolerance_pct(number_text(diameter_tolerance_pct, "diameter_tolerance_pct"));
   const selection::CandidateList list =
       selection::load_candidates(tyres, !catalogue.is_none(),
                                  catalogue.is_none() ? "" : arg_as<std::string>(catalogue, "catalogue", "a folder path (str)"));
@@ -202,8 +278,9 @@ py::list api_compare(py::object vehicle, std::vector<std::string> tyres, py::obj
   return out;
 }
 
-py::list api_sweep(py::object tyre, std::vector<py::tuple> axes, py::object load_n, double speed_kmh, py::object vehicle,
+py::list api_sweep(py::object tyre, py::object axes_arg, py::object load_n, py::object speed_kmh, py::object vehicle,
                py::object cycle, py::object threads) {
+  const auto axes = arg_as<std::vector<py::sequence>>(axes_arg, "axes", "a list of (param, from, to[, steps])");
   selection::SweepRequest req;
   for (const auto& a : axes) {
     if (a.size() < 3 || a.size() > 4) throw InputError("axes", "each axis is (param, from, to) or (param, from, to, steps)");
@@ -213,7 +290,7 @@ py::list api_sweep(py::object tyre, std::vector<py::tuple> axes, py::object load
     if (a.size() == 4) req.steps.push_back(number_text(a[3], "axes (steps)"));
   }
   req.load_n = number_text(load_n, "load_n");
-  req.speed_kmh = format_value(speed_kmh);
+  req.speed_kmh = number_text(speed_kmh, "speed_kmh");
   req.threads = number_text(threads, "threads");
   const selection::SweepOptions so = selection::sweep_options_from_request(req);
   const TyreSpec t = *tyre_from(tyre);
@@ -237,10 +314,16 @@ py::list api_sweep(py::object tyre, std::vector<py::tuple> axes, py::object load
   return out;
 }
 
-py::object api_diagnose(py::object vehicle, std::vector<std::string> recordings, py::dict columns, py::dict scales,
-                    std::string preset, py::object tyre) {
+py::object api_diagnose(py::object vehicle, py::object recording_paths, py::object columns_arg, py::object scales_arg,
+                    py::object preset_arg, py::object tyre) {
+  // A str is a sequence too: recordings='trip.csv' would have been read letter by letter.
+  if (py::isinstance<py::str>(recording_paths)) throw InputError("recordings", "expected a list of CSV paths (str), not one str");
+  const auto recordings = arg_as<std::vector<std::string>>(recording_paths, "recordings", "a list of CSV paths (str)");
+  const auto columns = arg_as<py::dict>(columns_arg, "columns", "a dict of canonical name (str) to source column (str)");
+  const auto scales = arg_as<py::dict>(scales_arg, "scales", "a dict of canonical name (str) to factor (number)");
+  const auto preset = arg_as<std::string>(preset_arg, "preset", "a preset name (str): 'anl_d3' or 'rsk_twizy'");
   YamlMap vehicle_file = py::isinstance<py::dict>(vehicle)
-                             ? YamlMap::load_text(to_json(vehicle), "vehicle dict")
+                             ? YamlMap::load_text(dict_json(vehicle, "vehicle dict"), "vehicle dict")
                              : YamlMap::load_file(vehicle_path(vehicle));
   Vehicle v = load_vehicle(vehicle_file);
   if (const auto t = tyre_from(tyre)) fit_tyres(v, *t);
@@ -268,10 +351,23 @@ py::object api_diagnose(py::object vehicle, std::vector<std::string> recordings,
   return from_json(json);
 }
 
+// py::vectorize's own mismatch error names neither argument and is no InputError.
+void check_broadcast(const py::array& a, const py::array& b, const std::string& a_name, const std::string& b_name) {
+  try {
+    py::module_::import("numpy").attr("broadcast")(a, b);
+  } catch (const py::error_already_set& e) {
+    if (!e.matches(PyExc_ValueError)) throw;
+    throw InputError(a_name + ", " + b_name, "shapes " + py::str(a.attr("shape")).cast<std::string>() + " and " +
+                                                 py::str(b.attr("shape")).cast<std::string>() +
+                                                 " do not broadcast: give arrays of one shape, or a number for either");
+  }
+}
+
 // The library's EngineMap built by the vehicle reader from a dict of the `powertrain.engine` block's keys, at each
 // (speed, torque) pair; numpy broadcasts the two, scalars give scalars.
-py::dict api_engine_map(py::dict engine, py::object speed_rpm, py::object torque_nm) {
-  const EngineMap map(read_engine_block(YamlMap::load_text(to_json(engine), "engine dict")));
+py::dict api_engine_map(py::object engine, py::object speed_rpm, py::object torque_nm) {
+  const auto block = arg_as<py::dict>(engine, "engine", "a dict with the powertrain.engine block's keys");
+  const EngineMap map(read_engine_block(YamlMap::load_text(dict_json(block, "engine dict"), "engine dict")));
   const Range rpm_range = Range::closed(0.0, 3e4), torque_range = Range::closed(0.0, 1e5);
   auto fuel = py::vectorize([&](double rpm, double torque) {
     return map.fuel_power_w(checked_number(rpm, "speed_rpm", rpm_range) * units::kRadpsPerRpm,
@@ -280,10 +376,9 @@ py::dict api_engine_map(py::dict engine, py::object speed_rpm, py::object torque
   auto full_load = py::vectorize([&](double rpm) {
     return map.max_torque_nm(checked_number(rpm, "speed_rpm", rpm_range) * units::kRadpsPerRpm);
   });
-  const auto speeds = py::array_t<double, py::array::forcecast>::ensure(speed_rpm);
-  const auto torques = py::array_t<double, py::array::forcecast>::ensure(torque_nm);
-  if (!speeds) throw InputError("speed_rpm", "must be a number or an array of numbers");
-  if (!torques) throw InputError("torque_nm", "must be a number or an array of numbers");
+  const auto speeds = number_array(speed_rpm, "speed_rpm");
+  const auto torques = number_array(torque_nm, "torque_nm");
+  check_broadcast(speeds, torques, "speed_rpm", "torque_nm");
   py::dict out;
   out["fuel_power_w"] = fuel(speeds, torques);
   out["max_torque_nm"] = full_load(speeds);
@@ -306,14 +401,16 @@ RrcPoint fit_point(py::handle p, const TyreSize& size, const std::string& where)
 
 // `rollsim tyre fit --json` through the same library steps, and the tyre file it writes as a dict (for
 // simulate(tyre=...)); the file itself only when `output` is given.
-py::dict api_tyre_fit(const std::string& size, py::object points, py::object label, py::object j2452,
+py::dict api_tyre_fit(py::object size_arg, py::object points, py::object label, py::object j2452,
                       py::object drum_radius_m, py::object free, py::object rrc_uncertainty_pct, py::object pressure_bar,
-                      const std::string& name, py::object output) {
+                      py::object name_arg, py::object output) {
+  const auto size = arg_as<std::string>(size_arg, "size", "a size designation (str)");
+  const auto name = arg_as<std::string>(name_arg, "name", "the tyre's name (str)");
   TyreFitInputs in;
   in.size = parse_tyre_size(size, "size");
   if (!points.is_none()) {
     std::size_t i = 0;
-    for (const auto p : points) {
+    for (const auto p : arg_as<py::sequence>(points, "points", "a list of points")) {
       in.points.push_back(fit_point(p, in.size, "points[" + std::to_string(i) + "]"));
       ++i;
     }
@@ -365,9 +462,9 @@ py::dict api_tyre_fit(const std::string& size, py::object points, py::object lab
   return out;
 }
 
-py::dict api_sensitivity(py::object tyre, py::object vehicle, py::object cycle, py::object load_n, double speed_kmh) {
-  const double speed_mps =
-      units::kmh_to_mps(parse_option_number(format_value(speed_kmh), "--speed-kmh", Range::open_low(0.0, 500.0)));
+py::dict api_sensitivity(py::object tyre, py::object vehicle, py::object cycle, py::object load_n, py::object speed_kmh) {
+  const double speed_mps = units::kmh_to_mps(
+      parse_option_number(number_text(speed_kmh, "speed_kmh"), "--speed-kmh", Range::open_low(0.0, 500.0)));
   std::optional<Vehicle> v;
   if (!vehicle.is_none()) v = vehicle_from(vehicle);
   const std::optional<TyreSpec> t = tyre_from(tyre);
@@ -383,7 +480,8 @@ py::dict api_sensitivity(py::object tyre, py::object vehicle, py::object cycle, 
   return from_json(selection::sensitivity_json(s).str());
 }
 
-py::dict api_validate(const std::string& list, py::object threads) {
+py::dict api_validate(py::object list_arg, py::object threads) {
+  const auto list = arg_as<std::string>(list_arg, "epa_test_car_list", "a CSV path (str)");
   const unsigned n = threads.is_none() ? 0u
                                        : static_cast<unsigned>(parse_option_count(number_text(threads, "threads"), "threads",
                                                                                    Range::closed(1, 1024)));
@@ -441,7 +539,7 @@ replay: kinematic replay instead of driver + CVODE. Returns {'summary': dict (th
 aec_kwh_per_10km or fuel_l_per_100km, energy_breakdown_kwh, ...), 'trace': dict of numpy arrays (the --trace
 columns: time_s, speed_kmh, rolling_force_n, battery_power_kw, ...; empty with trace=False)}.)");
 
-  m.def("compare", &api_compare, "vehicle"_a, "tyres"_a = std::vector<std::string>{}, "cycle"_a = "nedc",
+  m.def("compare", &api_compare, "vehicle"_a, "tyres"_a = py::list(), "cycle"_a = "nedc",
         "catalogue"_a = py::none(), "diameter_tolerance_pct"_a = 3.0,
         R"(Tyre selection (`rollsim compare --json`): the car on the cycle with each tyre on all four wheels.
 

@@ -570,5 +570,93 @@ TEST_F(OutsideTesting, TheMendsOwnReviewFindings) {
   EXPECT_TRUE(has(r.err, "warning: at 2 of 2 points the battery charged past full")) << r.err;
 }
 
+// Session 17's outside testing of real users' input files (/work/notes/s17-inputs.md): each test below failed on the
+// session's starting binary.
+
+// U2: a semicolon, tab or decimal-comma file was blamed on a misspelt column or on its first decimal's line.
+TEST_F(OutsideTesting, AnotherSeparatorOrADecimalCommaIsNamed) {
+  const std::string semi = write("semi.csv", "time_s;speed_kmh\n0;0\n1;1,5\n2;3\n");
+  expect_refused("simulate --vehicle ev --cycle '" + semi + "'",
+                 semi + ": line 1: the header holds ';' and no comma: the file looks semicolon-separated (perhaps with "
+                        "decimal commas); rollsim reads comma-separated CSV with a decimal point (1.5)");
+  const std::string tabs = write("tabs.csv", "time_s\tspeed_kmh\n0\t0\n1\t3\n");
+  expect_refused("simulate --vehicle ev --cycle '" + tabs + "'", tabs + ": line 1: the header holds tabs and no comma: the file looks tab-separated");
+  const std::string comma = write("comma.csv", "time_s,speed_kmh\n0,0\n1,1,5\n2,3\n");
+  expect_refused("simulate --vehicle ev --cycle '" + comma + "'",
+                 comma + ": line 3: has 3 cells but the header (line 1) has 2 columns: 'time_s', 'speed_kmh'; the numbers "
+                         "look written with decimal commas (1,5): rollsim reads comma-separated CSV with a decimal point (1.5)");
+  const std::string quoted = write("quoted.csv", "time_s,speed_kmh\n0,0\n1,\"1,5\"\n");
+  expect_refused("simulate --vehicle ev --cycle '" + quoted + "'",
+                 "line 3, column 'speed_kmh': '1,5' is not a number; rollsim reads a decimal point (1.5), not a decimal comma");
+  const std::string rec = write("rec.csv", "Time[s];Eng_FuelFlow_Direct_DI[ccps];Dyno_Spd[mph]\n0,0;0,0;0,0\n");
+  expect_refused("diagnose --vehicle camry_2018 --preset anl_d3 --recording '" + rec + "'",
+                 rec + ": line 1: the header holds ';' and no comma: the file looks semicolon-separated");
+}
+
+// U6: Excel's "Unicode text" (UTF-16) was read as UTF-8 and the message showed mojibake.
+TEST_F(OutsideTesting, AUtf16FileIsNamed) {
+  auto utf16 = [](const std::string& ascii, bool bom) {
+    std::string out = bom ? std::string("\xFF\xFE", 2) : std::string();
+    for (char c : ascii) out += std::string(1, c) + std::string(1, '\0');
+    return out;
+  };
+  const std::string text = "time_s,speed_kmh\r\n0,0\r\n1,3\r\n";
+  const std::string with_bom = write("bom.csv", utf16(text, true));
+  expect_refused("simulate --vehicle ev --cycle '" + with_bom + "'",
+                 with_bom + ": the file is UTF-16 (a UTF-16 byte-order mark; Excel's \"Unicode text\"); rollsim reads "
+                            "UTF-8: save it as \"CSV UTF-8 (comma delimited)\"");
+  const std::string no_bom = write("nobom.csv", utf16(text, false));
+  expect_refused("simulate --vehicle ev --cycle '" + no_bom + "'",
+                 no_bom + ": line 1: holds a NUL byte: the file looks UTF-16 (or binary)");
+}
+
+// U7: a '#' line was read as the header or reported as a short row, without the rule.
+TEST_F(OutsideTesting, CommentLinesAreRefusedByName) {
+  const std::string top = write("top.csv", "# WLTC class 3b exported from tool X\ntime_s,speed_kmh\n0,0\n1,3\n");
+  expect_refused("simulate --vehicle ev --cycle '" + top + "'",
+                 top + ": line 1: '# WLTC class 3b exported from tool X' is a comment line; comment lines are not allowed");
+  const std::string end = write("end.csv", "time_s,speed_kmh\n0,0\n1,3\n# end of cycle\n");
+  expect_refused("simulate --vehicle ev --cycle '" + end + "'", end + ": line 4: '# end of cycle' is a comment line");
+  std::string rows = slurp(kCamryUdds) + "# logger stopped\n";
+  const std::string rec = write("rec.csv", rows);
+  expect_refused("diagnose --vehicle camry_2018 --preset anl_d3 --recording '" + rec + "'", "'# logger stopped' is a comment line");
+}
+
+// I1: a cycle refused the extra columns (phase, gear) and trailing commas that the recording reader accepts. Now
+// every reader drops trailing empty cells, and a cycle ignores other columns, saying so, but not one named like a
+// cycle column (a misspelt grade would drive a flat road).
+TEST_F(OutsideTesting, CyclesIgnoreOtherColumnsAndTrailingCommasLikeRecordings) {
+  fs::create_directories(dir_ / "a");
+  fs::create_directories(dir_ / "b");
+  fs::create_directories(dir_ / "c");
+  const std::string plain = write("a/c.csv", "time_s,speed_kmh\n0,0\n10,36\n50,36\n60,0\n");
+  const std::string extra = write("b/c.csv", "time_s,speed_kmh,phase,gear\n0,0,low,1\n10,36,low,3\n50,36,low,3\n60,0,low,1\n");
+  const std::string trailing = write("c/c.csv", "time_s,speed_kmh,\n0,0,\n10,36\n50,36,,\n60,0,\n");
+  const CmdResult a = run_rollsim("simulate --vehicle ev --cycle '" + plain + "' --json");
+  const CmdResult b = run_rollsim("simulate --vehicle ev --cycle '" + extra + "' --json");
+  const CmdResult c = run_rollsim("simulate --vehicle ev --cycle '" + trailing + "' --json");
+  ASSERT_EQ(a.exit_code, 0) << a.err;
+  ASSERT_EQ(b.exit_code, 0) << b.err;
+  ASSERT_EQ(c.exit_code, 0) << c.err;
+  auto no_source = [](std::string out) { return std::regex_replace(out, std::regex(R"([abc]/c\.csv)"), "c.csv"); };
+  EXPECT_EQ(no_source(b.out), no_source(a.out));
+  EXPECT_EQ(no_source(c.out), no_source(a.out));
+  EXPECT_TRUE(has(b.err, "note: " + extra + ": columns 'phase', 'gear' not read; cycle columns are time_s")) << b.err;
+  EXPECT_FALSE(has(c.err, "note:")) << c.err;
+  const std::string cased = write("cased.csv", "time_s,speed_kmh,Grade_pct\n0,0,5\n1,3,5\n");
+  expect_refused("simulate --vehicle ev --cycle '" + cased + "'",
+                 "unknown column 'Grade_pct' (misspelt?); allowed: time_s, speed_kmh or speed_mps");
+  const std::string unnamed = write("unnamed.csv", "time_s,speed_kmh,\n0,0,\n1,3,7\n");
+  expect_refused("simulate --vehicle ev --cycle '" + unnamed + "'",
+                 unnamed + ": line 3: '7' in column 3, which has no name in the header (line 1)");
+  // A recording whose data rows (not its header) end with a comma was refused as too wide.
+  std::string rec_rows;
+  std::istringstream in(slurp(kCamryUdds));
+  for (std::string line; std::getline(in, line);) rec_rows += line + (rec_rows.empty() ? "\n" : ",\n");
+  const std::string rec = write("rec.csv", rec_rows);
+  const CmdResult r = run_rollsim("diagnose --vehicle camry_2018 --preset anl_d3 --recording '" + rec + "'");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+}
+
 }  // namespace
 }  // namespace rollsim::test

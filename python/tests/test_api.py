@@ -361,5 +361,84 @@ class InputErrors(unittest.TestCase):
                     call()
 
 
+class Session17Inputs(unittest.TestCase):
+    """Session 17's outside testing of real users' inputs (/work/notes/s17-inputs.md); each failed on the module of the
+    session's start."""
+
+    @classmethod
+    def setUpClass(cls):
+        import yaml
+        with open(REPO / "vehicles" / "ev.yaml") as f:
+            cls.ev = yaml.safe_load(f)
+        cls.short = ([0.0, 10.0, 50.0, 60.0], [0.0, 36.0, 36.0, 0.0])
+
+    def aec(self, **kw):
+        return rollsim.simulate(trace=False, **kw)["summary"]["aec_kwh_per_10km"]
+
+    def test_numpy_scalars_in_a_dict_are_numbers(self):
+        # U4: TypeError "Object of type float32 is not JSON serializable", naming no key.
+        import copy
+        base = self.aec(vehicle=self.ev, cycle=self.short)
+        for value in (np.float32(1631), np.int64(1631), np.array(1631.0)):
+            vd = copy.deepcopy(self.ev)
+            vd["body"]["test_mass_kg"] = value
+            self.assertEqual(self.aec(vehicle=vd, cycle=self.short), base, msg=type(value).__name__)
+        tyre = {"size": "165/65 R15 81T", "pressure_bar": 2.5}
+        self.assertEqual(self.aec(tyre={**tyre, "pressure_bar": np.float32(2.5)}, cycle=self.short),
+                         self.aec(tyre=tyre, cycle=self.short))
+        vd = copy.deepcopy(self.ev)
+        vd["body"]["test_mass_kg"] = np.bool_(True)  # a number key given a truth value: the reader's own error
+        with self.assertRaisesRegex(rollsim.InputError, "vehicle dict: key 'body.test_mass_kg': 'true' is not a number"):
+            self.aec(vehicle=vd, cycle=self.short)
+        vd["body"]["test_mass_kg"] = {1631}
+        with self.assertRaisesRegex(rollsim.InputError, "vehicle dict: key 'body.test_mass_kg': a set is not allowed"):
+            self.aec(vehicle=vd, cycle=self.short)
+
+    def test_wrong_shapes_are_input_errors_naming_the_argument(self):
+        # U5: raw pybind errors (RuntimeError from vectorize, TypeError "incompatible function arguments").
+        engine = {"displacement_l": 2.0, "gross_indicated_efficiency": 0.42, "friction_mep_bar": 0.6,
+                  "pumping_mep_closed_throttle_bar": 0.8, "unthrottled_imep_bar": 10.0, "idle_speed_rpm": 750,
+                  "rated_speed_rpm": 6000, "max_speed_rpm": 6500, "max_torque_nm": 200, "max_power_kw": 110}
+        recording = os.path.join(SHARED, "data", "recordings", "anl_d3_2018_toyota_camry", "61811012_test_data.csv")
+        cases = [
+            (r"speed_rpm, torque_nm: shapes \(3,\) and \(2,\) do not broadcast",
+             lambda: rollsim.engine_map(engine, np.array([2000, 3000, 4000]), np.array([100, 150]))),
+            ("engine: expected a dict", lambda: rollsim.engine_map("camry", 2000, 100)),
+            ("recordings: expected a list of CSV paths", lambda: rollsim.diagnose(vehicle="camry_2018", recordings=recording)),
+            ("preset: expected", lambda: rollsim.diagnose(vehicle="camry_2018", recordings=[recording], preset=None)),
+            ("tyres: expected a list", lambda: rollsim.compare("ev", tyres="nominal")),
+            ("replay: expected True or False", lambda: rollsim.simulate(replay=1)),
+            ("size: expected", lambda: rollsim.tyre_fit(205, label="B")),
+            ("axes: expected", lambda: rollsim.sweep("175-70R14", ("pressure", 1, 2))),
+            ("speed_kmh: expected a number", lambda: rollsim.sensitivity("175-70R14", speed_kmh="80")),
+        ]
+        for expected, call in cases:
+            with self.subTest(expected=expected):
+                with self.assertRaisesRegex(rollsim.InputError, expected):
+                    call()
+
+    def test_masked_and_bool_arrays_are_refused(self):
+        # S10: the mask was ignored (its hidden value driven) and a bool array drove a 0/1 km/h trace.
+        t, v = np.array(self.short[0]), np.array(self.short[1])
+        masked = np.ma.masked_array(v, mask=[False, True, False, False])
+        with self.assertRaisesRegex(rollsim.InputError, "cycle column 'speed_kmh': a masked array with 1 masked value"):
+            self.aec(cycle=(t, masked))
+        with self.assertRaisesRegex(rollsim.InputError, "cycle column 'speed_kmh': a bool array is not allowed"):
+            self.aec(cycle=(t, v > 20))
+        with self.assertRaisesRegex(rollsim.InputError, "--speed-kmh: a bool array"):
+            rollsim.tyre("175-70R14", speed_kmh=np.array([True, False]))
+        # Nothing masked: the data is the trace.
+        self.assertEqual(self.aec(cycle=(t, np.ma.masked_array(v))), self.aec(cycle=(t, v)))
+
+    def test_other_cycle_columns_are_ignored_with_a_warning(self):
+        # I1: as in a cycle CSV, a column that is no cycle column is not read, and said.
+        t, v = self.short
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            got = self.aec(cycle={"time_s": t, "speed_kmh": v, "gear": [1, 3, 3, 1]})
+        self.assertEqual(got, self.aec(cycle=(t, v)))
+        self.assertTrue(any("column 'gear' not read" in str(w.message) for w in caught), [str(w.message) for w in caught])
+
+
 if __name__ == "__main__":
     unittest.main()

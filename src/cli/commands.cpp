@@ -13,6 +13,7 @@ std::vector<std::string> vehicle_input_files(const Vehicle& vehicle) {
 
 DriveCycle load_cycle_noted(const std::string& name_or_path, const std::string& option) {
   DriveCycle c = load_cycle(name_or_path, option);
+  if (const std::string note = ignored_columns_note(c); !note.empty()) std::cerr << "note: " << note << "\n";
   for (const auto& n : c.notes) std::cerr << "warning: " << n << "\n";
   return c;
 }

@@ -28,7 +28,8 @@ void register_validate_command(CLI::App& app, const ProcessGroup& group);
 /// The files a vehicle was read from (its file and its tyres' files), for an output's check that it is no input.
 std::vector<std::string> vehicle_input_files(const Vehicle& vehicle);
 
-/// load_cycle, with what the trace holds that a user should hear of (DriveCycle::notes) said on stderr.
-DriveCycle load_cycle_noted(const std::string& name_or_path, const std::string& option);
+/// load_cycle, and on stderr what the user should hear of it: a note naming the file's columns that were not read
+/// (ignored_columns_note) and a warning for each of DriveCycle::notes (a long interval driven while moving).
+DriveCycle load_cycle_noted(const std::string& name_or_path, const std::string& option = "--cycle");
 
 }  // namespace rollsim::cli

@@ -40,6 +40,15 @@ std::optional<double> parse_number(const std::string& text) {
   return value;
 }
 
+std::string not_a_number(const std::string& cell) {
+  std::string point = cell;
+  const auto comma = point.find(',');
+  if (comma != std::string::npos) point[comma] = '.';
+  const bool decimal_comma = comma != std::string::npos && parse_number(point).has_value();
+  return "'" + cell + "' is not a number" +
+         (decimal_comma ? "; rollsim reads a decimal point (" + point + "), not a decimal comma" : std::string());
+}
+
 std::optional<std::size_t> CsvTable::column(const std::string& name) const {
   std::optional<std::size_t> found;
   for (std::size_t i = 0; i < header.size(); ++i) {
@@ -61,8 +70,80 @@ std::string CsvTable::where(std::size_t row, std::size_t col) const {
   return file + ": line " + std::to_string(row_line.at(row)) + ", column '" + header.at(col) + "'";
 }
 
+namespace {
+
+// Excel's "Unicode text" and some loggers write UTF-16: every other byte is NUL, and read as UTF-8 the first
+// message would show mojibake. Said once, at the file, with the way out.
+void refuse_utf16(const std::string& path, const std::string& text) {
+  const bool bom = text.size() >= 2 && ((text[0] == '\xFF' && text[1] == '\xFE') || (text[0] == '\xFE' && text[1] == '\xFF'));
+  const auto nul = text.find('\0');
+  if (!bom && nul == std::string::npos) return;
+  const std::string line = std::to_string(1 + std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(bom ? 0 : nul), '\n'));
+  throw InputError(path + (bom ? "" : ": line " + line),
+                   bom ? "the file is UTF-16 (a UTF-16 byte-order mark; Excel's \"Unicode text\"); rollsim reads UTF-8: save "
+                         "it as \"CSV UTF-8 (comma delimited)\""
+                       : "holds a NUL byte: the file looks UTF-16 (or binary); rollsim reads UTF-8 text: save it as "
+                         "\"CSV UTF-8 (comma delimited)\"");
+}
+
+// A one-cell header holding ';' or a tab is a file with another separator (Excel writes ';' where the decimal mark
+// is a comma). Reading it as one column would blame a misspelt column or the first decimal, far from the cause.
+void refuse_other_separator(const CsvTable& t) {
+  if (t.header.size() != 1) return;
+  const std::string& h = t.header.front();
+  const bool semicolon = h.find(';') != std::string::npos;
+  if (!semicolon && h.find('\t') == std::string::npos) return;
+  throw InputError(t.file + ": line " + std::to_string(t.header_line),
+                   "the header holds " + std::string(semicolon ? "';'" : "tabs") + " and no comma: the file looks " +
+                       (semicolon ? "semicolon" : "tab") +
+                       "-separated (perhaps with decimal commas); rollsim reads comma-separated CSV with a decimal point "
+                       "(1.5): save it with ',' between cells and '.' as the decimal mark");
+}
+
+// No reader has a comment convention; a '#' line would be read as the header or as a short row.
+bool starts_comment(const std::string& text, std::size_t at) {
+  const auto first = text.find_first_not_of(" \t", at);
+  return first != std::string::npos && text[first] == '#';
+}
+
+std::string first_line_of(const std::string& text, std::size_t at) {
+  const auto end = text.find_first_of("\r\n", at);
+  return trim(text.substr(at, end == std::string::npos ? std::string::npos : end - at));
+}
+
+[[noreturn]] void refuse_comment(const std::string& path, std::size_t line, const std::string& text) {
+  throw InputError(path + ": line " + std::to_string(line),
+                   "'" + text + "' is a comment line; comment lines are not allowed (a header line, then data rows): delete it");
+}
+
+bool looks_integer(const std::string& cell) {
+  const std::size_t start = (!cell.empty() && (cell[0] == '-' || cell[0] == '+')) ? 1 : 0;
+  return cell.size() > start && std::all_of(cell.begin() + static_cast<std::ptrdiff_t>(start), cell.end(),
+                                            [](unsigned char c) { return std::isdigit(c); });
+}
+
+// A row wider than its header, every cell a whole number: most likely "1,5" written for 1.5.
+std::string width_mismatch(const CsvTable& t, const std::vector<std::string>& cells) {
+  std::string msg = "has " + std::to_string(cells.size()) + " cells but the header (line " + std::to_string(t.header_line) +
+                    ") has " + std::to_string(t.header.size()) + " columns: " + t.columns_list();
+  if (cells.size() > t.header.size() && std::all_of(cells.begin(), cells.end(), looks_integer)) {
+    msg += "; the numbers look written with decimal commas (1,5): rollsim reads comma-separated CSV with a decimal "
+           "point (1.5)";
+  }
+  return msg;
+}
+
+// A trailing comma (an empty last field, as spreadsheets pad rows) loses nothing: such empty cells past the header's
+// named columns are dropped, in the header and in every row, by every reader alike. A value there is refused.
+void drop_trailing_empty_cells(std::vector<std::string>& cells, std::size_t keep) {
+  while (cells.size() > keep && cells.back().empty()) cells.pop_back();
+}
+
+}  // namespace
+
 CsvTable read_csv(const std::string& path, char delimiter, std::size_t max_rows, const std::string& rows_are) {
   std::string text = read_input_file(path, kMaxCsvFileBytes);
+  refuse_utf16(path, text);
   if (text.size() >= 3 && text.compare(0, 3, "\xEF\xBB\xBF") == 0) text.erase(0, 3);
 
   CsvTable table;
@@ -70,9 +151,12 @@ CsvTable read_csv(const std::string& path, char delimiter, std::size_t max_rows,
   std::size_t line = 1;
   std::size_t pos = 0;
   bool have_header = false;
+  std::size_t unnamed_columns = 0;  // empty names after the header's last named column (a trailing comma)
+  std::size_t header_start = 0;
   while (pos < text.size()) {
     // Parse one record starting at `pos`; a record may span lines inside quotes.
     const std::size_t record_line = line;
+    const std::size_t record_start = pos;
     std::vector<std::string> cells;
     std::string cell;
     bool in_quotes = false;
@@ -130,14 +214,25 @@ CsvTable read_csv(const std::string& path, char delimiter, std::size_t max_rows,
     if (!have_header) {
       table.header = std::move(cells);
       table.header_line = record_line;
+      header_start = record_start;
       have_header = true;
+      const std::size_t width = table.header.size();
+      drop_trailing_empty_cells(table.header, 1);
+      unnamed_columns = width - table.header.size();
+      refuse_other_separator(table);
       continue;
     }
-    if (cells.size() != table.header.size()) {
+    if (starts_comment(text, record_start)) refuse_comment(path, record_line, first_line_of(text, record_start));
+    drop_trailing_empty_cells(cells, table.header.size());
+    if (cells.size() > table.header.size() && cells.size() <= table.header.size() + unnamed_columns) {
       throw InputError(path + ": line " + std::to_string(record_line),
-                       "has " + std::to_string(cells.size()) + " cells but the header (line " +
-                           std::to_string(table.header_line) + ") has " + std::to_string(table.header.size()) +
-                           " columns: " + table.columns_list());
+                       "'" + cells.back() + "' in column " + std::to_string(cells.size()) +
+                           ", which has no name in the header (line " + std::to_string(table.header_line) + ")");
+    }
+    if (cells.size() != table.header.size()) {
+      // A '#' header is a comment line that the header's place hid until the rows disagreed with it.
+      if (table.header.front().rfind('#', 0) == 0) refuse_comment(path, table.header_line, first_line_of(text, header_start));
+      throw InputError(path + ": line " + std::to_string(record_line), width_mismatch(table, cells));
     }
     if (table.rows.size() == max_rows) {
       throw InputError(path + ": line " + std::to_string(record_line),

@@ -178,7 +178,30 @@ std::vector<std::string> moving_gap_notes(const CsvTable& table, const DriveCycl
   return out;
 }
 
+bool is_cycle_column(const std::string& h) {
+  return h == "time_s" || h == "speed_kmh" || h == "speed_mps" || h == "grade_pct" || h == "elevation_m" ||
+         h == "heading_deg" || h == "engine_on";
+}
+
+// Exports carry more columns than a cycle (phase, gear, distance), ignored as a recording's are. A name that
+// resembles a cycle column is refused instead: 'Grade_pct' or 'grade_deg' ignored would drive a flat road, and
+// 'Time_s' beside time_s would hide which one the user meant.
+bool resembles_cycle_column(const std::string& h) {
+  const std::string l = lower_ascii(h);
+  for (const char* stem : {"time", "speed", "veloc", "grade", "slope", "elev", "alt", "height", "head", "engine"})
+    if (l.find(stem) != std::string::npos) return true;
+  return false;
+}
+
 }  // namespace
+
+std::string ignored_columns_note(const DriveCycle& c) {
+  if (c.ignored_columns.empty()) return "";
+  std::string list;
+  for (std::size_t i = 0; i < c.ignored_columns.size(); ++i) list += (i ? ", " : "") + c.ignored_columns[i];
+  return c.source + ": " + (c.ignored_columns.size() == 1 ? "column " : "columns ") + list +
+         " not read; cycle columns are time_s, speed_kmh or speed_mps, grade_pct or elevation_m, heading_deg, engine_on";
+}
 
 DriveCycle cycle_from_table(const CsvTable& table, const std::string& name) {
   const std::string& path = table.file;
@@ -191,12 +214,17 @@ DriveCycle cycle_from_table(const CsvTable& table, const std::string& name) {
     throw InputError(path + ": line " + std::to_string(table.header_line),
                      "holds numbers, but the first line must be a header naming the columns (" + allowed + ")");
   }
+  std::vector<std::string> ignored;
   for (std::size_t i = 0; i < table.header.size(); ++i) {
     const std::string& h = table.header[i];
-    if (h != "time_s" && h != "speed_kmh" && h != "speed_mps" && h != "grade_pct" && h != "elevation_m" && h != "heading_deg" &&
-        h != "engine_on") {
-      throw InputError(path + ": line " + std::to_string(table.header_line) + ", column " + std::to_string(i + 1),
-                       "unknown column '" + h + "' (misspelt?); allowed: " + allowed + "; " + found);
+    if (!is_cycle_column(h)) {
+      if (resembles_cycle_column(h)) {
+        throw InputError(path + ": line " + std::to_string(table.header_line) + ", column " + std::to_string(i + 1),
+                         "unknown column '" + h + "' (misspelt?); allowed: " + allowed +
+                             "; other columns are ignored, but not one named like these; " + found);
+      }
+      ignored.push_back(h.empty() ? "column " + std::to_string(i + 1) + " (no name)" : "'" + h + "'");
+      continue;
     }
     for (std::size_t j = 0; j < i; ++j) {
       if (table.header[j] == h) {
@@ -224,7 +252,7 @@ DriveCycle cycle_from_table(const CsvTable& table, const std::string& name) {
     const std::string& cell = table.rows[row][col];
     if (cell.empty()) throw InputError(table.where(row, col), "is empty; expected a number");
     const auto v = parse_number(cell);
-    if (!v) throw InputError(table.where(row, col), "'" + cell + "' is not a number");
+    if (!v) throw InputError(table.where(row, col), not_a_number(cell));
     if (!std::isfinite(*v)) throw InputError(table.where(row, col), "'" + cell + "' is not allowed: must be a finite number");
     return *v;
   };
@@ -232,6 +260,7 @@ DriveCycle cycle_from_table(const CsvTable& table, const std::string& name) {
   DriveCycle c;
   c.name = name;
   c.source = path;
+  c.ignored_columns = std::move(ignored);
   const std::size_t n = table.rows.size();
   c.time_s.resize(n);
   c.speed_mps.resize(n);

@@ -342,7 +342,7 @@ Recording load_recording(const std::string& path, const ColumnMapping& mapping) 
       const std::string& cell = table.rows[r][col];
       if (is_missing(cell)) continue;
       const auto v = parse_number(cell);
-      if (!v) throw InputError(table.where(r, col), "'" + cell + "' is not a number");
+      if (!v) throw InputError(table.where(r, col), not_a_number(cell));
       if (!std::isfinite(*v)) throw InputError(table.where(r, col), "'" + cell + "' is not allowed: must be finite");
       ch.values[r] = *v * scale;
     }

@@ -28,15 +28,21 @@ struct CsvTable {
 };
 
 /// Reads `path`. Supports RFC 4180 quoting ("a,b" and "" inside quotes, line breaks inside quotes), CRLF
-/// line ends and a UTF-8 byte-order mark. Blank lines are skipped. Throws InputError for a missing or
-/// unreadable file, an empty file, an unterminated quote, or a row whose cell count differs from the header,
-/// a file larger than kMaxCsvFileBytes (input_file.hpp) or more than `max_rows` data rows (named `rows_are`).
+/// line ends and a UTF-8 byte-order mark. Blank lines are skipped, and so are empty cells past the header's last
+/// named column (trailing commas). Throws InputError for a missing or unreadable file, an empty file, a UTF-16
+/// file, a one-cell header holding ';' or a tab (another separator), a comment line ('#'), an unterminated
+/// quote, a value in a column the header leaves unnamed, a row whose cell count differs from the header (saying
+/// when its numbers look written with decimal commas), a file larger than kMaxCsvFileBytes (input_file.hpp) or
+/// more than `max_rows` data rows (named `rows_are`).
 CsvTable read_csv(const std::string& path, char delimiter = ',', std::size_t max_rows = SIZE_MAX,
                   const std::string& rows_are = "rows");
 
 /// Parses a whole cell as a number (surrounding spaces allowed, nothing else). Returns nullopt for text
 /// that is not a number. "nan" and "inf" parse (to NaN and infinity) so callers can reject them by name.
 std::optional<double> parse_number(const std::string& text);
+
+/// "'x' is not a number", saying so when the cell is a number written with a decimal comma ('1,5').
+std::string not_a_number(const std::string& cell);
 
 /// Trims spaces and tabs at both ends.
 std::string trim(const std::string& text);

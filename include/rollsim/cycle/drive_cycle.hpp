@@ -31,6 +31,9 @@ struct DriveCycle {
   /// What the file holds that a user should hear of, though it is allowed (one line each, no "warning:" prefix):
   /// a long interval between samples of a moving car, which the linear interpolation drives as if it were there.
   std::vector<std::string> notes;
+  /// Columns of the file that are not cycle columns (a table's phase, gear), quoted ('phase'), in file order: not
+  /// read, and said (ignored_columns_note), so no output implies that they were used.
+  std::vector<std::string> ignored_columns;
 
   bool engine_off_at(std::size_t segment) const { return segment < engine_off.size() && engine_off[segment]; }
   bool any_engine_off() const;
@@ -67,9 +70,14 @@ std::vector<std::string> shipped_cycle_names();
 /// `grade_pct` (percent, within +-30) or `elevation_m` (converted to grade over travelled distance); optionally
 /// `heading_deg` (direction of travel, clockwise from north, [0, 360]: wind_heading reads it) and `engine_on` (1, or
 /// 0 where the engine is switched off over the segment from that sample, standing only: no fuel, a cold engine
-/// cools). Any bad value throws InputError naming file, line, column, the value and the allowed range.
+/// cools). Other columns are ignored (DriveCycle::ignored_columns), unless named like a cycle column (time, speed,
+/// grade, elevation, altitude, heading, engine in any case): those are refused as misspellings. Any bad value
+/// throws InputError naming file, line, column, the value and the allowed range.
 /// `option` names where the name came from in error messages (e.g. "--cycle").
 DriveCycle load_cycle(const std::string& name_or_path, const std::string& option = "--cycle");
+
+/// "FILE: columns 'phase', 'gear' not read (...)" for a cycle with ignored columns (a note for stderr), else "".
+std::string ignored_columns_note(const DriveCycle& cycle);
 
 /// Reads a cycle CSV at `path` (no name lookup); `name` becomes DriveCycle::name.
 DriveCycle read_cycle_csv(const std::string& path, const std::string& name);
