@@ -526,5 +526,14 @@ TEST_F(OutsideTesting, TheMendsOwnReviewFindings) {
   EXPECT_TRUE(has(r.err, "warning: at 2 of 2 points the battery charged past full")) << r.err;
 }
 
+// Session 17's outside test of real users' input files (notes/s17-inputs.md), each refused at the key that is wrong.
+
+// U3: a tab in the indentation gave yaml-cpp's "illegal map value" alone.
+TEST_F(OutsideTesting, ATabIndentedYamlLineIsNamed) {
+  const std::string tyre = write("tab.yaml", "size: \"185/65 R15 88H\"\npressure_bar: 2.5\nmodel:\n\tcoulomb_damping_n: 170\n");
+  expect_refused("tyre '" + tyre + "' --load-n 4000",
+                 tyre + ": line 4: malformed YAML: illegal map value; line 4 is indented with a tab, and YAML allows only spaces");
+}
+
 }  // namespace
 }  // namespace rollsim::test
