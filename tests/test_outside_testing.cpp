@@ -528,6 +528,15 @@ TEST_F(OutsideTesting, TheMendsOwnReviewFindings) {
 
 // Session 17's outside test of real users' input files (notes/s17-inputs.md), each refused at the key that is wrong.
 
+// S2: `tyres: {all: A, front: B}` drove four A tyres; B was dropped without a word.
+TEST_F(OutsideTesting, AllBesideFrontOrRearIsRefused) {
+  for (const char* axle : {"front", "rear"}) {
+    const std::string car = write(std::string(axle) + ".yaml", shipped_vehicle_with("ev.yaml", "all: nominal.yaml",
+                                                                                    "all: nominal.yaml\n  " + std::string(axle) + ": low-rrc.yaml"));
+    expect_refused("simulate --vehicle '" + car + "'", car + ": key 'tyres." + axle + "': not allowed together with 'all': give 'all'");
+  }
+}
+
 // U3: a tab in the indentation gave yaml-cpp's "illegal map value" alone.
 TEST_F(OutsideTesting, ATabIndentedYamlLineIsNamed) {
   const std::string tyre = write("tab.yaml", "size: \"185/65 R15 88H\"\npressure_bar: 2.5\nmodel:\n\tcoulomb_damping_n: 170\n");

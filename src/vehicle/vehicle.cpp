@@ -212,6 +212,13 @@ Vehicle load_vehicle(YamlMap root) {
   root.accept("sources");
   v.body = read_body(root.map("body"));
   if (auto t = root.optional_map("tyres")) {
+    // `all` beside `front` or `rear` would leave one of them unused: which tyre did the user mean?
+    for (const char* axle : {"front", "rear"}) {
+      if (t->has("all") && t->has(axle)) {
+        throw InputError(t->where(axle), "not allowed together with 'all': give 'all' (one tyre on all four wheels) or "
+                                         "'front' and 'rear' (one per axle), not both");
+      }
+    }
     if (t->has("all")) {
       v.front_tyre = load_tyre_named(t->string("all"), *t, "all");
       v.rear_tyre = v.front_tyre;
