@@ -537,6 +537,21 @@ TEST_F(OutsideTesting, AllBesideFrontOrRearIsRefused) {
   }
 }
 
+// S6: body.wheel_radius_m beside tyres was read and ignored (the tyres gear the car). A coast-down car diagnosed with
+// --tyre is written back with the key commented out, so that the written file loads.
+TEST_F(OutsideTesting, AWheelRadiusBesideTyresIsRefused) {
+  const std::string car = write("wr.yaml", shipped_vehicle_with("ice.yaml", "  drag_coefficient:", "  wheel_radius_m: 0.5\n  drag_coefficient:"));
+  expect_refused("simulate --vehicle '" + car + "'",
+                 car + ": key 'body.wheel_radius_m': 0.5 m is not allowed beside tyres: the tyres gear the car");
+  const fs::path out = dir_ / "fitted.yaml";
+  const CmdResult r = run_rollsim("diagnose --vehicle camry_2018 --preset anl_d3 --recording '" + kCamryUdds +
+                                  "' --tyre catalogue/215-55R17 --write-vehicle '" + out.string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(has(slurp(out), "# wheel_radius_m: 0.33")) << slurp(out);
+  const CmdResult again = run_rollsim("simulate --vehicle '" + out.string() + "'");
+  EXPECT_EQ(again.exit_code, 0) << again.err;
+}
+
 // U3: a tab in the indentation gave yaml-cpp's "illegal map value" alone.
 TEST_F(OutsideTesting, ATabIndentedYamlLineIsNamed) {
   const std::string tyre = write("tab.yaml", "size: \"185/65 R15 88H\"\npressure_bar: 2.5\nmodel:\n\tcoulomb_damping_n: 170\n");

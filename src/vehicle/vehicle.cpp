@@ -46,6 +46,15 @@ BodyParams read_body(YamlMap m) {
   return b;
 }
 
+// With tyres, the driven tyre's rolling radius gears the car; a wheel radius beside them would be read and ignored,
+// and a user who copied it from a coast-down car would believe the gearing used it.
+[[noreturn]] void reject_wheel_radius_beside_tyres(const Vehicle& v, const std::string& where) {
+  const TyreSpec& driven = v.body.driven_axle == DrivenAxle::rear ? *v.rear_tyre : *v.front_tyre;
+  throw InputError(where, format_value(v.body.wheel_radius_m) + " m is not allowed beside tyres: the tyres gear the car "
+                          "(the driven tyre '" + driven.name + "', outer radius " + fixed(driven.state.geometry.outer_radius_m, 3) +
+                          " m); wheel_radius_m is only for a car without tyres (coast-down road load): remove it, or the tyres");
+}
+
 CoastdownParams read_coastdown(YamlMap m) {
   CoastdownParams c;
   const bool us = m.has("a_lbf") || m.has("b_lbf_per_mph") || m.has("c_lbf_per_mph2");
@@ -210,7 +219,8 @@ Vehicle load_vehicle(YamlMap root) {
   v.name = root.string_or("name", std::filesystem::path(path).stem().string());
   root.accept("description");
   root.accept("sources");
-  v.body = read_body(root.map("body"));
+  const YamlMap body = root.map("body");
+  v.body = read_body(body);
   if (auto t = root.optional_map("tyres")) {
     // `all` beside `front` or `rear` would leave one of them unused: which tyre did the user mean?
     for (const char* axle : {"front", "rear"}) {
@@ -231,6 +241,7 @@ Vehicle load_vehicle(YamlMap root) {
     t->accept("rear");
     t->finish();
   }
+  if (v.front_tyre && body.has("wheel_radius_m")) reject_wheel_radius_beside_tyres(v, body.where("wheel_radius_m"));
   if (auto c = root.optional_map("coastdown")) v.coastdown = read_coastdown(*c);
   if (!v.front_tyre && !v.coastdown)
     throw InputError(root.where("tyres"), "a vehicle needs tyres (tyres: {all: FILE}) or coastdown coefficients");
