@@ -552,6 +552,24 @@ TEST_F(OutsideTesting, AWheelRadiusBesideTyresIsRefused) {
   EXPECT_EQ(again.exit_code, 0) << again.err;
 }
 
+// S7: tyre-file unit slips inside the old bounds gave absurd operating points (0.25 bar, a 237 mm deflection).
+TEST_F(OutsideTesting, TyreFileUnitSlipsAreRefusedNamingTheLikelyUnit) {
+  const std::string size = "size: \"185/65 R15 88H\"\n";
+  const std::string mpa = write("mpa.yaml", size + "pressure_bar: 0.25\n");
+  expect_refused("tyre '" + mpa + "' --load-n 4000", mpa + ": key 'pressure_bar': 0.25 bar is not allowed for a passenger tyre "
+                                                     "('185/65 R15 88H'): must be in [1, 5] bar");
+  expect_refused("tyre '" + mpa + "' --load-n 4000", "is it in MPa? (0.25 MPa = 2.5 bar)");
+  const std::string psi = write("psi.yaml", size + "pressure_bar: 19\n");
+  expect_refused("tyre '" + psi + "' --load-n 4000", "is it in psi? (19 psi = 1.31 bar)");
+  const std::string newtons = write("n.yaml", "outer_radius_m: 0.305\nsection_width_m: 0.195\npressure_bar: 2.1\nmax_load_kg: 6031\n");
+  expect_refused("tyre '" + newtons + "'", newtons + ": key 'max_load_kg': a rated load of 6031 kg would deflect the tyre by");
+  expect_refused("tyre '" + newtons + "'", "is it in N? (6031 N = 615 kg)");
+  const std::string pounds = write("lb.yaml", "size: \"205/55 R16 91V\"\npressure_bar: 2.3\nmax_load_kg: 1356\n");
+  expect_refused("tyre '" + pounds + "'", pounds + ": key 'max_load_kg': 1356 kg is not allowed for '205/55 R16 91V', whose load "
+                                                   "index 91 rates it 615 kg");
+  expect_refused("tyre '" + pounds + "'", "is it in lb? (1356 lb = 615.1 kg)");
+}
+
 // U3: a tab in the indentation gave yaml-cpp's "illegal map value" alone.
 TEST_F(OutsideTesting, ATabIndentedYamlLineIsNamed) {
   const std::string tyre = write("tab.yaml", "size: \"185/65 R15 88H\"\npressure_bar: 2.5\nmodel:\n\tcoulomb_damping_n: 170\n");

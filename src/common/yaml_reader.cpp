@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "rollsim/common/error.hpp"
+#include "rollsim/common/format.hpp"
 #include "rollsim/common/input_file.hpp"
 
 namespace rollsim {
@@ -282,6 +283,15 @@ int parse_option_count(const std::string& text, const std::string& option, Range
   const double v = parse_option_number(text, option, range);
   if (v != std::floor(v)) throw InputError(option, "'" + text + "' is not a whole number; " + range.describe());
   return static_cast<int>(v);
+}
+
+std::string unit_slip_hint(double v, Range fits, const std::string& unit, std::initializer_list<UnitSlip> slips) {
+  for (const UnitSlip& s : slips) {
+    const double converted = v * s.factor;
+    if (fits.contains(converted))
+      return "; is it in " + std::string(s.unit) + "? (" + format_value(v) + " " + s.unit + " = " + significant(converted, 4) + " " + unit + ")";
+  }
+  return "";
 }
 
 double checked_number(double v, const std::string& where, Range range) {
