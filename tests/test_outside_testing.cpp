@@ -570,6 +570,35 @@ TEST_F(OutsideTesting, TyreFileUnitSlipsAreRefusedNamingTheLikelyUnit) {
   expect_refused("tyre '" + pounds + "'", "is it in lb? (1356 lb = 615.1 kg)");
 }
 
+// S8/U1: vehicle unit slips were accepted, or blamed on another key (a mass in tonnes on rotating_mass_kg or on the
+// tyre model's constants, a voltage in kV on the battery's resistance). The key that is wrong is named first.
+TEST_F(OutsideTesting, VehicleUnitSlipsAreNamedAtTheirOwnKey) {
+  struct Slip {
+    const char* from;
+    const char* to;
+    const char* message;
+  };
+  for (const Slip& s : {Slip{"test_mass_kg: 1631", "test_mass_kg: 1.631", "key 'body.test_mass_kg': 1.631 kg is not allowed: no "
+                                                                            "four-wheeled road vehicle is that light"},
+                        Slip{"test_mass_kg: 1631", "test_mass_kg: 1.631", "is it in t? (1.631 t = 1631 kg)"},
+                        Slip{"frontal_area_m2: 2.30", "frontal_area_m2: 19.5", "is it in ft^2? (19.5 ft^2 = 1.812 m^2)"},
+                        Slip{"open_circuit_voltage_v: 360", "open_circuit_voltage_v: 0.36",
+                             "key 'powertrain.battery.open_circuit_voltage_v': 0.36 V is not allowed"},
+                        Slip{"aux_power_w: 600", "aux_power_w: 0.6", "key 'powertrain.aux_power_w': 0.6 W is not allowed"},
+                        Slip{"usable_capacity_kwh: 21.3", "usable_capacity_kwh: 0.0213", "is it in MWh? (0.0213 MWh = 21.3 kWh)"}}) {
+    const std::string car = write("slip.yaml", shipped_vehicle_with("ev.yaml", s.from, s.to));
+    expect_refused("simulate --vehicle '" + car + "'", s.message);
+  }
+  // Merely implausible values run, with a warning naming the key.
+  const std::string lb = write("lb.yaml", shipped_vehicle_with("ev.yaml", "test_mass_kg: 1631", "test_mass_kg: 3596"));
+  CmdResult r = run_rollsim("simulate --vehicle '" + lb + "'");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(has(r.err, "exceeds its rated maximum 6031 N; is body.test_mass_kg in lb? (3596 lb = 1631 kg)")) << r.err;
+  const std::string soc = write("soc.yaml", shipped_vehicle_with("ev.yaml", "initial_soc_pct: 95", "initial_soc_pct: 0.95"));
+  r = run_rollsim("simulate --vehicle '" + soc + "'");
+  EXPECT_TRUE(has(r.err, "warning: " + soc + ": key 'powertrain.battery.initial_soc_pct': 0.95 % is a battery all but empty")) << r.err;
+}
+
 // U3: a tab in the indentation gave yaml-cpp's "illegal map value" alone.
 TEST_F(OutsideTesting, ATabIndentedYamlLineIsNamed) {
   const std::string tyre = write("tab.yaml", "size: \"185/65 R15 88H\"\npressure_bar: 2.5\nmodel:\n\tcoulomb_damping_n: 170\n");
