@@ -658,5 +658,85 @@ TEST_F(OutsideTesting, CyclesIgnoreOtherColumnsAndTrailingCommasLikeRecordings) 
   EXPECT_EQ(r.exit_code, 0) << r.err;
 }
 
+// Session 17's outside test of real users' input files (notes/s17-inputs.md), each refused at the key that is wrong.
+
+// S2: `tyres: {all: A, front: B}` drove four A tyres; B was dropped without a word.
+TEST_F(OutsideTesting, AllBesideFrontOrRearIsRefused) {
+  for (const char* axle : {"front", "rear"}) {
+    const std::string car = write(std::string(axle) + ".yaml", shipped_vehicle_with("ev.yaml", "all: nominal.yaml",
+                                                                                    "all: nominal.yaml\n  " + std::string(axle) + ": low-rrc.yaml"));
+    expect_refused("simulate --vehicle '" + car + "'", car + ": key 'tyres." + axle + "': not allowed together with 'all': give 'all'");
+  }
+}
+
+// S6: body.wheel_radius_m beside tyres was read and ignored (the tyres gear the car). A coast-down car diagnosed with
+// --tyre is written back with the key commented out, so that the written file loads.
+TEST_F(OutsideTesting, AWheelRadiusBesideTyresIsRefused) {
+  const std::string car = write("wr.yaml", shipped_vehicle_with("ice.yaml", "  drag_coefficient:", "  wheel_radius_m: 0.5\n  drag_coefficient:"));
+  expect_refused("simulate --vehicle '" + car + "'",
+                 car + ": key 'body.wheel_radius_m': 0.5 m is not allowed beside tyres: the tyres gear the car");
+  const fs::path out = dir_ / "fitted.yaml";
+  const CmdResult r = run_rollsim("diagnose --vehicle camry_2018 --preset anl_d3 --recording '" + kCamryUdds +
+                                  "' --tyre catalogue/215-55R17 --write-vehicle '" + out.string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(has(slurp(out), "# wheel_radius_m: 0.33")) << slurp(out);
+  const CmdResult again = run_rollsim("simulate --vehicle '" + out.string() + "'");
+  EXPECT_EQ(again.exit_code, 0) << again.err;
+}
+
+// S7: tyre-file unit slips inside the old bounds gave absurd operating points (0.25 bar, a 237 mm deflection).
+TEST_F(OutsideTesting, TyreFileUnitSlipsAreRefusedNamingTheLikelyUnit) {
+  const std::string size = "size: \"185/65 R15 88H\"\n";
+  const std::string mpa = write("mpa.yaml", size + "pressure_bar: 0.25\n");
+  expect_refused("tyre '" + mpa + "' --load-n 4000", mpa + ": key 'pressure_bar': 0.25 bar is not allowed for a passenger tyre "
+                                                     "('185/65 R15 88H'): must be in [1, 5] bar");
+  expect_refused("tyre '" + mpa + "' --load-n 4000", "is it in MPa? (0.25 MPa = 2.5 bar)");
+  const std::string psi = write("psi.yaml", size + "pressure_bar: 19\n");
+  expect_refused("tyre '" + psi + "' --load-n 4000", "is it in psi? (19 psi = 1.31 bar)");
+  const std::string newtons = write("n.yaml", "outer_radius_m: 0.305\nsection_width_m: 0.195\npressure_bar: 2.1\nmax_load_kg: 6031\n");
+  expect_refused("tyre '" + newtons + "'", newtons + ": key 'max_load_kg': a rated load of 6031 kg would deflect the tyre by");
+  expect_refused("tyre '" + newtons + "'", "is it in N? (6031 N = 615 kg)");
+  const std::string pounds = write("lb.yaml", "size: \"205/55 R16 91V\"\npressure_bar: 2.3\nmax_load_kg: 1356\n");
+  expect_refused("tyre '" + pounds + "'", pounds + ": key 'max_load_kg': 1356 kg is not allowed for '205/55 R16 91V', whose load "
+                                                   "index 91 rates it 615 kg");
+  expect_refused("tyre '" + pounds + "'", "is it in lb? (1356 lb = 615.1 kg)");
+}
+
+// S8/U1: vehicle unit slips were accepted, or blamed on another key (a mass in tonnes on rotating_mass_kg or on the
+// tyre model's constants, a voltage in kV on the battery's resistance). The key that is wrong is named first.
+TEST_F(OutsideTesting, VehicleUnitSlipsAreNamedAtTheirOwnKey) {
+  struct Slip {
+    const char* from;
+    const char* to;
+    const char* message;
+  };
+  for (const Slip& s : {Slip{"test_mass_kg: 1631", "test_mass_kg: 1.631", "key 'body.test_mass_kg': 1.631 kg is not allowed: no "
+                                                                            "four-wheeled road vehicle is that light"},
+                        Slip{"test_mass_kg: 1631", "test_mass_kg: 1.631", "is it in t? (1.631 t = 1631 kg)"},
+                        Slip{"frontal_area_m2: 2.30", "frontal_area_m2: 19.5", "is it in ft^2? (19.5 ft^2 = 1.812 m^2)"},
+                        Slip{"open_circuit_voltage_v: 360", "open_circuit_voltage_v: 0.36",
+                             "key 'powertrain.battery.open_circuit_voltage_v': 0.36 V is not allowed"},
+                        Slip{"aux_power_w: 600", "aux_power_w: 0.6", "key 'powertrain.aux_power_w': 0.6 W is not allowed"},
+                        Slip{"usable_capacity_kwh: 21.3", "usable_capacity_kwh: 0.0213", "is it in MWh? (0.0213 MWh = 21.3 kWh)"}}) {
+    const std::string car = write("slip.yaml", shipped_vehicle_with("ev.yaml", s.from, s.to));
+    expect_refused("simulate --vehicle '" + car + "'", s.message);
+  }
+  // Merely implausible values run, with a warning naming the key.
+  const std::string lb = write("lb.yaml", shipped_vehicle_with("ev.yaml", "test_mass_kg: 1631", "test_mass_kg: 3596"));
+  CmdResult r = run_rollsim("simulate --vehicle '" + lb + "'");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(has(r.err, "exceeds its rated maximum 6031 N; is body.test_mass_kg in lb? (3596 lb = 1631 kg)")) << r.err;
+  const std::string soc = write("soc.yaml", shipped_vehicle_with("ev.yaml", "initial_soc_pct: 95", "initial_soc_pct: 0.95"));
+  r = run_rollsim("simulate --vehicle '" + soc + "'");
+  EXPECT_TRUE(has(r.err, "warning: " + soc + ": key 'powertrain.battery.initial_soc_pct': 0.95 % is a battery all but empty")) << r.err;
+}
+
+// U3: a tab in the indentation gave yaml-cpp's "illegal map value" alone.
+TEST_F(OutsideTesting, ATabIndentedYamlLineIsNamed) {
+  const std::string tyre = write("tab.yaml", "size: \"185/65 R15 88H\"\npressure_bar: 2.5\nmodel:\n\tcoulomb_damping_n: 170\n");
+  expect_refused("tyre '" + tyre + "' --load-n 4000",
+                 tyre + ": line 4: malformed YAML: illegal map value; line 4 is indented with a tab, and YAML allows only spaces");
+}
+
 }  // namespace
 }  // namespace rollsim::test

@@ -248,6 +248,21 @@ TEST(TyreFile, BadFilesNameFileKeyValueAndWhatIsAllowed) {
   }
 }
 
+// Plausibility by the size's class (ETRTO/ISO): what a real tyre of the class runs at loads, a unit slip does not.
+TEST(TyreFile, PressureAndRatingArePlausibleForTheTyresClass) {
+  EXPECT_EQ(load_error("lt", "size: \"LT245/75 R16 120/116S\"\npressure_bar: 5.5\n"), "");
+  EXPECT_EQ(load_error("truck", "size: \"315/80 R22.5\"\npressure_bar: 9\n"), "");
+  EXPECT_EQ(load_error("geometry", "outer_radius_m: 0.5\nsection_width_m: 0.3\npressure_bar: 9\n"), "");
+  EXPECT_EQ(load_error("spare", "size: \"125/70 R16\"\npressure_bar: 4.2\n"), "");
+  EXPECT_EQ(load_error("low", "size: \"205/55 R16 91V\"\npressure_bar: 1.2\n"), "");
+  EXPECT_EQ(load_error("rating", "size: \"205/55 R16 91V\"\npressure_bar: 2.3\nmax_load_kg: 650\n"), "");
+  EXPECT_TRUE(contains(load_error("car", "size: \"205/55 R16 91V\"\npressure_bar: 5.5\n"), "must be in [1, 5] bar"));
+  EXPECT_TRUE(contains(load_error("ltpsi", "size: \"LT245/75 R16 120/116S\"\npressure_bar: 10\n"), "must be in [1, 8] bar"));
+  EXPECT_TRUE(contains(load_error("truckmpa", "size: \"315/80 R22.5\"\npressure_bar: 0.85\n"), "is it in MPa? (0.85 MPa = 8.5 bar)"));
+  EXPECT_TRUE(contains(load_error("index", "size: \"175/70 R14\"\npressure_bar: 2.1\nload_index: 84\nmodel:\n"
+                                           "  stiffness_pressure_coeff: 0.00001\n"), "key 'load_index': a rated load of 500 kg"));
+}
+
 TEST(TyreFile, DeflectionReachingTheRimIsRejected) {
   // 175/70 R14: sidewall 122.5 mm; at 2.1 bar Kz is about 190 N/mm, so 30 kN deflects ~158 mm: past the rim
   // but still inside the outer radius (300 mm). Without the rim the model would accept it.

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "rollsim/common/error.hpp"
+#include "rollsim/common/format.hpp"
 #include "rollsim/common/input_file.hpp"
 
 namespace rollsim {
@@ -60,6 +61,20 @@ void check_keys(const YAML::Node& node, const std::string& path, std::size_t& vi
   }
 }
 
+// The first line up to `line` (from 1) whose indentation holds a tab, or 0. YAML forbids tabs in indentation, and
+// yaml-cpp's own message for them ("illegal map value") does not say so.
+int tab_indented_line(const std::string& text, int line) {
+  std::size_t start = 0;
+  for (int n = 1; n <= line && start <= text.size(); ++n) {
+    const std::size_t end = std::min(text.find('\n', start), text.size());
+    const std::size_t indent_end = text.find_first_not_of(" \t", start);
+    const bool content = indent_end < end && text[indent_end] != '#';  // blank and comment lines are not indentation
+    if (content && text.find('\t', start) < indent_end) return n;
+    start = end + 1;
+  }
+  return 0;
+}
+
 }  // namespace
 
 std::string Range::describe_for(double v) const {
@@ -77,7 +92,11 @@ YamlMap YamlMap::load_text(const std::string& text, const std::string& path) {
   try {
     root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
-    throw InputError(path + ": line " + std::to_string(e.mark.line + 1), "malformed YAML: " + e.msg);
+    const int line = e.mark.line + 1;
+    const int tab = tab_indented_line(text, line);
+    throw InputError(path + ": line " + std::to_string(line),
+                     "malformed YAML: " + e.msg +
+                         (tab ? "; line " + std::to_string(tab) + " is indented with a tab, and YAML allows only spaces for indentation" : ""));
   }
   if (!root.IsMap()) throw InputError(path, "expected a YAML mapping of keys to values at the top level");
   std::size_t visited = 0;
@@ -281,6 +300,15 @@ int parse_option_count(const std::string& text, const std::string& option, Range
   const double v = parse_option_number(text, option, range);
   if (v != std::floor(v)) throw InputError(option, "'" + text + "' is not a whole number; " + range.describe());
   return static_cast<int>(v);
+}
+
+std::string unit_slip_hint(double v, Range fits, const std::string& unit, std::initializer_list<UnitSlip> slips) {
+  for (const UnitSlip& s : slips) {
+    const double converted = v * s.factor;
+    if (fits.contains(converted))
+      return "; is it in " + std::string(s.unit) + "? (" + format_value(v) + " " + s.unit + " = " + significant(converted, 4) + " " + unit + ")";
+  }
+  return "";
 }
 
 double checked_number(double v, const std::string& where, Range range) {

@@ -11,7 +11,8 @@ VehicleRun run_vehicle(const Vehicle& base, const std::optional<TyreSpec>& tyre,
     fit_tyres(run.vehicle, *tyre);
     run.tyre_label = tyre->name;
   }
-  run.warnings = check_tyre_loads(run.vehicle, tyre ? "--tyre '" + tyre->source + "'" : base.source);
+  run.warnings = base.warnings;
+  for (auto& w : check_tyre_loads(run.vehicle, tyre ? "--tyre '" + tyre->source + "'" : base.source)) run.warnings.push_back(w);
   const VehicleModel model = VehicleModel::assemble(run.vehicle);
   try {
     run.result = replay ? simulate_replay(model, cycle, options) : simulate_forward(model, cycle, options);

@@ -1,14 +1,17 @@
 #include "rollsim/tyre/tyre_spec.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <initializer_list>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "rollsim/common/error.hpp"
+#include "rollsim/common/format.hpp"
 #include "rollsim/common/units.hpp"
 #include "rollsim/common/yaml_reader.hpp"
 
@@ -191,6 +194,68 @@ void read_model_map(YamlMap& m, TyreState& state) {
   m.finish();
 }
 
+// Inflation a tyre of the size's class can run at (ETRTO / ISO): passenger tyres about 1.5-3.5 bar (a temporary
+// spare 4.2), light-truck up to about 6.5 (load range F), truck and bus up to 9-10. The bounds are wider than these
+// and only catch a value in another unit: 0.25 typed in MPa, 19 typed in psi.
+struct PressureClass {
+  const char* name;
+  double max_bar;
+  const char* usual;
+};
+
+PressureClass pressure_class(const std::optional<TyreSize>& size) {
+  const bool half_inch_rim = size && std::fmod(std::round(size->rim_diameter_m / units::kMPerInch * 10.0), 10.0) == 5.0;
+  if (size && size->prefix == SizePrefix::light_truck) return {"a light-truck (LT) tyre", 8.0, "about 3-6.5 bar"};
+  if (half_inch_rim) return {"a tyre on a truck rim (17.5, 19.5, 22.5 in)", 10.0, "about 6-9 bar"};
+  if (size) return {"a passenger tyre", 5.0, "about 1.5-3.5 bar, a temporary spare 4.2"};
+  return {"a road vehicle's tyre", 10.0, "passenger 1.5-3.5 bar, light truck up to 6.5, truck up to 9-10"};
+}
+
+constexpr double kMinPlausibleBar = 1.0;  // below, a road tyre is flat: the sidewall carries the car
+constexpr double kPaPerPsi = 6894.757;
+
+void check_pressure_plausible(double bar, const std::optional<TyreSize>& size, const std::string& where) {
+  const PressureClass c = pressure_class(size);
+  if (bar >= kMinPlausibleBar && bar <= c.max_bar) return;
+  const std::string of = size ? " ('" + size->designation + "')" : "";
+  throw InputError(where, format_value(bar) + " bar is not allowed for " + c.name + of + ": must be in [" + format_value(kMinPlausibleBar) +
+                              ", " + format_value(c.max_bar) + "] bar (such tyres run at " + c.usual + ")" +
+                              unit_slip_hint(bar, Range::closed(kMinPlausibleBar, c.max_bar), "bar", {{"MPa", 10.0}, {"psi", kPaPerPsi / 1e5}}));
+}
+
+constexpr double kKgPerLb = 0.45359237;
+
+// An explicit max_load_kg against the load index of the size: the index is the tyre's rating, so a value more than
+// half again above or below it is another unit (newtons, pounds, tonnes), not another rating.
+void check_rating_against_index(double max_kg, const TyreSize& size, const std::string& where) {
+  const double index_kg = *load_index_max_load_kg(*size.load_index);
+  const double lo = index_kg / 1.5, hi = index_kg * 1.5;
+  if (max_kg >= lo && max_kg <= hi) return;
+  throw InputError(where, format_value(max_kg) + " kg is not allowed for '" + size.designation + "', whose load index " +
+                              std::to_string(*size.load_index) + " rates it " + format_value(index_kg) + " kg: must be in [" +
+                              significant(lo, 4) + ", " + significant(hi, 4) + "] kg" +
+                              unit_slip_hint(max_kg, Range::closed(lo, hi), "kg", {{"N", 1.0 / units::kStandardGravity_mps2}, {"lb", kKgPerLb}, {"t", 1e3}}));
+}
+
+// At its rated load a tyre deflects about 15-25 % of its section height (the shipped tyres 9-26 %, at 2.5 bar or
+// their own pressure if higher, as ETRTO rates standard-load tyres); half of it is beyond any tyre's rating. Without
+// a rim the height is bounded by the outer radius less the smallest rim's (8 in).
+void check_rated_deflection(const TyreSpec& spec, const std::string& where, bool given_in_kg) {
+  TyreState rated = spec.state;
+  rated.pressure_pa = std::max(rated.pressure_pa, units::bar_to_pa(2.5));
+  const auto& g = rated.geometry;
+  const double height_m = g.rim_radius_m > 0.0 ? g.outer_radius_m - g.rim_radius_m : std::max(g.outer_radius_m - 4.0 * units::kMPerInch, g.outer_radius_m / 2.0);
+  const double kz = vertical_stiffness_n_per_m(rated);
+  const double deflection_m = spec.max_load_n / kz;
+  if (!(deflection_m > 0.5 * height_m)) return;
+  const double max_kg = spec.max_load_n / units::kStandardGravity_mps2, allowed_kg = 0.5 * height_m * kz / units::kStandardGravity_mps2;
+  throw InputError(where, "a rated load of " + format_value(std::round(max_kg)) + " kg would deflect the tyre by " + fixed(deflection_m * 1e3, 1) +
+                              " mm at " + significant(units::pa_to_bar(rated.pressure_pa), 3) + " bar, " + fixed(100.0 * deflection_m / height_m, 0) +
+                              " % of its section height (" + fixed(height_m * 1e3, 0) + " mm); tyres deflect about 15-25 % at their rating: " +
+                              "allowed at most 50 %, a rating below " + significant(allowed_kg, 4) + " kg" +
+                              (given_in_kg ? unit_slip_hint(max_kg, Range::closed(0.0, allowed_kg), "kg", {{"N", 1.0 / units::kStandardGravity_mps2}, {"lb", kKgPerLb}}) : ""));
+}
+
 const char* kFormat =
     "expected a size designation like '205/55 R16 91V' ([P|LT]width/aspect [Z]R rim [load index][speed symbol] "
     "[XL|Reinforced])";
@@ -342,7 +407,9 @@ TyreSpec load_tyre(YamlMap y) {
                                        format_value(g.outer_radius_m) + " m: the rim must be inside the tyre");
   }
 
-  spec.state.pressure_pa = units::bar_to_pa(y.number("pressure_bar", Range::open_low(0.0, 20.0)));
+  const double pressure_bar = y.number("pressure_bar", Range::open_low(0.0, 20.0));
+  check_pressure_plausible(pressure_bar, spec.size, y.where("pressure_bar"));
+  spec.state.pressure_pa = units::bar_to_pa(pressure_bar);
 
   const auto max_kg = opt_number(y, "max_load_kg", Range::open_low(0.0, 20000.0));
   const auto li = opt_number(y, "load_index", Range::closed(kFirstLoadIndex, kLastLoadIndex));
@@ -359,6 +426,7 @@ TyreSpec load_tyre(YamlMap y) {
     spec.max_load_n = *load_index_max_load_kg(*spec.size->load_index) * units::kStandardGravity_mps2;
   }
 
+  if (max_kg && spec.size && spec.size->load_index) check_rating_against_index(*max_kg, *spec.size, y.where("max_load_kg"));
   if (y.has("model") && y.node()["model"].IsScalar()) {
     spec.state.model = model_kind(y.string("model"), y.where("model"));
     if (spec.state.model == TyreModelKind::Hysteresis) {
@@ -368,6 +436,10 @@ TyreSpec load_tyre(YamlMap y) {
     }
   } else if (auto m = opt_map(y, "model")) {
     read_model_map(*m, spec.state);
+  }
+  if (spec.max_load_n > 0.0) {
+    const std::string rating_key = max_kg ? "max_load_kg" : li ? "load_index" : "size";
+    check_rated_deflection(spec, y.where(rating_key), max_kg.has_value());
   }
   y.finish();
   return spec;

@@ -110,7 +110,7 @@ ConventionalPowertrainParams read_engine_map_powertrain(YamlMap& pt) {
   p.engine = read_engine_block(pt.map("engine"));
   p.transmission = read_transmission(pt.map("transmission"), p.engine.max_torque_nm);
   p.fuel = read_fuel(pt.map("fuel"));
-  p.aux_power_w = pt.number_or("aux_power_w", 0.0, Range::closed(0.0, 1e5));
+  p.aux_power_w = read_aux_power_w(pt);
   p.alternator_efficiency = pt.number_or("alternator_efficiency", 1.0, Range::efficiency());
   return p;
 }

@@ -9,6 +9,9 @@ namespace rollsim {
 /// A `fuel:` block: density, lower heating value and CO2 per kg, in the file's units.
 FuelParams read_fuel(YamlMap m);
 
+/// `aux_power_w` of a powertrain block [W]: 0 (left out) or a road vehicle's electrical load, at least 10 W.
+double read_aux_power_w(YamlMap& pt);
+
 /// `powertrain: {type: engine_map, ...}`: an engine with a fuel map (EngineMap) behind a transmission that picks
 /// its own ratio (ConventionalPowertrain). Every key in the file's units, each with its bounds.
 ConventionalPowertrainParams read_engine_map_powertrain(YamlMap& pt);

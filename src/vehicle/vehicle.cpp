@@ -23,12 +23,26 @@ TyreSpec load_tyre_named(const std::string& name, const YamlMap& m, const std::s
   return load_tyre_file(resolve_tyre_path(name, m.file(), m.where(key)));
 }
 
+// A value no road vehicle has (from a 350 kg quadricycle to a 60 t road train) is a unit slip. It is refused at its
+// own key, naming what is physical and the unit it would fit in, before a check combining it with another key
+// (rotating mass, the tyres' domain, the battery's power) would blame that key instead.
+double for_road_vehicle(const YamlMap& m, const std::string& key, double v, Range physical, const std::string& unit,
+                        const std::string& why, std::initializer_list<UnitSlip> slips) {
+  if (physical.contains(v)) return v;
+  throw InputError(m.where(key), format_value(v) + " " + unit + " is not allowed: " + why + "; " + physical.describe() +
+                                     " " + unit + unit_slip_hint(v, physical, unit, slips));
+}
+
 BodyParams read_body(YamlMap m) {
   BodyParams b;
   b.test_mass_kg = m.number("test_mass_kg", Range::open_low(0.0, 1e5));
+  for_road_vehicle(m, "test_mass_kg", b.test_mass_kg, Range::closed(100.0, 1e5), "kg",
+                   "no four-wheeled road vehicle is that light (a light quadricycle with its driver weighs 350 kg or more)", {{"t", 1e3}});
   b.rotating_mass_kg = m.number_or("rotating_mass_kg", 0.0, Range::closed(0.0, b.test_mass_kg));
   b.drag_coefficient = m.number("drag_coefficient", Range::open_low(0.0, 2.0));
   b.frontal_area_m2 = m.number("frontal_area_m2", Range::open_low(0.0, 20.0));
+  for_road_vehicle(m, "frontal_area_m2", b.frontal_area_m2, Range::open_low(0.0, 12.0), "m^2",
+                   "no road vehicle is that large in front (2.6 m wide and 4.6 m high at most: 12 m^2)", {{"ft^2", 0.09290304}});
   b.air_density_kg_per_m3 = m.number_or("air_density_kg_per_m3", 1.2, Range::open_low(0.0, 2.0));
   b.front_axle_load_fraction = m.number_or("front_axle_load_fraction", 0.5, Range::fraction());
   const std::string axle = m.string_or("driven_axle", "front");
@@ -44,6 +58,15 @@ BodyParams read_body(YamlMap m) {
   b.wheel_radius_m = m.number_or("wheel_radius_m", 0.0, Range::closed(0.0, 1.0));
   m.finish();
   return b;
+}
+
+// With tyres, the driven tyre's rolling radius gears the car; a wheel radius beside them would be read and ignored,
+// and a user who copied it from a coast-down car would believe the gearing used it.
+[[noreturn]] void reject_wheel_radius_beside_tyres(const Vehicle& v, const std::string& where) {
+  const TyreSpec& driven = v.body.driven_axle == DrivenAxle::rear ? *v.rear_tyre : *v.front_tyre;
+  throw InputError(where, format_value(v.body.wheel_radius_m) + " m is not allowed beside tyres: the tyres gear the car "
+                          "(the driven tyre '" + driven.name + "', outer radius " + fixed(driven.state.geometry.outer_radius_m, 3) +
+                          " m); wheel_radius_m is only for a car without tyres (coast-down road load): remove it, or the tyres");
 }
 
 CoastdownParams read_coastdown(YamlMap m) {
@@ -81,7 +104,7 @@ void check_battery_carries_no_load(const ElectricPowertrainParams& p, const std:
                                        significant(voc * voc / (4.0 * needed_w), 3) + " ohm");
 }
 
-ElectricPowertrainParams read_electric(YamlMap& pt) {
+ElectricPowertrainParams read_electric(YamlMap& pt, std::vector<std::string>& warnings) {
   ElectricPowertrainParams p;
   {
     YamlMap m = pt.map("motor");
@@ -105,10 +128,20 @@ ElectricPowertrainParams read_electric(YamlMap& pt) {
   {
     YamlMap m = pt.map("battery");
     p.battery.open_circuit_voltage_v = m.number("open_circuit_voltage_v", Range::open_low(0.0, 2000.0));
+    for_road_vehicle(m, "open_circuit_voltage_v", p.battery.open_circuit_voltage_v, Range::closed(2.0, 2000.0), "V",
+                     "below a single cell's voltage (2-4 V); a traction battery has tens to hundreds of volts", {{"kV", 1e3}});
     p.battery.internal_resistance_ohm = m.number("internal_resistance_ohm", Range::closed(0.0, 100.0));
     resistance_key = m.where("internal_resistance_ohm");
-    p.battery.usable_capacity_j = units::kwh_to_j(m.number("usable_capacity_kwh", Range::open_low(0.0, 1e4)));
+    const double capacity_kwh = m.number("usable_capacity_kwh", Range::open_low(0.0, 1e4));
+    for_road_vehicle(m, "usable_capacity_kwh", capacity_kwh, Range::closed(0.1, 1e4), "kWh",
+                     "below any traction battery (a hybrid car's holds 0.5-2 kWh, a light quadricycle's 6)", {{"MWh", 1e3}});
+    p.battery.usable_capacity_j = units::kwh_to_j(capacity_kwh);
     p.battery.initial_soc = m.number_or("initial_soc_pct", 100.0, Range::closed(0.0, 100.0)) / 100.0;
+    // A start below 1 % is possible (a drive to empty) but is far more often a fraction typed for a percentage.
+    if (p.battery.initial_soc > 0.0 && p.battery.initial_soc <= 0.01)
+      warnings.push_back(m.where("initial_soc_pct") + ": " + format_value(100.0 * p.battery.initial_soc) +
+                         " % is a battery all but empty at the start; is it a fraction? (" +
+                         format_value(100.0 * p.battery.initial_soc) + " = " + format_value(1e4 * p.battery.initial_soc) + " %)");
     m.finish();
   }
   {
@@ -121,7 +154,7 @@ ElectricPowertrainParams read_electric(YamlMap& pt) {
       throw InputError(m.where("fade_speed_kmh"), "must be >= min_speed_kmh");
     m.finish();
   }
-  p.aux_power_w = pt.number_or("aux_power_w", 0.0, Range::closed(0.0, 1e5));
+  p.aux_power_w = read_aux_power_w(pt);
   check_battery_carries_no_load(p, resistance_key);
   return p;
 }
@@ -181,12 +214,20 @@ CombustionPowertrainParams read_combustion(YamlMap& pt, double driven_radius_m) 
     m.finish();
   }
   p.fuel = read_fuel(pt.map("fuel"));
-  p.aux_power_w = pt.number_or("aux_power_w", 0.0, Range::closed(0.0, 1e5));
+  p.aux_power_w = read_aux_power_w(pt);
   p.alternator_efficiency = pt.number_or("alternator_efficiency", 1.0, Range::efficiency());
   return p;
 }
 
 }  // namespace
+
+// Zero leaves the auxiliaries out; a few watts are no car's electrical load (its control units alone draw tens).
+double read_aux_power_w(YamlMap& pt) {
+  const double w = pt.number_or("aux_power_w", 0.0, Range::closed(0.0, 1e5));
+  if (w == 0.0) return w;
+  return for_road_vehicle(pt, "aux_power_w", w, Range::closed(10.0, 1e5), "W",
+                          "a car's electrical load is tens of watts at least (its control units alone); 0 leaves it out", {{"kW", 1e3}});
+}
 
 FuelParams read_fuel(YamlMap m) {
   FuelParams f;
@@ -210,8 +251,16 @@ Vehicle load_vehicle(YamlMap root) {
   v.name = root.string_or("name", std::filesystem::path(path).stem().string());
   root.accept("description");
   root.accept("sources");
-  v.body = read_body(root.map("body"));
+  const YamlMap body = root.map("body");
+  v.body = read_body(body);
   if (auto t = root.optional_map("tyres")) {
+    // `all` beside `front` or `rear` would leave one of them unused: which tyre did the user mean?
+    for (const char* axle : {"front", "rear"}) {
+      if (t->has("all") && t->has(axle)) {
+        throw InputError(t->where(axle), "not allowed together with 'all': give 'all' (one tyre on all four wheels) or "
+                                         "'front' and 'rear' (one per axle), not both");
+      }
+    }
     if (t->has("all")) {
       v.front_tyre = load_tyre_named(t->string("all"), *t, "all");
       v.rear_tyre = v.front_tyre;
@@ -224,6 +273,7 @@ Vehicle load_vehicle(YamlMap root) {
     t->accept("rear");
     t->finish();
   }
+  if (v.front_tyre && body.has("wheel_radius_m")) reject_wheel_radius_beside_tyres(v, body.where("wheel_radius_m"));
   if (auto c = root.optional_map("coastdown")) v.coastdown = read_coastdown(*c);
   if (!v.front_tyre && !v.coastdown)
     throw InputError(root.where("tyres"), "a vehicle needs tyres (tyres: {all: FILE}) or coastdown coefficients");
@@ -233,7 +283,7 @@ Vehicle load_vehicle(YamlMap root) {
   YamlMap pt = root.map("powertrain");
   const std::string type = pt.string("type");
   if (type == "electric") {
-    v.powertrain = read_electric(pt);
+    v.powertrain = read_electric(pt, v.warnings);
   } else if (type == "combustion") {
     const std::optional<TyreSpec>& driven = v.body.driven_axle == DrivenAxle::rear ? v.rear_tyre : v.front_tyre;
     v.powertrain = read_combustion(pt, driven ? driven->state.geometry.outer_radius_m : v.body.wheel_radius_m);
@@ -266,8 +316,14 @@ std::vector<std::string> check_tyre_loads(const Vehicle& vehicle, const std::str
       throw InputError(where + ": " + axle + " tyre '" + tyre.name + "'", e.what());
     }
     if (tyre.max_load_n > 0.0 && load_n > tyre.max_load_n) {
+      // Tyres loaded a third beyond their rating that would carry the mass read in pounds: it was typed in pounds.
+      const double kKgPerLb = 0.45359237;
+      const double mass_kg = vehicle.body.test_mass_kg;
+      const std::string lb = load_n > 1.3 * tyre.max_load_n && load_n * kKgPerLb <= tyre.max_load_n
+                                 ? "; is body.test_mass_kg in lb? (" + format_value(mass_kg) + " lb = " + significant(mass_kg * kKgPerLb, 4) + " kg)"
+                                 : "";
       warnings.push_back(where + ": " + axle + " tyre '" + tyre.name + "': wheel load " + format_value(std::round(load_n)) +
-                         " N exceeds its rated maximum " + format_value(std::round(tyre.max_load_n)) + " N");
+                         " N exceeds its rated maximum " + format_value(std::round(tyre.max_load_n)) + " N" + lb);
     }
   }
   return warnings;

@@ -22,6 +22,20 @@ std::string resolve_tyre_path(const std::string& name, const std::string& vehicl
   throw InputError(where, "tyre file '" + name + "' not found beside the vehicle file or in the shipped tyres/");
 }
 
+namespace {
+
+// The line (from 0) of the body's wheel_radius_m key, or -1. A vehicle file refuses the key beside tyres, so a
+// coast-down file written back with the --tyre its diagnosis used must drop it to load again.
+int wheel_radius_line(const std::string& vehicle_path) {
+  const YAML::Node body = YamlMap::load_file(vehicle_path).node()["body"];
+  if (!body.IsMap()) return -1;
+  for (const auto& kv : body)
+    if (kv.first.Scalar() == "wheel_radius_m") return kv.first.Mark().line;
+  return -1;
+}
+
+}  // namespace
+
 std::string portable_vehicle_yaml(const std::string& text, const std::string& vehicle_path, const std::string& tyre_override) {
   namespace fs = std::filesystem;
   auto quoted = [](const std::string& path) {
@@ -49,7 +63,16 @@ std::string portable_vehicle_yaml(const std::string& text, const std::string& ve
     for (const auto& [key, path] : tyres) out << "  " << key << ": " << path << "\n";
     written = true;
   };
+  const int radius_line = tyres.empty() ? -1 : wheel_radius_line(vehicle_path);
+  int n = -1;
   for (std::string line; std::getline(in, line);) {
+    if (++n == radius_line) {
+      const std::size_t at = line.find_first_not_of(" ");
+      if (at == std::string::npos || line.compare(at, 14, "wheel_radius_m") != 0)
+        throw InputError(vehicle_path + ": key 'body.wheel_radius_m'", "must stand on its own line to be dropped beside the tyres");
+      out << line.substr(0, at) << "# " << line.substr(at) << "  # dropped by rollsim: the tyres below gear the car\n";
+      continue;
+    }
     const bool top_level = !line.empty() && line[0] != ' ' && line[0] != '\t' && line[0] != '#';
     if (in_block && top_level) in_block = false;
     if (in_block) continue;

@@ -34,6 +34,16 @@ struct Range {
 /// and what is allowed. The one check behind every number a user gives.
 double checked_number(double v, const std::string& where, Range range);
 
+/// Another unit a value may have been typed in: its name and the factor from it to the key's own unit.
+struct UnitSlip {
+  const char* unit;
+  double factor;
+};
+
+/// "; is it in psi? (19 psi = 1.31 bar)" for the first of `slips` whose reading of `v` lies in `fits` (in `unit`),
+/// else "": the end of a message refusing `v` as implausible.
+std::string unit_slip_hint(double v, Range fits, const std::string& unit, std::initializer_list<UnitSlip> slips);
+
 /// A number given as text on the command line or by the Python API: parsed whole and checked against `range`;
 /// throws InputError naming `option`, the text or value, and what is allowed (strtod alone would accept "nan").
 double parse_option_number(const std::string& text, const std::string& option, Range range);

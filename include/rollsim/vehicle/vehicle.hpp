@@ -50,6 +50,7 @@ struct Vehicle {
   std::optional<CoastdownParams> coastdown;  ///< when set, it is the road load; tyres only gear the car
   PowertrainParams powertrain;
   std::vector<EffectSpec> effects;  ///< the file's `effects:` block; models are built by the simulation's assembly
+  std::vector<std::string> warnings;  ///< values allowed but implausible in the file (a unit slip?), said by simulate
 
   bool is_electric() const { return std::holds_alternative<ElectricPowertrainParams>(powertrain); }
   /// The fuel the powertrain burns, or nullptr when it burns none.
