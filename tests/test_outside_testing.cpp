@@ -658,6 +658,59 @@ TEST_F(OutsideTesting, CyclesIgnoreOtherColumnsAndTrailingCommasLikeRecordings) 
   EXPECT_EQ(r.exit_code, 0) << r.err;
 }
 
+// A car that could not drive its trace (a 0.254 N m motor: a kN m slip) printed 124,323,551 kWh/10 km, shares of
+// its traction of 7.9 million % and a balance "closing" to 11 million %, as results.
+TEST_F(OutsideTesting, ACarThatCannotDriveItsTracePrintsNoPerDistanceFigure) {
+  const std::string car = write("stuck.yaml", shipped_vehicle_with("ev.yaml", "max_torque_nm: 254", "max_torque_nm: 0.254"));
+  const std::string trip = write("trip.csv", "time_s,speed_kmh\n0,0\n10,50\n60,50\n70,0\n");
+  const CmdResult r = run_rollsim("simulate --vehicle '" + car + "' --cycle '" + trip + "'");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(has(r.out, "the car covered only 0.000 km of the trace's 0.833 km: per-distance figures (kWh/10 km, range)"))
+      << r.out;
+  EXPECT_FALSE(has(r.out, "kWh/10 km =")) << r.out;
+  EXPECT_TRUE(has(r.out, "  rolling resistance (tyres)   0.0000        -")) << r.out;
+  const CmdResult j = run_rollsim("simulate --vehicle '" + car + "' --cycle '" + trip + "' --json");
+  EXPECT_TRUE(has(j.out, "\"aec_kwh_per_10km\": null")) << j.out;
+  EXPECT_TRUE(has(j.out, "\"moved\": false")) << j.out;
+}
+
+// A shipped Twizy trip with column `column` (0-based) of every data line divided by `divisor`.
+std::string twizy_scaled(std::size_t column, double divisor) {
+  std::ifstream in(std::string(ROLLSIM_SHARED_DIR) + "/data/recordings/rsk_renault_twizy/T1_07_01_2021.csv");
+  std::ostringstream out;
+  std::string line;
+  std::getline(in, line);
+  out << line << "\n";
+  while (std::getline(in, line)) {
+    std::vector<std::string> f;
+    std::stringstream ss(line);
+    for (std::string cell; std::getline(ss, cell, ',');) f.push_back(cell);
+    f.at(column) = std::to_string(std::stod(f.at(column)) / divisor);
+    for (std::size_t i = 0; i < f.size(); ++i) out << (i ? "," : "") << f[i];
+    out << "\n";
+  }
+  return out.str();
+}
+
+// Unit slips in a recording were diagnosed as physics: speed logged in m/s named a 19 % grade, and a SOC logged as a
+// 0-1 fraction read as 7810 % off. A factor of two against the model and a speed channel that is not the GPS track's
+// are said; a SOC channel that never passes 1 % is refused as the fraction it looks like.
+TEST_F(OutsideTesting, UnitSlipsInARecordingAreSaidNotDiagnosed) {
+  const std::string mps = write("speed_mps.csv", twizy_scaled(3, 3.6));  // Speed, km/h -> m/s
+  const CmdResult r = run_rollsim("diagnose --vehicle twizy --preset rsk_twizy --recording '" + mps + "'");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(has(r.err, "warning: the model's energy is")) << r.err;
+  EXPECT_TRUE(has(r.err, "beyond what missing physics explains: check the units and the mapping")) << r.err;
+  EXPECT_TRUE(has(r.err, "warning: " + mps + ": the speed channel covers")) << r.err;
+  EXPECT_TRUE(has(r.err, "(x3.5")) << r.err;  // x3.58: CAN and GPS distances differ by a few % on the shipped trips
+  expect_refused("diagnose --vehicle twizy --preset rsk_twizy --recording '" + write("soc.csv", twizy_scaled(2, 100.0)) + "'",
+                 "its soc channel stays within");
+  // The shipped trip as it is: no warning.
+  const CmdResult ok = run_rollsim("diagnose --vehicle twizy --preset rsk_twizy --recording '" + std::string(ROLLSIM_SHARED_DIR) +
+                                   "/data/recordings/rsk_renault_twizy/T1_07_01_2021.csv'");
+  EXPECT_FALSE(has(ok.err, "warning")) << ok.err;
+}
+
 // Session 17's outside test of real users' input files (notes/s17-inputs.md), each refused at the key that is wrong.
 
 // S2: `tyres: {all: A, front: B}` drove four A tyres; B was dropped without a word.

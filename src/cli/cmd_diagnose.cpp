@@ -65,6 +65,9 @@ void run_diagnose(const DiagnoseCliOptions& o) {
     dopt.engine_start.push_back(s == "hot" ? EngineStart::hot : s == "cold" ? EngineStart::cold : EngineStart::infer);
   }
   const Diagnosis d = diagnose(v, recs, dopt);
+  // The diagnosis' warnings (units and mappings a finding would otherwise be read past) also go where warnings go.
+  for (const auto& note : d.notes)
+    if (note.rfind("warning:", 0) == 0) std::cerr << note << "\n";
   std::cout << diagnosis_text(d);
   std::vector<OutputFile> files;
   if (!o.json.empty()) files.push_back({o.json, "--json", diagnosis_json(d)});

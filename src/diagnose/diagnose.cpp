@@ -172,6 +172,50 @@ void report_calibration(const diag::Calibration& c, const diag::Observations& o,
   out.lag_ci_high_s = lag.high_s;
 }
 
+// The path the GPS fixes trace [m], a fix that jumps farther than the car could go since the last one skipped (a
+// glitch must not make a unit slip of the speed channel).
+double gps_track_m(const Recording& r) {
+  const auto& lat = *r.latitude_deg;
+  const auto& lon = *r.longitude_deg;
+  const double north_m_per_deg = units::kEarthRadius_m * units::deg_to_rad(1.0);
+  double track_m = 0.0;
+  std::size_t last = 0;
+  for (std::size_t i = 1; i < r.time_s.size() && i < lat.size() && i < lon.size(); ++i) {
+    const double east_m_per_deg = north_m_per_deg * std::cos(units::deg_to_rad(lat[last]));
+    const double step_m = std::hypot((lat[i] - lat[last]) * north_m_per_deg, (lon[i] - lon[last]) * east_m_per_deg);
+    const double reach_m = 3.0 * std::max(r.speed_mps[i], r.speed_mps[last]) * (r.time_s[i] - r.time_s[last]) + 50.0;
+    if (!std::isfinite(step_m) || step_m > reach_m) continue;  // a glitch: measure from the last good fix
+    track_m += step_m;
+    last = i;
+  }
+  return track_m;
+}
+
+// A recording against the model by a factor no physics a road car leaves out explains, or a speed channel whose
+// distance is not the GPS track's, is said before any finding is read as physics: these are units and mappings.
+std::vector<std::string> unit_slip_warnings(const std::vector<Recording>& recordings, double raw_error_pct) {
+  std::vector<std::string> out;
+  const double ratio = 1.0 + raw_error_pct / 100.0;
+  if (!(ratio > 0.5 && ratio < 2.0)) {
+    out.push_back("warning: the model's energy is " + fixed(ratio, 2) + " x the recording's (uncalibrated error " +
+                  fixed(raw_error_pct, 1) + " %), beyond what missing physics explains: check the units and the mapping "
+                  "of the speed and energy channels (--column, --scale) before reading the findings as physics");
+  }
+  for (const auto& r : recordings) {
+    if (!r.latitude_deg || !r.longitude_deg) continue;
+    double speed_m = 0.0;
+    for (std::size_t i = 0; i + 1 < r.time_s.size(); ++i) speed_m += r.speed_mps[i] * (r.time_s[i + 1] - r.time_s[i]);
+    const double gps_m = gps_track_m(r);
+    if (!(gps_m > 1000.0 && speed_m > 0.0)) continue;
+    const double k = gps_m / speed_m;
+    if (k > 0.7 && k < 1.0 / 0.7) continue;
+    out.push_back("warning: " + r.source + ": the speed channel covers " + fixed(speed_m / 1e3, 2) + " km and the GPS track " +
+                  fixed(gps_m / 1e3, 2) + " km (x" + fixed(k, 2) + "; km/h read as m/s is x3.6, mph as km/h x1.61): is the "
+                  "speed in the unit its mapping says?");
+  }
+  return out;
+}
+
 }  // namespace
 
 std::vector<bool> engine_off_samples(const Recording& r, double min_s) {
@@ -282,6 +326,7 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
   choose_channel_sampling(rp, obs, base, lag, out);
   base.window_j = window_energies(base.power_w, obs, lag.samples);
   out.raw_trip_energy_error_pct = energy_error_pct(base.window_j, obs.measured_j);
+  for (auto& w : unit_slip_warnings(recordings, out.raw_trip_energy_error_pct)) out.notes.push_back(std::move(w));
   set_engine_starts(cycles, recordings, obs, base, opt, out);
   const Signatures sig = compute_signatures(rp, obs, base, lag.samples, amb, ctx, opt);
   const Calibration cal = calibrate(obs, sig.base, sig.rrc, sig.drag, opt.priors, opt.bic_threshold);

@@ -87,6 +87,12 @@ void check_informative(const Recording& r, const std::vector<double>& measured_w
   }
   const std::vector<double>& x = kind == ChannelKind::soc ? *r.soc_fraction : measured_w;
   const auto [lo, hi] = std::minmax_element(x.begin(), x.end());
+  // A battery at 1 % or less all the way would be empty long before; a 0-1 fraction read as percent looks so.
+  if (kind == ChannelKind::soc && *hi <= 0.01 && *hi > *lo) {
+    throw InputError(r.source, "its soc channel stays within " + fixed(100.0 * *lo, 3) + "-" + fixed(100.0 * *hi, 3) +
+                                   " % while the car covers " + fixed(distance_m / 1e3, 2) +
+                                   " km: is it a fraction (0-1) read as percent? (--scale soc_pct=100 reads a fraction as percent)");
+  }
   // A coarse SOC (whole percent) may hold still over a short trip; over kMinStuckSocDistance_m it is stuck.
   const bool long_enough = kind != ChannelKind::soc || distance_m >= kMinStuckSocDistance_m;
   if (*lo == *hi && long_enough) {

@@ -62,8 +62,14 @@ std::string summary_text(const SimulationResult& r, bool solver_stats) {
   o << "  distance " << fixed(km, 3) << " km in " << fixed(r.duration_s, 0) << " s, mean speed "
     << fixed(km / (r.duration_s / units::kSPerHour), 1) << " km/h\n";
   if (!r.moved()) {
-    o << "  the car did not move: per-distance figures (" << (r.fuel ? "l/100 km, CO2 g/km" : "kWh/10 km, range")
-      << ") are undefined\n";
+    const std::string what = r.fuel ? "l/100 km, CO2 g/km" : "kWh/10 km, range";
+    if (r.distance_m > 0.0) {
+      o << "  the car covered only " << fixed(r.distance_m / 1000.0, 3) << " km of the trace's "
+        << fixed(r.trace_distance_m / 1000.0, 3) << " km: per-distance figures (" << what
+        << ") and the shares of its traction are undefined (the powertrain cannot drive this trace)\n";
+    } else {
+      o << "  the car did not move: per-distance figures (" << what << ") are undefined\n";
+    }
   }
   if (r.battery && r.moved()) {
     o << "  energy at the battery terminals: " << fixed(r.aec_kwh_per_10km(), 3) << " kWh/10 km = "
@@ -89,19 +95,22 @@ std::string summary_text(const SimulationResult& r, bool solver_stats) {
   const double source_j = r.source_energy_j();
   TextTable t({"energy", "kWh", "share %"});
   t.set_left_aligned(0);
+  // Shares of the traction mean nothing for a car that hardly moved (millijoules of traction against kilojoules of
+  // friction braking): "-" there, as for no traction at all.
+  const double traction_scale_j = r.moved() ? e.traction_j : 0.0;
   auto row = [&](const std::string& name, double j, double of_j) {
     t.add_row({name, fixed(units::j_to_kwh(j), 4), of_j != 0.0 ? fixed(100.0 * j / of_j, 1) : "-"});
   };
-  row("at the wheels: traction", e.traction_j, e.traction_j);
-  row("  rolling resistance (tyres)", e.rolling_j, e.traction_j);
-  row("  aerodynamic drag", e.aero_j, e.traction_j);
-  if (e.grade_j != 0.0) row("  grade (net climb)", e.grade_j, e.traction_j);
-  if (e.other_resistance_j != 0.0) row("  other resistance (effects)", e.other_resistance_j, e.traction_j);
-  row("  braking lost (friction)", e.friction_brake_j, e.traction_j);
-  if (r.battery) row("  regenerated at the wheels", e.regen_wheel_j, e.traction_j);
-  if (e.wheel_loss_j != 0.0) row("  tyre slip", e.wheel_loss_j, e.traction_j);
-  row("  kinetic energy change", e.kinetic_change_j, e.traction_j);
-  if (e.unmet_demand_j != 0.0) row("demanded beyond the powertrain (replay)", e.unmet_demand_j, e.traction_j);
+  row("at the wheels: traction", e.traction_j, traction_scale_j);
+  row("  rolling resistance (tyres)", e.rolling_j, traction_scale_j);
+  row("  aerodynamic drag", e.aero_j, traction_scale_j);
+  if (e.grade_j != 0.0) row("  grade (net climb)", e.grade_j, traction_scale_j);
+  if (e.other_resistance_j != 0.0) row("  other resistance (effects)", e.other_resistance_j, traction_scale_j);
+  row("  braking lost (friction)", e.friction_brake_j, traction_scale_j);
+  if (r.battery) row("  regenerated at the wheels", e.regen_wheel_j, traction_scale_j);
+  if (e.wheel_loss_j != 0.0) row("  tyre slip", e.wheel_loss_j, traction_scale_j);
+  row("  kinetic energy change", e.kinetic_change_j, traction_scale_j);
+  if (e.unmet_demand_j != 0.0) row("demanded beyond the powertrain (replay)", e.unmet_demand_j, traction_scale_j);
   if (r.battery) {
     row("battery terminals (net)", e.battery_terminal_j, source_j);
     row("  traction - regenerated", e.traction_j - e.regen_wheel_j, source_j);
@@ -124,7 +133,7 @@ std::string summary_text(const SimulationResult& r, bool solver_stats) {
     return scale_j != 0.0 ? fixed(100.0 * std::abs(residual_j) / std::abs(scale_j), 4) + " %"
                           : fixed(std::abs(residual_j), 3) + " J";
   };
-  o << "  energy balance closes to " << closure(e.wheel_residual_j(), e.traction_j) << " at the wheels and "
+  o << "  energy balance closes to " << closure(e.wheel_residual_j(), traction_scale_j) << " at the wheels and "
     << closure(e.powertrain_residual_j(), source_j) << " in the powertrain\n";
   o << "  speed tracking: max error " << fixed(units::mps_to_kmh(r.max_speed_error_mps), 2) << " km/h at t = "
     << fixed(r.max_speed_error_time_s, 1) << " s\n";

@@ -271,6 +271,7 @@ void finish_result(const VehicleModel& m, const DriveCycle& c, double distance_m
   r.cycle = c.name;
   r.duration_s = c.duration_s();
   r.distance_m = distance_m;
+  r.trace_distance_m = c.distance_m();
   r.energy = breakdown_from(acc);
   r.energy.kinetic_change_j = 0.5 * m.inertial_mass_kg() * (v_end * v_end - v_start * v_start);
   if (const FuelParams* f = m.powertrain->fuel()) {

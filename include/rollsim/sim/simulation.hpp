@@ -142,6 +142,7 @@ struct SimulationResult {
   std::string mode;  ///< "forward" or "replay"
   double duration_s = 0.0;
   double distance_m = 0.0;
+  double trace_distance_m = 0.0;  ///< what the trace asks to drive (a forward car that falls behind covers less)
   EnergyBreakdown energy;
   std::optional<BatteryFigures> battery;  ///< set when the powertrain has a battery
   std::optional<FuelFigures> fuel;        ///< set when it burns fuel
@@ -155,8 +156,11 @@ struct SimulationResult {
   std::vector<Shortfall> shortfalls;
   std::vector<TracePoint> trace;
 
-  /// Per-distance figures exist only for a run that moved; a standstill-only trace has none (they are NaN then).
-  bool moved() const { return distance_m > 0.0; }
+  /// Per-distance figures exist only for a run that drove its trace: a standstill-only trace has none, and neither has
+  /// a car that covered less than kMinShareOfTraceDriven of it (a motor of 0.25 N m: 10^8 kWh/10 km over millimetres,
+  /// a figure of no drive). They are NaN then.
+  bool moved() const { return distance_m > 0.0 && distance_m >= kMinShareOfTraceDriven * trace_distance_m; }
+  static constexpr double kMinShareOfTraceDriven = 0.1;
   /// Energy taken from the sources [J]: battery terminals plus fuel (lower heating value).
   double source_energy_j() const;
   /// Battery-terminal energy per distance in kWh/10 km (the platform study's unit).
