@@ -192,7 +192,7 @@ void register_sweep_command(CLI::App& app, const ProcessGroup& group) {
   sub->add_option("--from", o->request.from, "First value of the range (one per --param)")->type_name("X");
   sub->add_option("--to", o->request.to, "Last value of the range (one per --param)")->type_name("X");
   sub->add_option("--steps", o->request.steps, "Points per range including both ends (default 11)")->type_name("N");
-  sub->add_option("--load-n", o->request.load_n, "Fixed normal load per tyre [N] (default 80 % of maximum load)")->type_name("N");
+  sub->add_option("--load-n", o->request.load_n, "Fixed normal load per tyre [N] (default 80 % of maximum load; with --vehicle, the car's heavier static wheel load)")->type_name("N");
   sub->add_option("--speed-kmh", o->request.speed_kmh, "Fixed speed [km/h] (default 80)")->type_name("KMH");
   sub->add_option("--vehicle", o->vehicle, "Run this car with the swept tyre on all four wheels")->type_name("FILE");
   sub->add_option("--cycle", o->cycle, "Drive cycle for --vehicle (default nedc)")->type_name("CYCLE");

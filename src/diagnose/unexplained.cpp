@@ -118,9 +118,13 @@ std::optional<Finding> describe_unexplained(const SelectionContext& sc, const st
   }
   f.description = w.what + ", " + w.size_text + when + "; " + fixed(f.energy_share_pct, 1) +
                   " % of the measured energy, beside a channel scale of " + fixed(s, 3);
-  if (!sc.replayer.vehicle.is_electric() && b.decay_s == 0.0)
+  // Only a Willans line lacks the map; an engine_map car's residual is the map's own error, not a missing map.
+  if (std::holds_alternative<CombustionPowertrainParams>(sc.replayer.vehicle.powertrain) && b.decay_s == 0.0)
     f.description += ". The combustion engine is a Willans line with no efficiency map: efficiency changing with "
                      "load and speed (enrichment at high load, pumping loss at low load) has no module to name, and shows up this way";
+  else if (std::holds_alternative<ConventionalPowertrainParams>(sc.replayer.vehicle.powertrain) && b.decay_s == 0.0)
+    f.description += ". The engine has a fuel map: a residual like this is where the map (or the gear and converter "
+                     "choice that sets its operating point) differs from this engine's, which no effect module names";
   m = extended(m, b.signature, best);
   return f;
 }
