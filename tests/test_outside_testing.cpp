@@ -500,6 +500,12 @@ TEST_F(OutsideTesting, ALongIntervalBetweenMovingSamplesIsSaid) {
                          "straight line between them (150.000 of the trace's 150.278 km)")) << r.err;
   const std::string standing = write("soak.csv", "time_s,speed_kmh\n0,0\n10,50\n20,0\n10820,0\n10830,50\n10840,0\n");
   EXPECT_FALSE(has(run_rollsim("simulate --vehicle ev --cycle '" + standing + "'").err, "between samples")) << "a soak standing still";
+  // A trace in milliseconds: a few named, the rest counted.
+  std::string ms = "time_s,speed_kmh\n";
+  for (int i = 0; i < 10; ++i) ms += std::to_string(1000 * i) + "," + std::to_string(40 + i) + "\n";
+  const std::string in_ms = write("ms.csv", ms);
+  EXPECT_TRUE(has(run_rollsim("simulate --vehicle ev --cycle '" + in_ms + "'").err,
+                  in_ms + ": 6 more such intervals (")) << "a time column in milliseconds";
 }
 
 // The report's "regimes" heading and figure carried one id: invalid HTML, and #regimes was ambiguous.

@@ -163,17 +163,29 @@ void check_engine_off_standing(const CsvTable& table, std::size_t col, const std
 // Long intervals between samples where the car moves at either end: the trace drives them as a straight line, which
 // for a logger's dropout is distance that was never driven. Said, not refused: a hand-written trace may mean it.
 std::vector<std::string> moving_gap_notes(const CsvTable& table, const DriveCycle& c) {
+  constexpr std::size_t kNamed = 3;  // a trace in milliseconds has one per sample: name a few, count the rest
   std::vector<std::string> out;
   const double total_m = c.distance_m();
+  std::size_t more = 0;
+  double more_m = 0.0;
   for (std::size_t r = 1; r < c.time_s.size(); ++r) {
     const double dt = c.time_s[r] - c.time_s[r - 1];
     if (!(dt > kNotedMovingGap_s) || (c.speed_mps[r] == 0.0 && c.speed_mps[r - 1] == 0.0)) continue;
     const double gap_m = 0.5 * (c.speed_mps[r] + c.speed_mps[r - 1]) * dt;
+    if (out.size() == kNamed) {
+      ++more;
+      more_m += gap_m;
+      continue;
+    }
     out.push_back(table.file + ": lines " + std::to_string(table.row_line[r - 1]) + "-" + std::to_string(table.row_line[r]) +
                   ": " + fixed(dt, 0) + " s between samples at " + fixed(units::mps_to_kmh(c.speed_mps[r - 1]), 1) +
                   " and " + fixed(units::mps_to_kmh(c.speed_mps[r]), 1) + " km/h, driven as a straight line between them (" +
                   fixed(gap_m / 1000.0, 3) + " of the trace's " + fixed(total_m / 1000.0, 3) +
                   " km); if the log has a gap there, that distance was never driven");
+  }
+  if (more > 0) {
+    out.push_back(table.file + ": " + std::to_string(more) + " more such intervals (" + fixed(more_m / 1000.0, 3) +
+                  " km more); so many that the time column may not be in seconds (milliseconds?)");
   }
   return out;
 }
