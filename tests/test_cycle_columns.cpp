@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <variant>
 
 #include "rollsim/common/error.hpp"
 #include "rollsim/cycle/drive_cycle.hpp"
@@ -75,6 +76,30 @@ TEST(CycleColumns, EngineOffSegmentsBurnNoFuel) {
   EXPECT_LT(idle_j / 99.0, 5000.0);
 }
 
+// Start-stop at a light keeps the accessories on from the 12 V battery, which the alternator recharges after the
+// restart; a soak (key off) does not. The difference over a 99 s stop is the accessories' electrical energy at the
+// alternator's and the engine's efficiency: P t / (eta_alt eta_ind), from the vehicle file's own numbers.
+TEST(CycleColumns, StartStopKeepsTheAccessoriesOnAndTheAlternatorPaysForThem) {
+  const Vehicle v = load_vehicle_file(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/ice.yaml");
+  const auto& p = std::get<CombustionPowertrainParams>(v.powertrain);
+  std::string soak = "time_s,speed_kmh,engine_on,accessories_on\n", light = soak;
+  for (int t = 0; t <= 300; ++t) {
+    const double speed = t < 100 ? 0.0 : t < 110 ? 5.0 * (t - 100) : t < 190 ? 50.0 : t < 200 ? 5.0 * (200 - t) : 0.0;
+    const std::string off = t < 99 ? "0" : "1";
+    soak += std::to_string(t) + "," + std::to_string(speed) + "," + off + ",0\n";
+    light += std::to_string(t) + "," + std::to_string(speed) + "," + off + ",1\n";
+  }
+  const VehicleModel m = VehicleModel::assemble(v);
+  const double soak_j = simulate_forward(m, read_cycle_csv(write("soak.csv", soak), "soak")).energy.fuel_j;
+  const double light_j = simulate_forward(m, read_cycle_csv(write("light.csv", light), "light")).energy.fuel_j;
+  const double expected_j = p.aux_power_w * 99.0 / (p.alternator_efficiency * p.engine.indicated_efficiency);
+  EXPECT_NEAR(light_j - soak_j, expected_j, 1e-3 * expected_j);
+  // The replay books it alike.
+  const double soak_r = simulate_replay(m, read_cycle_csv(write("soak.csv", soak), "soak")).energy.fuel_j;
+  const double light_r = simulate_replay(m, read_cycle_csv(write("light.csv", light), "light")).energy.fuel_j;
+  EXPECT_NEAR(light_r - soak_r, expected_j, 1e-3 * expected_j);
+}
+
 TEST(CycleColumns, BadHeadingOrEngineValuesAreNamedErrors) {
   auto error_of = [](const std::string& name, const std::string& text) {
     try {
@@ -95,6 +120,10 @@ TEST(CycleColumns, BadHeadingOrEngineValuesAreNamedErrors) {
   const std::string m = error_of("m.csv", "time_s,speed_kmh,engine_on\n0,0,0\n1,3.6,1\n2,3.6,1\n");
   EXPECT_NE(m.find("line 2"), std::string::npos) << m;
   EXPECT_NE(m.find("not allowed while moving"), std::string::npos) << m;
+  const std::string acc = error_of("a.csv", "time_s,speed_kmh,engine_on,accessories_on\n0,0,0,1\n1,0,1,2\n");
+  EXPECT_NE(acc.find("2 is not allowed: accessories_on is 1 (on while the engine is off) or 0 (off)"), std::string::npos) << acc;
+  const std::string alone = error_of("b.csv", "time_s,speed_kmh,accessories_on\n0,0,1\n1,0,1\n");
+  EXPECT_NE(alone.find("it needs an engine_on column"), std::string::npos) << alone;
   const std::string empty = error_of("x.csv", "time_s,speed_kmh,heading_deg\n0,0,\n1,0,5\n");
   EXPECT_NE(empty.find("is empty"), std::string::npos) << empty;
   // Through the CLI: exit non-zero, the same message.

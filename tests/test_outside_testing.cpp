@@ -717,6 +717,22 @@ TEST_F(OutsideTesting, UnitSlipsInARecordingAreSaidNotDiagnosed) {
   EXPECT_FALSE(has(ok.err, "warning")) << ok.err;
 }
 
+// A car without auxiliaries (aux_power_w 0, the key's default) could not be simulated forward: its first standing
+// interval moved no energy, and CVODES refused the zero quadrature tolerance (CV_ILL_INPUT at t = 0). Found while
+// writing docs/vehicle-file.md. Without its 600 W the EV saves their energy over NEDC's 1180 s, within the battery's
+// own loss on them.
+TEST_F(OutsideTesting, ACarWithoutAuxiliariesIsSimulated) {
+  const std::string car = write("no_aux.yaml", shipped_vehicle_with("ev.yaml", "aux_power_w: 600", "aux_power_w: 0"));
+  const CmdResult r = run_rollsim("simulate --vehicle '" + car + "' --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(r.out, m, std::regex(R"("aec_kwh_per_10km": ([0-9.]+))"))) << r.out;
+  const double aux_kwh_per_10km = 600.0 * 1180.0 / 3.6e6 / 1.1028;
+  EXPECT_NEAR(std::stod(m[1].str()), 1.6442 - aux_kwh_per_10km, 0.005);
+  const std::string ice = write("ice_no_aux.yaml", shipped_vehicle_with("ice.yaml", "aux_power_w: 300", "aux_power_w: 0"));
+  EXPECT_EQ(run_rollsim("simulate --vehicle '" + ice + "'").exit_code, 0);
+}
+
 // Session 17's outside test of real users' input files (notes/s17-inputs.md), each refused at the key that is wrong.
 
 // S2: `tyres: {all: A, front: B}` drove four A tyres; B was dropped without a word.

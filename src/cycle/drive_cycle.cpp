@@ -147,6 +147,13 @@ bool engine_off(const CsvTable& table, std::size_t row, std::size_t col, double 
   return on == 0.0;
 }
 
+// 1: with the engine off, the electrical accessories stay on from the 12 V battery (start-stop); 0: off with the key.
+bool accessories_on(const CsvTable& table, std::size_t row, std::size_t col, double on) {
+  if (on != 0.0 && on != 1.0)
+    throw InputError(table.where(row, col), format_value(on) + " is not allowed: accessories_on is 1 (on while the engine is off) or 0 (off)");
+  return on == 1.0;
+}
+
 // The simulator switches an engine off only on a standing segment (a moving car's engine-off flag would be ignored,
 // a silently wrong number): both ends of an off segment must stand still.
 void check_engine_off_standing(const CsvTable& table, std::size_t col, const std::vector<double>& speed_mps,
@@ -192,7 +199,7 @@ std::vector<std::string> moving_gap_notes(const CsvTable& table, const DriveCycl
 
 bool is_cycle_column(const std::string& h) {
   return h == "time_s" || h == "speed_kmh" || h == "speed_mps" || h == "grade_pct" || h == "elevation_m" ||
-         h == "heading_deg" || h == "engine_on";
+         h == "heading_deg" || h == "engine_on" || h == "accessories_on";
 }
 
 // Exports carry more columns than a cycle (phase, gear, distance), ignored as a recording's are. A name that
@@ -212,12 +219,12 @@ std::string ignored_columns_note(const DriveCycle& c) {
   std::string list;
   for (std::size_t i = 0; i < c.ignored_columns.size(); ++i) list += (i ? ", " : "") + c.ignored_columns[i];
   return c.source + ": " + (c.ignored_columns.size() == 1 ? "column " : "columns ") + list +
-         " not read; cycle columns are time_s, speed_kmh or speed_mps, grade_pct or elevation_m, heading_deg, engine_on";
+         " not read; cycle columns are time_s, speed_kmh or speed_mps, grade_pct or elevation_m, heading_deg, engine_on, accessories_on";
 }
 
 DriveCycle cycle_from_table(const CsvTable& table, const std::string& name) {
   const std::string& path = table.file;
-  const std::string allowed = "time_s, speed_kmh or speed_mps, optional grade_pct or elevation_m, heading_deg, engine_on";
+  const std::string allowed = "time_s, speed_kmh or speed_mps, optional grade_pct or elevation_m, heading_deg, engine_on, accessories_on";
   const std::string found = "found columns: " + table.columns_list();
   // A header of numbers means the file has none, and its first sample would otherwise be lost or misread.
   bool header_numeric = !table.header.empty();
@@ -251,6 +258,9 @@ DriveCycle cycle_from_table(const CsvTable& table, const std::string& name) {
   const auto col_elev = table.column("elevation_m");
   const auto col_heading = table.column("heading_deg");
   const auto col_engine = table.column("engine_on");
+  const auto col_accessories = table.column("accessories_on");
+  if (col_accessories && !col_engine)
+    throw InputError(path + ": column 'accessories_on'", "says whether the accessories stay on while the engine is off: it needs an engine_on column");
   if (!col_t) throw InputError(path, "missing column 'time_s'; " + found);
   if (!col_kmh && !col_mps) throw InputError(path, "missing a speed column, 'speed_kmh' or 'speed_mps'; " + found);
   if (col_kmh && col_mps) throw InputError(path, "has both 'speed_kmh' and 'speed_mps'; give exactly one");
@@ -316,6 +326,7 @@ DriveCycle cycle_from_table(const CsvTable& table, const std::string& name) {
     if (col_elev) elevation.push_back(number(r, *col_elev));
     if (col_heading) c.heading_rad.push_back(heading_rad(table, r, *col_heading, number(r, *col_heading)));
     if (col_engine) off.push_back(engine_off(table, r, *col_engine, number(r, *col_engine)));
+    if (col_accessories) c.accessories_on.push_back(accessories_on(table, r, *col_accessories, number(r, *col_accessories)));
   }
   if (col_engine) check_engine_off_standing(table, *col_engine, c.speed_mps, off);
   c.set_engine_off(std::move(off));

@@ -168,8 +168,11 @@ struct Evaluator {
     const double v = std::max(in.speed_mps, 0.0);
     out.wheel_loss_w = 0.0;
     if (in.engine_off && m.powertrain->fuel()) {
-      // Switched off standing (a soak, start-stop): no fuel and no alternator, so no auxiliaries either.
+      // Switched off standing: no fuel and no alternator. With the key off (a soak) the accessories are off too;
+      // at a start-stop light they run from the 12 V battery, whose charge the alternator puts back after the
+      // restart: booked here, at the alternator's and the engine's efficiency, so the cycle's total holds it.
       out.flow = PowerFlow{};
+      if (in.accessories_on) m.powertrain->add_electric_load(m.powertrain->alternator_accessory_load_w(), out.flow);
       return;
     }
     double fuel_factor = 1.0;
@@ -407,6 +410,7 @@ class ForwardSystem final : public OdeSystem {
     const double a_ref = (c_.speed_mps[i + 1] - c_.speed_mps[i]) / dt;
     const double v_ref = c_.speed_mps[i] + a_ref * (t - c_.time_s[i]);
     EffectInputs in{t, v_ref, a_ref, c_.grade.empty() ? 0.0 : c_.grade[i], y[kDistance], 0.0, 0.0, c_.engine_off_at(i)};
+    in.accessories_on = c_.accessories_on_at(i);
     set_heading(c_, i, in);
     Instant ff;
     eval_.resistance(loads_[i], in, y + kBaseStates, ff);
@@ -441,6 +445,7 @@ class ForwardSystem final : public OdeSystem {
 
     // Feed-forward: what the trace needs at its own speed; feedback: PI on the speed error.
     EffectInputs in{t, v_ref, a_ref, grade, y[kDistance], 0.0, 0.0, standstill_[i] && c_.engine_off_at(i)};
+    in.accessories_on = c_.accessories_on_at(i);
     set_heading(c_, i, in);
     Instant ff;
     eval_.resistance(rl, in, x, ff);
@@ -554,8 +559,12 @@ SimulationResult simulate_forward(const VehicleModel& m, const DriveCycle& c, co
   // so the errors summed over the run are that fraction of the energy the whole run moves, on any cycle. A
   // fixed 10 J per interval left the balance at 0.013-0.047 % on the stop-and-go cycles, whose many short
   // intervals each carry little energy. Fuel volume [m^3] has its own 1 ml, well below a cycle's fuel.
+  // A standing interval of a car without auxiliaries moves no energy at all; CVODES refuses a zero tolerance
+  // (CV_ILL_INPUT at t = 0 with aux_power_w 0), so the scale has a floor of 1 J, far below any interval's flows.
+  constexpr double kMinEnergyScale_j = 1.0;
   auto quadrature_tolerances = [&](double t_from, double t_to) {
-    std::vector<double> atol(active.size(), opt.quadrature_energy_fraction * sys.energy_scale_j(t_from, t_to));
+    const double scale_j = std::max(kMinEnergyScale_j, sys.energy_scale_j(t_from, t_to));
+    std::vector<double> atol(active.size(), opt.quadrature_energy_fraction * scale_j);
     for (std::size_t k = 0; k < active.size(); ++k) {
       if (active[k] == kFuelVolume) atol[k] = 1e-9;
     }
@@ -789,7 +798,7 @@ SimulationResult simulate_replay(const VehicleModel& m, const DriveCycle& c, con
   SegmentMemo seen(stateless ? c.time_s.size() : 0);
   bool cruise_valid = false, cruise_limited = false;
   double cruise_v = -1.0, cruise_grade = 0.0;
-  bool cruise_engine_off = false;
+  bool cruise_engine_off = false, cruise_accessories_on = false;
   SimulationResult r;
   r.mode = "replay";
   bool limited = false;
@@ -798,10 +807,12 @@ SimulationResult simulate_replay(const VehicleModel& m, const DriveCycle& c, con
   // Powers at one point of a segment into `rate` (and the effects' state rates into `xdot`).
   Instant s;
   bool engine_off = false;  // the segment being evaluated switches the engine off (set per segment below)
+  bool accessories_on = false;  // ... and keeps the accessories on (start-stop)
   std::size_t segment_now = 0;
   auto evaluate_at = [&](double t, double v, double a, double grade, const RoadLoadCoeffs& rl, double dist_m) {
     scheduled_gear = m.powertrain->select_gear(v, scheduled_gear);
     EffectInputs in{t, v, a, grade, dist_m, 0.0, 0.0, engine_off && v == 0.0 && a == 0.0};
+    in.accessories_on = accessories_on;
     set_heading(c, segment_now, in);
     eval.resistance(rl, in, x.data(), s);
     // At rest and staying at rest the car is held on its brakes, as the forward simulation holds it: on a grade the
@@ -852,6 +863,7 @@ SimulationResult simulate_replay(const VehicleModel& m, const DriveCycle& c, con
     const double grade = c.grade.empty() ? 0.0 : c.grade[i];
     const RoadLoadCoeffs& rl = loads[i];
     engine_off = c.engine_off_at(i);
+    accessories_on = c.accessories_on_at(i);
     segment_now = i;
     bool segment_limited = false;
     double soc_before_ramp = 0.0;
@@ -864,7 +876,8 @@ SimulationResult simulate_replay(const VehicleModel& m, const DriveCycle& c, con
     }
     if (a == 0.0) {
       // Same speed, grade and (so, with hysteresis) gear as the cruise before: same powers, nothing to evaluate.
-      if (!(stateless && cruise_valid && v0 == cruise_v && grade == cruise_grade && engine_off == cruise_engine_off)) {
+      if (!(stateless && cruise_valid && v0 == cruise_v && grade == cruise_grade && engine_off == cruise_engine_off &&
+            accessories_on == cruise_accessories_on)) {
         book_cruise();
         evaluate_at(t0 + 0.5 * dt, v0, 0.0, grade, rl, distance_m);
         cruise_limited = s.flow.force_limited;
@@ -872,6 +885,7 @@ SimulationResult simulate_replay(const VehicleModel& m, const DriveCycle& c, con
         cruise_v = v0;
         cruise_grade = grade;
         cruise_engine_off = engine_off;
+        cruise_accessories_on = accessories_on;
         cruise_valid = true;
         xdot_sum = xdot;
       }

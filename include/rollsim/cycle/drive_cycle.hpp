@@ -22,6 +22,10 @@ struct DriveCycle {
   /// at a light), so it burns no fuel; empty when the engine runs throughout (every shipped cycle; a CSV file
   /// without an engine_on column or with the engine on throughout).
   std::vector<bool> engine_off;
+  /// Per sample: over a segment with the engine off, the electrical accessories stay on, fed by the 12 V battery
+  /// (start-stop at a light; the alternator puts the charge back after the restart); empty or false: they are off
+  /// with the engine (a soak with the key off). A cycle CSV's accessories_on column.
+  std::vector<bool> accessories_on;
   /// The engine is warm when the trace starts (a hot start, e.g. the second half of a test after a short soak);
   /// otherwise it starts cold, at ambient.
   bool engine_hot_start = false;
@@ -36,6 +40,7 @@ struct DriveCycle {
   std::vector<std::string> ignored_columns;
 
   bool engine_off_at(std::size_t segment) const { return segment < engine_off.size() && engine_off[segment]; }
+  bool accessories_on_at(std::size_t segment) const { return segment < accessories_on.size() && accessories_on[segment]; }
   bool any_engine_off() const;
   /// Stores engine_off's documented form: all-running becomes empty, so readers need not search for a true flag.
   void set_engine_off(std::vector<bool> off_per_segment);

@@ -18,6 +18,9 @@ struct EffectInputs {
   /// Direction of travel, clockwise from north [rad], where the trace knows it (recorded latitude and longitude).
   double heading_rad = 0.0;
   bool heading_known = false;
+  /// With engine_off: the car's electrical accessories stay on, fed by its 12 V battery (start-stop at a light),
+  /// not switched off with the key (a soak).
+  bool accessories_on = false;
 };
 
 /// A physical effect with its own parameters and, optionally, hidden states integrated with the vehicle's

@@ -51,6 +51,7 @@ class CombustionPowertrain final : public Powertrain {
   const FuelParams* fuel() const override { return &p_.fuel; }
   /// From the alternator at the engine's marginal (Willans) efficiency, even in fuel cut-off.
   void add_electric_load(double power_w, PowerFlow& flow) const override;
+  double alternator_accessory_load_w() const override { return p_.aux_power_w; }
   const CombustionPowertrainParams& params() const { return p_; }
 
  private:

@@ -70,6 +70,7 @@ class ConventionalPowertrain final : public Powertrain {
   const EngineMap* engine_map() const override { return &map_; }
   bool continuously_variable() const override { return p_.transmission.kind == TransmissionKind::cvt; }
   void add_electric_load(double power_w, PowerFlow& flow) const override;
+  double alternator_accessory_load_w() const override { return p_.aux_power_w; }
   const ConventionalPowertrainParams& params() const { return p_; }
 
  private:

@@ -97,6 +97,10 @@ class Powertrain {
   /// Adds an extra electrical load `power_w` (an effect's consumer) to `flow`, drawn where this powertrain
   /// draws its electricity (battery terminals, or an alternator on the engine).
   virtual void add_electric_load(double power_w, PowerFlow& flow) const = 0;
+
+  /// The electrical accessories' load an alternator carries [W] (0 where the traction battery carries it, inside
+  /// deliver): what a 12 V battery must supply while the engine is stopped with the accessories on.
+  virtual double alternator_accessory_load_w() const { return 0.0; }
 };
 
 }  // namespace rollsim
