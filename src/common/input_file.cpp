@@ -20,11 +20,17 @@ bool is_folder_path(const std::filesystem::path& path) {
   return std::filesystem::is_directory(path, ec);
 }
 
+std::optional<std::string> file_beside(const std::string& name, const std::string& referring_file,
+                                       const std::string& extension) {
+  if (name.empty()) return std::nullopt;
+  const std::string beside = (std::filesystem::path(referring_file).parent_path() / name).string();
+  if (is_regular_file_path(beside)) return beside;
+  if (!extension.empty() && is_regular_file_path(beside + extension)) return beside + extension;
+  return std::nullopt;
+}
+
 std::string path_beside(const std::string& name, const std::string& referring_file) {
-  const std::filesystem::path n(name);
-  if (name.empty() || n.is_absolute()) return name;
-  const std::filesystem::path beside = std::filesystem::path(referring_file).parent_path() / n;
-  return is_regular_file_path(beside) ? beside.string() : name;
+  return file_beside(name, referring_file).value_or(name);
 }
 
 std::string read_input_file(const std::string& path, std::uintmax_t max_bytes) {

@@ -55,15 +55,14 @@ std::vector<DriveCycle> cycles_of(const std::vector<Recording>& recordings, cons
 }
 
 // A bearing taken into [0, 360) deg.
-double wrap_deg(double deg) { return std::fmod(std::fmod(deg, 360.0) + 360.0, 360.0); }
 
 // The bearing's profile interval in words ("": none), its ends taken back to 0-360 deg.
 std::string bearing_interval_text(const Finding& f) {
   for (const auto& p : f.parameters) {
     if (p.name != "wind_from_deg" || !p.profiled) continue;
     if (p.ci_low_open && p.ci_high_open) return "; its bearing is not determined within a half circle";
-    return "; 95 % profile interval " + fixed(wrap_deg(p.ci_low), 0) + (p.ci_low_open ? " or beyond" : "") + " to " +
-           fixed(wrap_deg(p.ci_high), 0) + (p.ci_high_open ? " or beyond" : "") + " deg clockwise";
+    return "; 95 % profile interval " + fixed(units::wrap_deg(p.ci_low), 0) + (p.ci_low_open ? " or beyond" : "") + " to " +
+           fixed(units::wrap_deg(p.ci_high), 0) + (p.ci_high_open ? " or beyond" : "") + " deg clockwise";
   }
   return "";
 }
@@ -84,7 +83,7 @@ void describe_wind(const std::vector<DriveCycle>& cycles, std::vector<Finding>& 
       // pass 0 or 360 deg).
       const bool reverse = f.fitted.at("wind_speed_mps") < 0.0;
       const double from = f.fitted.at("wind_from_deg") + (reverse ? 180.0 : 0.0);
-      const double turn = wrap_deg(from) - f.fitted.at("wind_from_deg");
+      const double turn = units::wrap_deg(from) - f.fitted.at("wind_from_deg");
       if (reverse) f.fitted["wind_speed_mps"] = -f.fitted.at("wind_speed_mps");
       f.fitted["wind_from_deg"] += turn;
       for (auto& p : f.parameters) {
@@ -203,8 +202,7 @@ std::vector<std::string> unit_slip_warnings(const std::vector<Recording>& record
   }
   for (const auto& r : recordings) {
     if (!r.latitude_deg || !r.longitude_deg) continue;
-    double speed_m = 0.0;
-    for (std::size_t i = 0; i + 1 < r.time_s.size(); ++i) speed_m += r.speed_mps[i] * (r.time_s[i + 1] - r.time_s[i]);
+    const double speed_m = r.distance_m();
     const double gps_m = gps_track_m(r);
     if (!(gps_m > 1000.0 && speed_m > 0.0)) continue;
     const double k = gps_m / speed_m;

@@ -258,7 +258,7 @@ std::optional<ProfileResult> refine(const SelectionContext& sc, Candidate& c, co
     const double nominal = c.amplitude->nominal;
     std::vector<EffectList> runs;
     for (double d = -90.0; d <= 90.0 + 1e-9; d += kBearingReplayStep_deg) {
-      const double from = std::fmod(std::fmod(centre + d, 360.0) + 360.0, 360.0);
+      const double from = units::wrap_deg(centre + d);
       runs.push_back({make_effect(c.id, {{c.amplitude->name, nominal}, {"wind_from_deg", from}}, sc.ctx)});
     }
     std::vector<Eigen::VectorXd> sigs;

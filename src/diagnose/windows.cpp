@@ -79,8 +79,7 @@ void cut_windows(Observations& o, const std::vector<Recording>& recordings) {
 // A recording the diagnosis cannot read energy from: the car never moves, or its energy channel never changes (a
 // dead or stuck logger channel, which would otherwise read as the model being infinitely wrong).
 void check_informative(const Recording& r, const std::vector<double>& measured_w, ChannelKind kind) {
-  double distance_m = 0.0;
-  for (std::size_t i = 0; i + 1 < r.time_s.size(); ++i) distance_m += r.speed_mps[i] * (r.time_s[i + 1] - r.time_s[i]);
+  const double distance_m = r.distance_m();
   if (distance_m < kMinDiagnosedDistance_m) {
     throw InputError(r.source, "the car covers " + fixed(distance_m, 0) + " m in the recording; at least " +
                                    fixed(kMinDiagnosedDistance_m, 0) + " m of driving is needed to diagnose it");

@@ -125,8 +125,8 @@ PowerFlow ElectricPowertrain::deliver(double wheel_force_n, double speed_mps, in
     torque_nm = -regen_force_n * wheel_radius_m * eta / ratio;
     // Regenerating must recover energy; where the loss it adds would exceed it, the controller leaves it to
     // friction. The machine's no-load loss (iron, windage) is paid at this speed either way, so it does not count.
-    const double added_loss_w = motor_loss_w(torque_nm, motor_speed_radps) - motor_loss_w(0.0, motor_speed_radps);
-    if (regen_force_n > 0.0 && -regen_force_n * v * eta + added_loss_w >= 0.0) {
+    if (regen_force_n > 0.0 && -regen_force_n * v * eta + motor_loss_w(torque_nm, motor_speed_radps) -
+                                       motor_loss_w(0.0, motor_speed_radps) >= 0.0) {
       regen_force_n = 0.0;
       torque_nm = 0.0;
     }

@@ -12,12 +12,9 @@
 namespace rollsim {
 
 std::string resolve_tyre_path(const std::string& name, const std::string& vehicle_file, const std::string& where) {
-  namespace fs = std::filesystem;
   // Beside the vehicle file, then shipped: never the current folder, or one vehicle file would give another car
   // depending on where it is run from.
-  const fs::path beside = fs::path(vehicle_file).parent_path() / name;
-  for (const fs::path& p : {beside, fs::path(beside.string() + ".yaml")})
-    if (is_regular_file_path(p)) return p.string();
+  if (auto beside = file_beside(name, vehicle_file, ".yaml")) return *beside;
   if (auto shipped = shipped_data_file(name, "tyres", ".yaml")) return *shipped;
   throw InputError(where, "tyre file '" + name + "' not found beside the vehicle file or in the shipped tyres/");
 }

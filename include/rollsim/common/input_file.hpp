@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 
 namespace rollsim {
@@ -24,9 +25,12 @@ std::string read_input_file(const std::string& path, std::uintmax_t max_bytes);
 bool is_regular_file_path(const std::filesystem::path& path);
 bool is_folder_path(const std::filesystem::path& path);
 
-/// A file named inside another file (a fleet manifest, a regression baseline) travels with it: a relative `name`
-/// that exists beside `referring_file` is that file; otherwise `name` is returned unchanged, for the usual lookup
-/// (the current folder, then the shipped data).
+/// A file named inside another file (a vehicle file's tyres, a fleet manifest, a regression baseline) travels with
+/// it: `name` (or `name` + `extension`) resolved against `referring_file`'s folder, if that is a file (an absolute
+/// `name` resolves to itself).
+std::optional<std::string> file_beside(const std::string& name, const std::string& referring_file,
+                                       const std::string& extension = "");
+/// file_beside, else `name` unchanged for the usual lookup (the current folder, then the shipped data).
 std::string path_beside(const std::string& name, const std::string& referring_file);
 
 }  // namespace rollsim

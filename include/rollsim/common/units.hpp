@@ -1,6 +1,8 @@
 // Unit conversions used only at input and output boundaries; everything inside rollsim is SI.
 #pragma once
 
+#include <cmath>
+
 namespace rollsim::units {
 
 inline constexpr double kStandardGravity_mps2 = 9.80665;
@@ -23,6 +25,8 @@ inline constexpr double kPi = 3.14159265358979323846;
 inline constexpr double kRadpsPerRpm = 2.0 * kPi / 60.0;  ///< engine and motor speeds are given in rpm in files
 inline constexpr double kEarthRadius_m = 6371000.0;  ///< mean radius, for local flat-earth projections of GPS
 constexpr double deg_to_rad(double angle_deg) { return angle_deg * kPi / 180.0; }
+/// A bearing taken to [0, 360) deg.
+inline double wrap_deg(double angle_deg) { return std::fmod(std::fmod(angle_deg, 360.0) + 360.0, 360.0); }
 constexpr double rad_to_deg(double angle_rad) { return angle_rad * 180.0 / kPi; }
 constexpr double kmh_to_mps(double speed_kmh) { return speed_kmh * kMpsPerKmh; }
 constexpr double mps_to_kmh(double speed_mps) { return speed_mps / kMpsPerKmh; }
