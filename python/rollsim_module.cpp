@@ -150,7 +150,9 @@ std::optional<TyreSpec> tyre_from(py::handle t) {
 DriveCycle cycle_arrays(py::handle c);
 DriveCycle cycle_from(py::handle c) {
   const DriveCycle cycle = py::isinstance<py::str>(c) ? load_cycle(c.cast<std::string>(), "--cycle") : cycle_arrays(c);
+  // What the trace holds that a user should hear of, as warnings, as the CLI's load_cycle_noted says it on stderr.
   if (const std::string note = ignored_columns_note(cycle); !note.empty()) warn(note);
+  for (const auto& n : cycle.notes) warn(n);
   return cycle;
 }
 DriveCycle cycle_arrays(py::handle c) {
@@ -226,18 +228,11 @@ py::object api_tyre(py::object file, py::object size, py::object outer_radius_m,
   return stack(points);
 }
 
-// cycle_from, with what the trace holds that a user should hear of (DriveCycle::notes) as warnings, as the CLI says it.
-DriveCycle noted_cycle_from(py::handle c) {
-  DriveCycle d = cycle_from(c);
-  for (const auto& n : d.notes) warn(n);
-  return d;
-}
-
 py::dict api_simulate(py::object vehicle, py::object tyre, py::object cycle, py::object replay_arg, py::object trace_arg) {
   const bool replay = flag(replay_arg, "replay"), trace = flag(trace_arg, "trace");
   const Vehicle base = vehicle_from(vehicle);
   const std::optional<TyreSpec> tyre_set = tyre_from(tyre);
-  const DriveCycle c = noted_cycle_from(cycle);
+  const DriveCycle c = cycle_from(cycle);
   SimulationOptions opt;
   opt.record_trace = trace;
   VehicleRun run;
@@ -266,7 +261,7 @@ py::list api_compare(py::object vehicle, py::object tyre_names, py::object cycle
                                  catalogue.is_none() ? "" : arg_as<std::string>(catalogue, "catalogue", "a folder path (str)"));
   for (const auto& b : list.broken) warn("skipped broken catalogue file: " + b);
   const Vehicle v = vehicle_from(vehicle);
-  const DriveCycle c = noted_cycle_from(cycle);
+  const DriveCycle c = cycle_from(cycle);
   selection::Comparison cmp;
   {
     py::gil_scoped_release released;
@@ -297,7 +292,7 @@ py::list api_sweep(py::object tyre, py::object axes_arg, py::object load_n, py::
   selection::SweepResult r;
   if (!vehicle.is_none()) {
     const Vehicle v = vehicle_from(vehicle);
-    const DriveCycle c = noted_cycle_from(cycle);
+    const DriveCycle c = cycle_from(cycle);
     py::gil_scoped_release released;
     r = selection::sweep_vehicle(v, t, c, so);
   } else {
@@ -470,7 +465,7 @@ py::dict api_sensitivity(py::object tyre, py::object vehicle, py::object cycle, 
   const std::optional<TyreSpec> t = tyre_from(tyre);
   std::optional<double> at_n;
   if (!load_n.is_none()) at_n = parse_option_number(number_text(load_n, "load_n"), "--load-n", Range::open_low(0.0, 1e6));
-  const DriveCycle c = v ? noted_cycle_from(cycle) : DriveCycle{};
+  const DriveCycle c = v ? cycle_from(cycle) : DriveCycle{};
   selection::Sensitivity s;
   {
     py::gil_scoped_release released;
