@@ -45,6 +45,15 @@ double ElectricPowertrain::motor_loss_w(double torque_nm, double speed_radps) co
          l.windage_w_s3_per_rad3 * speed_radps * speed_radps * speed_radps + l.constant_w;
 }
 
+// The physical model's speed terms (iron, windage, constant) cancel, leaving the current's (copper) part; a table
+// loses nothing at zero torque, so all of its loss is added. Evaluated on every braking call, hence not as a
+// difference of two motor_loss_w.
+double ElectricPowertrain::torque_loss_w(double torque_nm, double speed_radps) const {
+  const auto& l = p_.motor.losses;
+  if (!l.efficiency.empty()) return motor_loss_w(torque_nm, speed_radps);
+  return l.copper_w_per_nm2 * torque_nm * torque_nm;
+}
+
 double ElectricPowertrain::max_battery_power_w() const {
   const double r = p_.battery.internal_resistance_ohm;
   const double voc = p_.battery.open_circuit_voltage_v;
@@ -125,8 +134,7 @@ PowerFlow ElectricPowertrain::deliver(double wheel_force_n, double speed_mps, in
     torque_nm = -regen_force_n * wheel_radius_m * eta / ratio;
     // Regenerating must recover energy; where the loss it adds would exceed it, the controller leaves it to
     // friction. The machine's no-load loss (iron, windage) is paid at this speed either way, so it does not count.
-    if (regen_force_n > 0.0 && -regen_force_n * v * eta + motor_loss_w(torque_nm, motor_speed_radps) -
-                                       motor_loss_w(0.0, motor_speed_radps) >= 0.0) {
+    if (regen_force_n > 0.0 && -regen_force_n * v * eta + torque_loss_w(torque_nm, motor_speed_radps) >= 0.0) {
       regen_force_n = 0.0;
       torque_nm = 0.0;
     }

@@ -82,6 +82,8 @@ class ElectricPowertrain final : public Powertrain {
 
  private:
   double motor_loss_w(double torque_nm, double speed_radps) const;
+  /// What torque adds to the loss the machine has at this speed anyway (regeneration's cost).
+  double torque_loss_w(double torque_nm, double speed_radps) const;
   /// The speed limiter's factor on the torque limit at this motor speed: 1 below the band, 0 at max speed.
   double speed_limit_factor(double speed_radps) const;
   ElectricPowertrainParams p_;
