@@ -108,6 +108,33 @@ TEST(WindHeading, GustyWindOnAWindingRouteIsNamedWithItsMeanBearing) {
   }
 }
 
+TEST(WindHeading, GustyWindsBearingIntervalHoldsTheTruthAsA95PercentIntervalDoes) {
+  // Gusts leave residuals that grow where the route runs along the wind, which a likelihood ratio with one variance
+  // for every window reads as more certainty than there is: its 95 % interval held the mean bearing on 63 of the 95
+  // seeds of 100 that named a 6 m/s gusty wind (diagnose-bench), and on 31 of these 40, all named. Widened to the
+  // bearing's jackknife variance it holds it on 88 of 95 there, 37 of 40 here. A true 95 % interval falls below 85 %
+  // of 40 about one time in 300; the bearings are spread round the compass.
+  const Vehicle v = ev();
+  int named = 0, held = 0;
+  for (unsigned seed = 1; seed <= 40; ++seed) {
+    SyntheticCase c;
+    c.gps = true;
+    c.effects = {{"wind_gusty_gps", 6.0}};
+    c.wind_from_deg = std::fmod(17.0 + 53.0 * seed, 360.0);
+    c.seed = seed;
+    const Diagnosis d = diagnose(v, {generate_case(v, c)});
+    if (d.findings.empty() || d.findings.front().effect != "wind_heading") continue;
+    const auto& ps = d.findings.front().parameters;
+    const auto p = std::find_if(ps.begin(), ps.end(), [](const auto& e) { return e.name == "wind_from_deg"; });
+    ASSERT_NE(p, ps.end());
+    ++named;
+    const double truth = p->value + std::remainder(*c.wind_from_deg - p->value, 360.0);
+    held += truth >= p->ci_low && truth <= p->ci_high;
+  }
+  EXPECT_GE(named, 34);
+  EXPECT_GE(held * 100, named * 85) << held << " of " << named << " named";
+}
+
 TEST(WindHeading, WithoutGpsTheDiagnosisSaysTheHeadingIsUnknown) {
   const Vehicle v = ev();
   SyntheticCase c;

@@ -263,8 +263,9 @@ ProfileResult profile_time_constant(const Model& m, const TimeProfile& tp, const
 /// wind_heading's bearing: the criterion profiled in 1 deg steps over the half circle centred on `centre_deg`, each
 /// signature interpolated between `replayed`, the wind's replayed signatures every `step_deg` from centre - 90 to
 /// centre + 90 deg (per unit of the wind speed's nominal value); its best adopted as profile_time_constant's is,
-/// against the centre's. The interval is where n_eff ln(RSS / RSS_min) < 3.84, unwrapped (it may pass 0 or 360 deg),
-/// open where it reaches +-90 deg.
+/// against the centre's. The interval is where n_eff ln(RSS / RSS_min) < 3.84 w, unwrapped (it may pass 0 or 360 deg),
+/// open where it reaches +-90 deg; w >= 1 widens it to the bearing's delete-a-block jackknife variance where that is
+/// larger than the one the ratio implies.
 ProfileResult profile_bearing(const Model& m, double centre_deg, double step_deg, const std::vector<Eigen::VectorXd>& replayed,
                               const Scored& centre_score, double amp_min, double amp_max);
 
