@@ -508,6 +508,17 @@ TEST_F(OutsideTesting, ALongIntervalBetweenMovingSamplesIsSaid) {
                   in_ms + ": 6 more such intervals (")) << "a time column in milliseconds";
 }
 
+// A km/h log under a speed_mps header (a WLTC's 131 km/h read as 473 km/h) was driven with 29 "could not follow"
+// warnings and nothing about the unit.
+TEST_F(OutsideTesting, AKmhLogUnderASpeedMpsHeaderIsSaid) {
+  const std::string kmh = write("kmh_as_mps.csv", "time_s,speed_mps\n0,0\n20,60\n40,131.3\n60,131.3\n80,60\n100,0\n");
+  const CmdResult r = run_rollsim("simulate --vehicle ev --cycle '" + kmh + "'");
+  EXPECT_TRUE(has(r.err, "warning: " + kmh + ": line 4, column 'speed_mps': 131.3 m/s is 473 km/h, faster than any "
+                         "drive cycle; if the column holds km/h, name it speed_kmh")) << r.err;
+  const std::string mps = write("mps.csv", "time_s,speed_mps\n0,0\n20,20\n40,36.5\n60,36.5\n80,20\n100,0\n");
+  EXPECT_FALSE(has(run_rollsim("simulate --vehicle ev --cycle '" + mps + "'").err, "faster than any")) << "a WLTC's top speed in m/s";
+}
+
 // The report's "regimes" heading and figure carried one id: invalid HTML, and #regimes was ambiguous.
 TEST_F(OutsideTesting, TheReportsIdsAreUnique) {
   const fs::path dir = dir_ / "report";

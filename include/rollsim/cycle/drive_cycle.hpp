@@ -103,5 +103,8 @@ inline constexpr double kMaxCycleTimeStep_s = 86400.0;
 /// A longer interval between two samples of a moving car is noted (DriveCycle::notes): a logger's gap is otherwise
 /// driven as a straight line between its ends, at speed, for as long as it lasts.
 inline constexpr double kNotedMovingGap_s = 30.0;
+/// A faster speed in a speed_mps column is noted: beyond every drive cycle, where a km/h log under the wrong
+/// header lands (a WLTC's 131 km/h reads as 473 km/h).
+inline constexpr double kNotedCycleSpeed_kmh = 250.0;
 
 }  // namespace rollsim
