@@ -32,14 +32,14 @@ constexpr double kRotatingMassShare = 0.015;
 // pistons grow with the engine, taken here in proportion to displacement.
 constexpr double kEngineInertiaPerDisplacement_kg_m2_per_m3 = 0.143 / 2.464e-3;
 
-// The shift floor against the gearing. A transmission controller's shift map is calibrated in road speed and
-// pedal, not in engine speed, so a car geared shorter holds each gear to a higher engine speed: per test vehicle,
-// the FTP-minus-HWFET error grew with the N/V ratio (README, "Validation"). Above the list's median petrol N/V the
-// floor rises as (N/V / median)^x, between one engine speed for every car (x = 0) and the same road speeds (x = 1);
-// x was chosen on the fitting half (a scan of 0.1 to 1.5, README), the only use of the list in it. Below the
-// median it stays: a controller keeps a coasting engine above its fuel cut-off's refuelling speed, which the
-// floor's 1100 rpm is (lowered to 1089 rpm for the Camry's 24.7 rpm/mph, the model enters cut-off 80 times on
-// its hot UDDS where the car does 63: CamryArgonne.CutOffEntriesMatchTheMeasuredFuelFlow).
+// The shift floor against the gearing. A transmission controller's shift map is calibrated in road speed and pedal, not
+// in engine speed, so a car geared shorter holds each gear to a higher engine speed: per test vehicle, the FTP-minus-
+// HWFET error grew with the N/V ratio (docs/validate-history.md). Above the list's median petrol N/V the floor rises as
+// (N/V / median)^x, between one engine speed for every car (x = 0) and the same road speeds (x = 1); x was chosen on
+// the fitting half (a scan of 0.1 to 1.5, docs/validate-history.md), the only use of the list in it. Below the median
+// it stays: a controller keeps a coasting engine above its fuel cut-off's refuelling speed, which the floor's 1100 rpm
+// is (lowered to 1089 rpm for the Camry's 24.7 rpm/mph, the model enters cut-off 80 times on its hot UDDS where the car
+// does 63: CamryArgonne.CutOffEntriesMatchTheMeasuredFuelFlow).
 constexpr double kShiftFloorReferenceNv_rpm_per_mph = 25.7;
 constexpr double kShiftFloorNvExponent = 0.25;
 
@@ -223,7 +223,7 @@ std::shared_ptr<const Powertrain> electric_of(const EpaTestRow& row) {
   p.motor.max_torque_nm = 3.0 * power_w / p.motor.max_speed_radps;
   // Against the shipped 80 kW machine's physical losses scaled to the rating (iron 1 %, copper 4 %, 150 W
   // standing): the city error 10.2 -> 7.0 % and the highway 5.2 -> 5.1 % on the fitting half, and the refitted
-  // charge efficiency 0.871 -> 0.863, FASTSim's own 0.86 (README, validate).
+  // charge efficiency 0.871 -> 0.863, FASTSim's own 0.86 (docs/validate-history.md).
   p.motor.losses = fastsim_motor_curve(power_w);
   // A 400 V class pack whose I^2 R is 4 % of rated power at rated power (R = 0.04 V^2 / P).
   p.battery.open_circuit_voltage_v = 360.0;

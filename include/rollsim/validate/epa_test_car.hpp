@@ -56,8 +56,8 @@ struct EpaTestRow {
   /// "Analytically Derived FE?" Yes: the result was not measured on the vehicle the row describes. EPA derived it
   /// from that vehicle's test (`base_test`) for another configuration, and the ADFE columns hold that
   /// configuration's test weight, N/V ratio and road-load power at 50 mph; the row's own weight, N/V and target
-  /// coefficients stay the tested vehicle's (README, validate: the list's 305 derived rows whose base test it also
-  /// holds). Empty for a measured row.
+  /// coefficients stay the tested vehicle's (docs/validate-history.md: the list's 305 derived rows whose base test
+  /// it also holds). Empty for a measured row.
   struct DerivedConfiguration {
     std::string base_test;
     std::optional<double> test_mass_kg, engine_radps_per_mps, road_load_power_w;
