@@ -155,7 +155,7 @@ ProfileResult profile_bearing(const Model& m, double centre_deg, double step_deg
   constexpr double kStepDeg = 1.0, kHalfDeg = 90.0;
   const std::size_t last = replayed.size() - 1;
   if (replayed.size() < 3 || replayed.size() % 2 == 0 || std::abs(static_cast<double>(last) * step_deg - 2.0 * kHalfDeg) > 1e-9)
-    throw std::logic_error("profile_bearing: needs an odd number of replays spanning the half circle");  // the caller's contract, not an input
+    throw std::logic_error("profile_bearing: needs an odd number of replays spanning the half circle");
   std::vector<double> grid, rss;
   std::vector<Eigen::VectorXd> sigs;
   for (double d = -kHalfDeg; d <= kHalfDeg + 1e-9; d += kStepDeg) {
