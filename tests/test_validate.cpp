@@ -324,7 +324,6 @@ class BothSources final : public Powertrain {
   int select_gear(double, int) const override { return 0; }
   double max_wheel_force_n(int, double, double) const override { return 1e9; }
   std::vector<double> shift_speeds_mps(int) const override { return {}; }
-  std::vector<double> regime_speeds_mps() const override { return {}; }
   const BatteryParams* battery() const override { return &battery_; }
   const FuelParams* fuel() const override { return &fuel_; }
   void add_electric_load(double w, PowerFlow& p) const override {

@@ -95,7 +95,23 @@ std::vector<double> breakpoints_s(const DriveCycle& c) {
   for (std::size_t i = 1; i + 1 < c.time_s.size(); ++i) {
     const double a0 = (c.speed_mps[i] - c.speed_mps[i - 1]) / (c.time_s[i] - c.time_s[i - 1]);
     const double a1 = (c.speed_mps[i + 1] - c.speed_mps[i]) / (c.time_s[i + 1] - c.time_s[i]);
-    if (std::abs(a1 - a0) > kKinkTolerance_mps2) out.push_back(c.time_s[i]);
+    // A standstill's start is a stop whatever the slope before it: a trace that creeps in at 1e-6 km/h (a resampled
+    // log's residue) has no kink there, and the car then never came to be held on its brakes.
+    const bool standstill_starts = c.speed_mps[i] == 0.0 && c.speed_mps[i + 1] == 0.0 && c.speed_mps[i - 1] != 0.0;
+    if (std::abs(a1 - a0) > kKinkTolerance_mps2 || standstill_starts) out.push_back(c.time_s[i]);
+  }
+  return out;
+}
+
+std::vector<double> crossing_times_s(const DriveCycle& c, double speed_mps, bool falling_only) {
+  std::vector<double> out;
+  for (std::size_t i = 0; i + 1 < c.time_s.size(); ++i) {
+    const double v0 = c.speed_mps[i], v1 = c.speed_mps[i + 1];
+    if (falling_only && !(v1 < v0)) continue;
+    if ((v0 < speed_mps && v1 > speed_mps) || (v0 > speed_mps && v1 < speed_mps))
+      out.push_back(c.time_s[i] + (speed_mps - v0) / (v1 - v0) * (c.time_s[i + 1] - c.time_s[i]));
+    else if (v1 == speed_mps && v0 != speed_mps && i + 2 < c.time_s.size())
+      out.push_back(c.time_s[i + 1]);
   }
   return out;
 }

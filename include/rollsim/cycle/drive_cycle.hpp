@@ -61,10 +61,14 @@ struct DriveCycle {
   double grade_at(double t, std::size_t& hint) const;
 };
 
-/// Interior sample times where the piecewise-linear speed changes slope (kinks), in increasing order; the
-/// first and last sample times are not included. An integrator uses them as stop times so that it never
-/// steps across a discontinuity of the acceleration.
+/// Interior sample times where the piecewise-linear speed changes slope (kinks) or a standstill begins, in
+/// increasing order; the first and last sample times are not included. An integrator uses them as stop times so
+/// that it never steps across a discontinuity of the acceleration.
 std::vector<double> breakpoints_s(const DriveCycle& cycle);
+/// Times, in increasing order, where the piecewise-linear speed crosses `speed_mps` (reaching it at an interior
+/// sample counts; the last sample does not), only while it falls if `falling_only`: where a powertrain's regime
+/// speed lies on the trace.
+std::vector<double> crossing_times_s(const DriveCycle& cycle, double speed_mps, bool falling_only = false);
 
 /// Names accepted by load_cycle besides paths, in a stable order ("wltc" is an alias of "wltc_class3b").
 std::vector<std::string> shipped_cycle_names();

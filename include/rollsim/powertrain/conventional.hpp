@@ -64,7 +64,6 @@ class ConventionalPowertrain final : public Powertrain {
   PowerFlow deliver(double wheel_force_n, double speed_mps, int gear, double wheel_radius_m) const override;
   int select_gear(double, int) const override { return 0; }
   std::vector<double> shift_speeds_mps(int) const override { return {}; }
-  std::vector<double> regime_speeds_mps() const override { return {}; }
   double max_wheel_force_n(int gear, double speed_mps, double wheel_radius_m) const override;
   const FuelParams* fuel() const override { return &p_.fuel; }
   const EngineMap* engine_map() const override { return &map_; }

@@ -79,8 +79,9 @@ class Powertrain {
   /// roots so it never steps over a shift. Empty for single-speed drives.
   virtual std::vector<double> shift_speeds_mps(int gear) const = 0;
 
-  /// Speeds [m/s] at which deliver() switches regime (regen fade, clutch lock-up); stop points for the integrator.
-  virtual std::vector<double> regime_speeds_mps() const = 0;
+  /// Speeds [m/s] at which deliver() changes how it splits a braking force (the regen fade's ends): kinks of the
+  /// energies only, so a simulation splits its steps where a deceleration falls through them. Empty by default.
+  virtual std::vector<double> braking_regime_speeds_mps() const { return {}; }
 
   /// The traction battery, or nullptr when the powertrain has none.
   virtual const BatteryParams* battery() const { return nullptr; }
