@@ -188,6 +188,25 @@ TEST(DriveCycleLookup, BreakpointsAreTheKinks) {
   EXPECT_LT(wb.back(), 1800.0);
 }
 
+TEST(DriveCycleLookup, AStandstillsStartIsABreakpointWithoutAKink) {
+  DriveCycle c;
+  c.time_s = {0, 1, 2, 3, 4, 5};
+  c.speed_mps = {3, 2, 1, 1e-9, 0, 0};  // creeps in: the slope from 1 to 1e-9 and on to 0 differs by 1e-9 m/s^2
+  c.grade.assign(6, 0.0);
+  EXPECT_EQ(rollsim::breakpoints_s(c), (std::vector<double>{3, 4}));
+}
+
+TEST(DriveCycleLookup, CrossingTimesOfASpeed) {
+  DriveCycle c;
+  c.time_s = {0, 10, 20, 30, 40};
+  c.speed_mps = {0, 20, 10, 5, 15};
+  c.grade.assign(5, 0.0);
+  EXPECT_EQ(rollsim::crossing_times_s(c, 15.0), (std::vector<double>{7.5, 15.0}));  // the last sample does not count
+  EXPECT_EQ(rollsim::crossing_times_s(c, 15.0, true), (std::vector<double>{15.0}));
+  EXPECT_EQ(rollsim::crossing_times_s(c, 10.0, true), (std::vector<double>{20.0}));  // reached at a sample
+  EXPECT_EQ(rollsim::crossing_times_s(c, 30.0), (std::vector<double>{}));
+}
+
 TEST_F(DriveCycleFiles, UserCsvWithGradeAndSpeedMps) {
   const auto c = load_cycle(write("hill.csv", "time_s,speed_mps,grade_pct\n0,0,0\n10,10,5\n20,10,-5\n"));
   EXPECT_EQ(c.name, "hill");

@@ -1,4 +1,5 @@
-// A found effect's time constant refined on a log grid, with its profile-likelihood interval.
+// A found effect's shape parameters profiled (time constants on a log grid, the wind's bearing by the degree), with
+// their intervals.
 #include <algorithm>
 #include <cmath>
 #include <limits>

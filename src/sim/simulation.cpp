@@ -4,8 +4,10 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <limits>
 #include <map>
+#include <stdexcept>
 
 #include "rollsim/common/units.hpp"
 
@@ -523,6 +525,27 @@ double max_battery_drain_w(const BatteryParams& b) {
 
 }  // namespace
 
+namespace {
+
+// The powertrain's braking regime speeds (the regen fade's ends) are kinks only of how the braking is split, which the
+// speed does not feel: error control let a smooth deceleration step across the whole fade window, booking 40 %
+// regeneration down to rest. The integrator stops, and restarts, where the trace falls through them (a stop without
+// the restart left the history's polynomial across the kink, and +0.5 % of the regeneration). `stops` is ascending
+// and ends at the trace's end; a crossing within a microsecond of a stop already there is that stop (two stops an
+// ulp apart would leave CVODES a step too short to take).
+void add_braking_regime_stops(const VehicleModel& m, const DriveCycle& c, std::vector<double>& stops) {
+  constexpr double kSameStop_s = 1e-6;
+  for (double v : m.powertrain->braking_regime_speeds_mps()) {
+    for (double t : crossing_times_s(c, v, true)) {
+      const auto it = std::lower_bound(stops.begin(), stops.end(), t);
+      const bool near = (it != stops.end() && *it - t < kSameStop_s) || (it != stops.begin() && t - *(it - 1) < kSameStop_s);
+      if (!near && t > c.time_s.front() + kSameStop_s) stops.insert(it, t);
+    }
+  }
+}
+
+}  // namespace
+
 SimulationResult simulate_forward(const VehicleModel& m, const DriveCycle& c, const SimulationOptions& opt) {
   ForwardSystem sys(m, c, opt);
   const int n = sys.size();
@@ -580,18 +603,8 @@ SimulationResult simulate_forward(const VehicleModel& m, const DriveCycle& c, co
   const double t0 = c.time_s.front();
   const double t_end = c.time_s.back();
   std::vector<double> stops = breakpoints_s(c);
-  // The powertrain's braking regime speeds (the regen fade's ends) are kinks only of how the braking is split, which
-  // the speed does not feel: error control let a smooth deceleration step across the whole fade window, booking
-  // 40 % regeneration down to rest. The integrator stops, and restarts, where the trace falls through them (a stop
-  // without the restart left the history's polynomial across the kink, and +0.5 % of the regeneration).
-  for (double v : m.powertrain->braking_regime_speeds_mps()) {
-    const std::vector<double> at = crossing_times_s(c, v, true);
-    stops.insert(stops.end(), at.begin(), at.end());
-  }
-  std::sort(stops.begin(), stops.end());
-  stops.erase(std::unique(stops.begin(), stops.end()), stops.end());
-  while (!stops.empty() && !(stops.back() < t_end)) stops.pop_back();
   stops.push_back(t_end);
+  add_braking_regime_stops(m, c, stops);
   auto stop_after = [&](double t) {
     const auto it = std::upper_bound(stops.begin(), stops.end(), t);
     return it == stops.end() ? t_end : *it;
@@ -792,7 +805,8 @@ SimulationResult simulate_replay(const VehicleModel& m, const DriveCycle& c, con
   constexpr std::size_t kMaxBrakingRegimeSpeeds = 4;
   std::vector<double> regime_speeds = m.powertrain->braking_regime_speeds_mps();
   std::sort(regime_speeds.begin(), regime_speeds.end(), std::greater<>());
-  if (regime_speeds.size() > kMaxBrakingRegimeSpeeds) throw std::logic_error("simulate_replay: more braking regime speeds than it splits a ramp at");
+  if (regime_speeds.size() > kMaxBrakingRegimeSpeeds)
+    throw std::logic_error("simulate_replay: more braking regime speeds than a ramp is split at");
 
   std::vector<double> x(eval.effect_states, 0.0), xdot(eval.effect_states, 0.0), xdot_sum(eval.effect_states, 0.0);
   {
@@ -927,8 +941,7 @@ SimulationResult simulate_replay(const VehicleModel& m, const DriveCycle& c, con
         SegmentEnergy e{};
         // A ramp falling through a braking regime speed (the regen fade's ends) is split there: the split of the
         // braking has a kink in speed, which two Gauss points across it miss (a 60-0 km/h ramp over 16 s recovered
-        // 2 % too little).
-        // Fractions of the ramp where it is cut, ascending: falling, it meets the higher speed first.
+        // 2 % too little). The cuts are fractions of the ramp, ascending: falling, it meets the higher speed first.
         std::array<double, 2 + kMaxBrakingRegimeSpeeds> cut{};
         std::size_t cuts = 0;
         cut[cuts++] = 0.0;
