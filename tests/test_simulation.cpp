@@ -208,9 +208,13 @@ TEST(Simulation, PetrolCarKicksDownToFollowDemandingCycles) {
   for (const char* cycle : {"udds", "wltc", "us06"}) {
     const auto c = load_cycle(cycle);
     const auto f = simulate_forward(m, c);
-    EXPECT_LT(f.max_speed_error_mps * 3.6, 2.0) << cycle;
-    EXPECT_TRUE(f.shortfalls.empty()) << cycle;
-    // US06 asks more than the 88 kW engine has for a few seconds: the replay books that, but only a sliver.
+    // US06 asks more than the 88 kW engine has for a few seconds. Until session 18 the kick-down took first gear at
+    // 47 km/h, 0.4 % past the engine's top speed, to keep within 2 km/h; within its top speed the car falls 2.2 km/h
+    // behind for a second at 574 s, inside the 2 mph an EPA dynamometer driver is allowed off the trace.
+    const bool us06 = std::string(cycle) == "us06";
+    EXPECT_LT(f.max_speed_error_mps * 3.6, us06 ? 2.0 * 1.609344 : 2.0) << cycle;
+    EXPECT_TRUE(us06 || f.shortfalls.empty()) << cycle;
+    // The replay books that demand, but only a sliver.
     const auto r = simulate_replay(m, c);
     EXPECT_LT(r.energy.unmet_demand_j, 0.005 * r.energy.traction_j) << cycle;
     EXPECT_LT(std::abs(f.fuel->volume_m3 / r.fuel->volume_m3 - 1.0), 0.005) << cycle;
@@ -358,4 +362,38 @@ TEST(Simulation, ATraceCreepingIntoAStandstillIsHeldThere) {
   const double creeping_j = simulate_forward(m, stop(1e-6)).energy.battery_terminal_j;
   // The creep's one second at 1e-6 km/h may cost the constant loss for that second, not for the minute after it.
   EXPECT_LT(std::abs(creeping_j - clean_j), 1500.0) << clean_j << " J clean";
+}
+
+// A demand beyond the engine's power made the forward kick-down fall through to a gear whose engine was past its top
+// speed, and stay there: ice.yaml ran first gear at 96 km/h (12,866 rpm against its 6300) on a 60-100 km/h
+// acceleration in 5 s, and camry_2018.yaml 11,816 rpm against 6600 (an outside check). A kicked-down gear now shifts
+// up at its engine's top speed, and a kick-down is only to a gear that gives more force.
+TEST(Simulation, AKickDownNeverTakesTheEnginePastItsTopSpeed) {
+  const std::vector<std::pair<double, double>> hard{{0.0, 0.0}, {20.0, 60.0}, {60.0, 60.0}, {65.0, 100.0}, {90.0, 100.0}};
+  for (const auto& [file, top_rpm] : {std::pair{"vehicles/ice.yaml", 6300.0}, std::pair{"vehicles/camry_2018.yaml", 6600.0}}) {
+    SimulationOptions opt;
+    opt.record_trace = true;
+    const auto r = simulate_forward(model_of(file), sampled(hard, 0.2), opt);
+    double top_seen_rpm = 0.0;
+    for (const auto& p : r.trace) top_seen_rpm = std::max(top_seen_rpm, p.machine_speed_radps * 60.0 / (2.0 * 3.141592653589793));
+    EXPECT_LE(top_seen_rpm, top_rpm * (1.0 + 1e-3)) << file;
+    EXPECT_GT(top_seen_rpm, 0.9 * top_rpm) << file << ": the hard acceleration uses the engine's range";
+  }
+}
+
+// The replay integrated a ramp with two Gauss points however long it was: across a 30 s coast from 60 km/h to rest
+// they missed the gear shifts and the fuel cut-off, and ice.yaml booked 116 kJ of fuel where the forward simulation
+// (and the same coast sampled at 0.05 s) book 73 kJ. A ramp is now integrated in pieces of at most a second.
+TEST(Simulation, ReplayOfACoarseTraceAgreesWithTheSameTraceSampledFinely) {
+  const std::vector<std::pair<double, double>> coast{{0.0, 60.0}, {30.0, 0.0}, {40.0, 0.0}};
+  for (const char* file : {"vehicles/ice.yaml", "vehicles/camry_2018_map.yaml"}) {
+    const auto m = model_of(file);
+    DriveCycle coarse = sampled(coast, 10.0);
+    coarse.time_s = {0.0, 30.0, 40.0};
+    coarse.speed_mps = {60.0 / 3.6, 0.0, 0.0};
+    coarse.grade.assign(3, 0.0);
+    const double fine_j = simulate_replay(m, sampled(coast, 0.05)).energy.fuel_j;
+    EXPECT_NEAR(simulate_replay(m, coarse).energy.fuel_j / fine_j, 1.0, 0.01) << file;
+    EXPECT_NEAR(simulate_forward(m, coarse).energy.fuel_j / fine_j, 1.0, 0.01) << file;
+  }
 }
