@@ -4,10 +4,8 @@
 #include <array>
 #include <cmath>
 #include <cstring>
-#include <functional>
 #include <limits>
 #include <map>
-#include <stdexcept>
 
 #include "rollsim/common/units.hpp"
 
@@ -403,7 +401,6 @@ class ForwardSystem final : public OdeSystem {
   }
   int scheduled_gear() const { return scheduled_gear_; }
 
-  /// The highest gear from `from` down that delivers `demand_n` at `speed_mps`.
   /// Where a kicked-down gear's engine reaches its top speed: the next gear up (to the schedule's) that gives force.
   int upshift_from_top_speed(int engaged, double speed_mps) const {
     int g = engaged + 1;
@@ -411,6 +408,7 @@ class ForwardSystem final : public OdeSystem {
     return std::min(g, scheduled_gear_);
   }
 
+  /// The highest gear from `from` down that delivers `demand_n` at `speed_mps`.
   int kickdown_gear(int from, double speed_mps, double demand_n) const {
     int g = from;
     while (g > 1 && demand_n > max_force(g, speed_mps) && max_force(g - 1, speed_mps) > max_force(g, speed_mps)) --g;
@@ -951,12 +949,11 @@ SimulationResult simulate_replay(const VehicleModel& m, const DriveCycle& c, con
       } else {
         std::fill(xdot_sum.begin(), xdot_sum.end(), 0.0);
         SegmentEnergy e{};
-        // A ramp falling through a braking regime speed (the regen fade's ends) is split there too: the split of the
-        // braking has a kink in speed, which two Gauss points across it miss (a 60-0 km/h ramp over 16 s recovered
-        // 2 % too little). The cuts are fractions of the ramp, ascending.
         // A long ramp (a coarse trace, a breakpoint table) is integrated in pieces of at most a second, as the
         // shipped 1 Hz cycles are: across a ramp of 30 s two Gauss points missed a combustion car's gear shifts and
-        // fuel cut-off (a 60-0 km/h coast of ice.yaml over 30 s booked 59 % too much fuel).
+        // fuel cut-off (a 60-0 km/h coast of ice.yaml over 30 s booked 59 % too much fuel). A ramp falling through a
+        // braking regime speed (the regen fade's ends) is cut there too: the split of the braking has a kink in speed
+        // (a 60-0 km/h ramp over 16 s recovered 2 % too little). The cuts are fractions of the ramp, ascending.
         const auto pieces = static_cast<std::size_t>(std::max(1.0, std::ceil(dt / kMaxReplayPiece_s - 1e-9)));
         cut.clear();
         for (std::size_t p = 0; p <= pieces; ++p) cut.push_back(static_cast<double>(p) / static_cast<double>(pieces));
