@@ -533,10 +533,6 @@ double max_battery_drain_w(const BatteryParams& b) {
   return b.internal_resistance_ohm > 0.0 ? voc * voc / b.internal_resistance_ohm : std::numeric_limits<double>::infinity();
 }
 
-}  // namespace
-
-namespace {
-
 // The powertrain's braking regime speeds (the regen fade's ends) are kinks only of how the braking is split, which the
 // speed does not feel: error control let a smooth deceleration step across the whole fade window, booking 40 %
 // regeneration down to rest. The integrator stops, and restarts, where the trace falls through them (a stop without
