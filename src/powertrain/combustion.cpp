@@ -41,15 +41,16 @@ double CombustionPowertrain::max_wheel_force_n(int gear, double speed_mps, doubl
   return force_n;
 }
 
-void add_alternator_load(double power_w, double alternator_efficiency, double indicated_efficiency,
+void add_alternator_load(double power_w, double alternator_efficiency, double marginal_efficiency,
                          const FuelParams& fuel, PowerFlow& flow) {
-  const double fuel_w = power_w / (alternator_efficiency * indicated_efficiency);
+  const double fuel_w = power_w / (alternator_efficiency * marginal_efficiency);
   flow.aux_power_w += power_w;
   flow.fuel_power_w += fuel_w;
   flow.engine_loss_w += fuel_w - power_w;
   flow.fuel_rate_m3_per_s += fuel_w / fuel.energy_j_per_m3();
 }
 
+// A Willans engine's fuel is linear in brake power: its marginal efficiency is the indicated one.
 void CombustionPowertrain::add_electric_load(double power_w, PowerFlow& flow) const {
   add_alternator_load(power_w, p_.alternator_efficiency, p_.engine.indicated_efficiency, p_.fuel, flow);
 }
@@ -64,7 +65,7 @@ PowerFlow CombustionPowertrain::deliver(double wheel_force_n, double speed_mps, 
   const double v = std::max(speed_mps, 0.0);
   const double coupled_speed_radps = v / wheel_radius_m * ratio;
   // Below idle speed the clutch slips: the engine turns at idle while the gearbox input turns slower.
-  const double engine_speed_radps = std::max(coupled_speed_radps, e.idle_speed_radps);
+  double engine_speed_radps = std::max(coupled_speed_radps, e.idle_speed_radps);
   const double accessory_power_w = p_.aux_power_w / p_.alternator_efficiency;
 
   PowerFlow out;
@@ -94,6 +95,8 @@ PowerFlow CombustionPowertrain::deliver(double wheel_force_n, double speed_mps, 
       out.aux_power_w = 0.0;
       return out;
     }
+    engine_speed_radps = e.idle_speed_radps;
+    out.machine_speed_radps = engine_speed_radps;
   }
   out.fuel_power_w = (brake_power_w + friction_power_w(engine_speed_radps)) / e.indicated_efficiency;
   out.engine_loss_w = out.fuel_power_w - brake_power_w;

@@ -26,8 +26,9 @@ struct PowerFlow;
 class EngineMap;
 
 /// Books an electric load of `power_w` carried by an engine through its alternator: the fuel it costs at the
-/// engine's indicated efficiency, and the loss that is not the load. One rule for every fuel-burning powertrain.
-void add_alternator_load(double power_w, double alternator_efficiency, double indicated_efficiency,
+/// engine's marginal efficiency (extra fuel per extra brake work at part load), and the loss that is not the load.
+/// One rule for every fuel-burning powertrain.
+void add_alternator_load(double power_w, double alternator_efficiency, double marginal_efficiency,
                          const FuelParams& fuel, PowerFlow& flow);
 
 /// Powers at one instant, all [W], signed where noted. Everything downstream of the wheel that the energy
