@@ -52,6 +52,38 @@ TEST(CliSimulate, TraceIsWrittenWholeOrNotAtAll) {
   std::filesystem::remove_all(dir);
 }
 
+// A trace carries the car's own sources only (a petrol car printed a state of charge of 0), and its running totals
+// end at the run's totals: the last row of the forward run is the cycle's last sample.
+TEST(CliSimulate, TraceColumnsAreTheCarsOwnAndItsTotalsEndAtTheRunsTotals) {
+  const auto dir = rollsim::test::temp_dir() / "simulate_columns";
+  std::filesystem::create_directories(dir);
+  for (const std::string car : {"ev", "ice"}) {
+    const auto trace = (dir / (car + ".csv")).string();
+    const auto out = run("simulate --vehicle " + car + " --cycle udds --json --trace " + trace);
+    ASSERT_EQ(out.exit_code, 0) << out.text;
+    std::ifstream in(trace);
+    std::string header, line, last;
+    std::getline(in, header);
+    while (std::getline(in, line)) last = line;
+    const bool electric = car == "ev";
+    EXPECT_EQ(header.find("soc_pct") != std::string::npos, electric) << header;
+    EXPECT_EQ(header.find("battery_energy_kwh") != std::string::npos, electric) << header;
+    EXPECT_EQ(header.find("fuel_rate_lph") != std::string::npos, !electric) << header;
+    EXPECT_EQ(header.find("fuel_l,") != std::string::npos || header.ends_with("fuel_l"), !electric) << header;
+    // The last cell is the running total (battery_energy_kwh or fuel_l), against the JSON's total.
+    const double total = std::stod(last.substr(last.rfind(',') + 1));
+    const std::string key = electric ? "\"battery_terminals\": " : "\"fuel_l_per_100km\": ";
+    const auto at = out.text.find(key);
+    ASSERT_NE(at, std::string::npos) << out.text;
+    const double json_value = std::stod(out.text.substr(at + key.size()));
+    const auto km_at = out.text.find("\"distance_km\": ");
+    const double km = std::stod(out.text.substr(km_at + 15));
+    const double expected = electric ? json_value : json_value * km / 100.0;
+    EXPECT_NEAR(total / expected, 1.0, 1e-6) << car;
+  }
+  std::filesystem::remove_all(dir);
+}
+
 TEST(CliSimulate, BadInputGivesOneClearErrorAndNonZeroExit) {
   for (const std::string args : {"simulate --vehicle no_such_car", "simulate --vehicle ev --tyre no_such_tyre",
                                  "simulate --vehicle ev --cycle no_such_cycle"}) {

@@ -234,7 +234,8 @@ JsonObject to_json(const SimulationResult& r, const std::string& tyre_label) {
 
 std::vector<TraceColumn> trace_columns(const SimulationResult& r) {
   using P = TracePoint;
-  const std::vector<std::pair<std::string, double (*)(const P&)>> columns{
+  using Column = std::pair<std::string, double (*)(const P&)>;
+  std::vector<Column> columns{
       {"time_s", [](const P& p) { return p.time_s; }},
       {"target_speed_kmh", [](const P& p) { return units::mps_to_kmh(p.target_speed_mps); }},
       {"speed_kmh", [](const P& p) { return units::mps_to_kmh(p.speed_mps); }},
@@ -246,12 +247,23 @@ std::vector<TraceColumn> trace_columns(const SimulationResult& r) {
       {"grade_force_n", [](const P& p) { return p.grade_force_n; }},
       {"wheel_force_n", [](const P& p) { return p.wheel_force_n; }},
       {"traction_power_kw", [](const P& p) { return p.traction_power_w / 1e3; }},
-      {"battery_power_kw", [](const P& p) { return p.battery_power_w / 1e3; }},
-      {"battery_current_a", [](const P& p) { return p.battery_current_a; }},
-      {"fuel_rate_lph", [](const P& p) { return p.fuel_rate_m3_per_s / units::kM3PerLitre * units::kSPerHour; }},
-      {"tyre_rrc", [](const P& p) { return p.rrc; }},
-      {"soc_pct", [](const P& p) { return p.soc * 100.0; }},
   };
+  // A car's own sources only: a petrol car printed a state of charge of 0 and an electric one a fuel rate of 0.
+  if (r.battery) {
+    columns.insert(columns.end(), {
+        {"battery_power_kw", [](const P& p) { return p.battery_power_w / 1e3; }},
+        {"battery_current_a", [](const P& p) { return p.battery_current_a; }},
+    });
+  }
+  if (r.fuel) columns.push_back({"fuel_rate_lph", [](const P& p) { return p.fuel_rate_m3_per_s / units::kM3PerLitre * units::kSPerHour; }});
+  columns.push_back({"tyre_rrc", [](const P& p) { return p.rrc; }});
+  if (r.battery) {
+    columns.insert(columns.end(), {
+        {"soc_pct", [](const P& p) { return p.soc * 100.0; }},
+        {"battery_energy_kwh", [](const P& p) { return units::j_to_kwh(p.battery_terminal_energy_j); }},
+    });
+  }
+  if (r.fuel) columns.push_back({"fuel_l", [](const P& p) { return p.fuel_volume_m3 / units::kM3PerLitre; }});
   std::vector<TraceColumn> out;
   for (const auto& [name, value] : columns) {
     TraceColumn c{name, {}};

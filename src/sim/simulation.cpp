@@ -288,8 +288,14 @@ void finish_result(const VehicleModel& m, const DriveCycle& c, double distance_m
   }
 }
 
+double soc_of(const VehicleModel& m, const double* acc) {
+  const BatteryParams* b = m.powertrain->battery();
+  return b && b->usable_capacity_j > 0.0 ? b->initial_soc - (acc[kTerminal] + acc[kBatteryLoss]) / b->usable_capacity_j : 0.0;
+}
+
+// `acc`: the run's accumulators at time t, for the state of charge and the running totals.
 TracePoint trace_point(const VehicleModel& m, double t, double target_mps, double v, double a, double grade,
-                       const Instant& s, int gear, double soc) {
+                       const Instant& s, int gear, const double* acc) {
   TracePoint p{};
   p.time_s = t;
   p.target_speed_mps = target_mps;
@@ -312,7 +318,9 @@ TracePoint trace_point(const VehicleModel& m, double t, double target_mps, doubl
   p.rrc = s.rolling_n / normal_n;
   p.machine_speed_radps = s.flow.machine_speed_radps;
   p.gear_ratio = s.flow.gear_ratio;
-  p.soc = soc;
+  p.soc = soc_of(m, acc);
+  p.battery_terminal_energy_j = acc[kTerminal];
+  p.fuel_volume_m3 = acc[kFuelVolume];
   p.gear = gear;
   return p;
 }
@@ -521,11 +529,6 @@ class ForwardSystem final : public OdeSystem {
   double shifts_up_ = -1.0, shifts_down_ = -1.0;
 };
 
-double soc_of(const VehicleModel& m, const double* acc) {
-  const BatteryParams* b = m.powertrain->battery();
-  return b && b->usable_capacity_j > 0.0 ? b->initial_soc - (acc[kTerminal] + acc[kBatteryLoss]) / b->usable_capacity_j : 0.0;
-}
-
 // The most chemical power the battery can give [W]: Voc^2 / 4R at its terminals plus as much again in I^2 R,
 // doubled for effects' extra losses; infinite without internal resistance. No step can empty the battery faster.
 double max_battery_drain_w(const BatteryParams& b) {
@@ -653,7 +656,7 @@ SimulationResult simulate_forward(const VehicleModel& m, const DriveCycle& c, co
       const double accel = sys.evaluate(t, y.data(), s, nullptr);
       const double grade = c.grade.empty() ? 0.0 : c.grade[c.segment_index(t)];
       const auto q = t == c.time_s.front() ? q0 : integ.quadratures_at(t);
-      r.trace.push_back(trace_point(m, t, target, y[kSpeed], accel, grade, s, sys.gear, soc_of(m, all_accumulators(q).data())));
+      r.trace.push_back(trace_point(m, t, target, y[kSpeed], accel, grade, s, sys.gear, all_accumulators(q).data()));
     }
   };
   if (opt.record_trace) record(t0, y0);
@@ -905,9 +908,12 @@ SimulationResult simulate_replay(const VehicleModel& m, const DriveCycle& c, con
     double soc_before_ramp = 0.0;
     std::array<double, kAccumulators> segment_energy_j{};  // a ramp's integral (for the trace)
     if (opt.record_trace) {
+      // A cruise is booked when the next segment differs; the sample at its end must see it (the state of charge
+      // lagged a second behind through every cruise and standstill).
+      book_cruise();
       const int g = gear;
       evaluate_at(t0, v0, a, grade, rl, distance_m);
-      r.trace.push_back(trace_point(m, t0, v0, v0, a, grade, s, gear, soc_of(m, acc.data())));
+      r.trace.push_back(trace_point(m, t0, v0, v0, a, grade, s, gear, acc.data()));
       gear = g;
     }
     if (a == 0.0) {

@@ -44,10 +44,16 @@ struct TraceColumn {
   std::vector<double> values;
 };
 
-/// The --trace columns in file order, one value per trace point.
+/// The --trace columns in file order, one value per trace point. Powers and rates are the values at the point
+/// (traction_power_kw: the power the drive delivers at the wheels, 0 when braking). A battery's columns
+/// (battery_power_kw, battery_current_a, soc_pct, battery_energy_kwh) and a fuel's (fuel_rate_lph, fuel_l) appear
+/// only for a car that has one. battery_energy_kwh and fuel_l are running totals from the start, as the run
+/// integrates them: a difference of two rows is that interval's energy or fuel exactly, where point rates summed
+/// over a 1 Hz trace miss every kink. The forward run's rows are the cycle's samples; the replay's are its segment
+/// starts (the last sample is not a row, so the last row's totals lack the last segment).
 std::vector<TraceColumn> trace_columns(const SimulationResult& r);
 
-/// One row per trace point: speed, forces, powers, tyre RRC, battery current or fuel rate, state of charge.
+/// One row per trace point, the columns of trace_columns.
 void write_trace_csv(std::ostream& out, const SimulationResult& r);
 
 /// The figure a run is judged by: kWh/10 km for electric cars, l/100 km for combustion ones.

@@ -116,6 +116,10 @@ struct TracePoint {
   double machine_speed_radps;  ///< engine or motor speed (0 with the engine off)
   double gear_ratio;           ///< the powertrain's engaged gear ratio (0: none, or a powertrain without gears)
   double soc;  ///< state of charge, fraction (electric)
+  /// Running totals from the start to this sample, as the run integrates them: their last values are the run's
+  /// totals, and differences give any interval's exactly (point powers summed over a trace do not, at kinks).
+  double battery_terminal_energy_j;  ///< drawn at the battery's terminals (regeneration negative)
+  double fuel_volume_m3;
   int gear;
 };
 
