@@ -538,6 +538,45 @@ TEST(EpaList, WholeListSkipsByNameAndAgreesAsReportedOnTheHeldOutHalf) {
   }
   EXPECT_GT(hybrids, 10);
   EXPECT_GE(absurd, 1);
+  // Outside testing (session 19) found three things in the list that no name says:
+  // - A test is repeated on one line per aftertreatment device (80 tests, 119 extra lines, most of them diesel):
+  //   each counts once, and the repeats name the line that counts.
+  std::map<std::string, int> counted;
+  for (const auto& o : v.rows) {
+    if (o.repeat_of_line == 0) {
+      ++counted[o.row->test_number];
+    } else {
+      EXPECT_NE(o.skip, validate::SkipReason::none) << o.row->test_number;
+      EXPECT_LT(o.repeat_of_line, o.row->line);
+    }
+  }
+  for (const auto& [test, n] : counted) EXPECT_EQ(n, 1) << test;
+  EXPECT_EQ(v.rows.size() - counted.size(), 119u);
+  // - An FTP run with four bags (FE Bag 4 given) is the hybrids' procedure (SAE J1711, 40 CFR 600.115-11(c)), and
+  //   the 48 V mild hybrids that no name flags are tested so: BMW's M340i, Mercedes' E 450, Volvo's B5. Every
+  //   liquid-fuel test of such a vehicle is skipped as a hybrid.
+  int four_bag = 0;
+  for (const auto& o : v.rows) {
+    const bool other_reason = o.row->cycle == validate::EpaCycle::sc03 || o.row->cycle == validate::EpaCycle::cold ||
+                              o.row->fuel == validate::EpaFuel::electricity;
+    if (o.row->bag4_mpg && *o.row->bag4_mpg > 0.0 && !other_reason) {
+      EXPECT_EQ(o.skip, validate::SkipReason::hybrid) << o.row->test_number << " " << o.row->model;
+      ++four_bag;
+    }
+    for (const char* mild : {"M340i xDrive", "E 450 4MATIC", "XC60 B5"}) {
+      if (o.row->model == mild && !other_reason) EXPECT_EQ(o.skip, validate::SkipReason::hybrid) << o.row->test_number << " " << mild;
+    }
+  }
+  EXPECT_GT(four_bag, 100);
+  // - The Ferrari Portofino M's four results are 13.7 % below what their own HC, CO and CO2 give (40 CFR 600.113's
+  //   carbon balance, which every other petrol row meets within a few per cent): not that test's results, skipped.
+  int inconsistent = 0;
+  for (const auto& o : v.rows) {
+    if (o.skip != validate::SkipReason::inconsistent_result) continue;
+    ++inconsistent;
+    EXPECT_EQ(o.row->make, "Ferrari") << o.row->test_number << " " << o.skip_detail;
+  }
+  EXPECT_EQ(inconsistent, 4);
   EXPECT_EQ(kwh_rows, 16);  // Hyundai, Ford and Rivian: both cycles of each vehicle in the same unit
   // The split keeps every test of a model on one side.
   for (const auto& o : v.rows) EXPECT_EQ(o.fitting_half, validate::in_fitting_half(*o.row));
@@ -607,7 +646,7 @@ TEST(EpaList, WholeListSkipsByNameAndAgreesAsReportedOnTheHeldOutHalf) {
     if (s.powertrain == "electric") EXPECT_LT(s.physics.median_abs_error_pct, 8.0) << s.cycle;
   }
   // The maker calibration (README, "The maker calibration"), judged on models it never saw: on the held-out half as
-  // split it meets every target the physics alone misses (at this commit petrol FTP-75 4.8 / 11.8 %, electric CD
+  // split it meets every target the physics alone misses (at this commit petrol FTP-75 4.6 / 11.0 %, electric CD
   // UDDS 1.9 / 10.4 %) and keeps those it meets. Many of those models are trims of nameplates the fitting half
   // holds; for a new nameplate it does not meet them (scripts/validate-nameplates, README). It leaves the physics'
   // prediction as it was, and a fitting row's factor is learned without its own model.

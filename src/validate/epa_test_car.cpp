@@ -119,6 +119,8 @@ std::string to_string(SkipReason r) {
     case SkipReason::cold_test: return "cold-ambient test (-7 degC): no cold-ambient model";
     case SkipReason::other_procedure: return "test procedure not simulated";
     case SkipReason::hybrid: return "hybrid or plug-in hybrid: no hybrid model";
+    case SkipReason::duplicate_test: return "the same test as an earlier line (counted once)";
+    case SkipReason::inconsistent_result: return "measured result contradicts the row's own exhaust carbon";
     case SkipReason::fuel_cell: return "hydrogen fuel cell: no fuel-cell model";
     case SkipReason::unsupported_fuel: return "fuel without properties here";
     case SkipReason::missing_field: return "missing field";
@@ -146,6 +148,9 @@ std::vector<EpaTestRow> read_epa_test_car_list(const std::string& path) {
                     c_adfe = col("Analytically Derived FE?"), c_adfe_test = col("ADFE Test Number"),
                     c_adfe_power = col(kAdfePower), c_adfe_etw = col(kAdfeWeight), c_adfe_nv = col(kAdfeNv);
   const std::size_t c_bag[3] = {col("FE Bag 1"), col("FE Bag 2"), col("FE Bag 3")};
+  // Optional: a list without them is read as before.
+  const auto c_bag4 = t.column("FE Bag 4"), c_hc = t.column("THC (g/mi)"), c_co = t.column("CO (g/mi)"),
+             c_co2 = t.column("CO2 (g/mi)");
   if (t.rows.empty()) throw InputError(path, "no test rows: the file has the list's columns but no data line");
   std::vector<EpaTestRow> rows;
   rows.reserve(t.rows.size());
@@ -181,6 +186,11 @@ std::vector<EpaTestRow> read_epa_test_car_list(const std::string& path) {
     if (const auto v = number(c_c)) r.road_c_n_s2_per_m2 = *v * kNPerLbf / (kMpsPerMph * kMpsPerMph);
     r.measured = number(c_fe);
     for (int b = 0; b < 3; ++b) r.bag_mpg[b] = number(c_bag[b]);
+    auto optional_number = [&](const std::optional<std::size_t>& c) { return c ? number(*c) : std::nullopt; };
+    r.bag4_mpg = optional_number(c_bag4);
+    r.hc_g_per_mi = optional_number(c_hc);
+    r.co_g_per_mi = optional_number(c_co);
+    r.co2_g_per_mi = optional_number(c_co2);
     if (lower_ascii(trim(cells[c_adfe])) == "yes") {
       EpaTestRow::DerivedConfiguration d;
       d.base_test = trim(cells[c_adfe_test]);

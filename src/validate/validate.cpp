@@ -10,6 +10,7 @@
 
 #include "rollsim/common/distribute.hpp"
 #include "rollsim/common/error.hpp"
+#include "rollsim/common/format.hpp"
 #include "rollsim/common/statistics.hpp"
 #include "rollsim/common/text.hpp"
 #include "rollsim/common/units.hpp"
@@ -86,6 +87,7 @@ bool name_says_hybrid(const EpaTestRow& r) {
 
 struct VehicleFacts {
   bool charge_depleting_on_fuel = false;
+  bool four_bag_ftp = false;  ///< an FTP of this vehicle was run with four bags, as hybrids are (SAE J1711)
   double ftp_mpg = 0.0, hwfet_mpg = 0.0;
   bool electric_result_in_mpge = false;  ///< a charge-depleting result at 60 MPG or more: MPGe, as the unit says
 };
@@ -99,6 +101,7 @@ std::map<std::string, VehicleFacts> vehicle_facts(const std::vector<EpaTestRow>&
   for (const auto& r : rows) {
     auto& v = f[vehicle_key(r)];
     if (charge_depleting(r.cycle) && liquid(r.fuel)) v.charge_depleting_on_fuel = true;
+    if (r.cycle == EpaCycle::ftp75 && r.bag4_mpg && *r.bag4_mpg > 0.0) v.four_bag_ftp = true;
     if (charge_depleting(r.cycle) && r.fuel == EpaFuel::electricity && r.measured && *r.measured >= kKwhPer100MiBelow)
       v.electric_result_in_mpge = true;
     // Only results in a liquid-fuel car's plausible range inform the hybrid rule: an absurd one is skipped as such.
@@ -112,6 +115,21 @@ std::map<std::string, VehicleFacts> vehicle_facts(const std::vector<EpaTestRow>&
 // A conventional car's highway economy beats its city economy by 25-50 %; regenerative braking and engine-off
 // stops bring a hybrid's city figure up to its highway one.
 constexpr double kHybridHighwayOverCity = 1.10;
+
+// ---- the measured result against the row's own exhaust: EPA computes fuel economy from the carbon in it ----
+// 40 CFR 600.113: mpg = K / (0.866 HC + 0.429 CO + 0.273 CO2), g/mi; K = 2778 for diesel, and for petrol
+// 5174e4 CWF SG / (0.6 SG NHV + 5471) = 2421-2424 with the certification fuel's carbon fraction, density and heating
+// value (0.864, 0.745, 18,500 BTU/lb). Over this list the two agree to +-0.9 % (10th-90th percentile, petrol) and
+// exactly (diesel); a row off by more than kCarbonBalanceTolerance carries a result that is not its own test's.
+constexpr double kCarbonBalancePetrol = 2421.0, kCarbonBalanceDiesel = 2778.0, kCarbonBalanceTolerance = 0.05;
+
+std::optional<double> carbon_balance_mpg(const EpaTestRow& r) {
+  if (r.fuel != EpaFuel::petrol && r.fuel != EpaFuel::diesel) return std::nullopt;
+  if (!r.hc_g_per_mi || !r.co_g_per_mi || !r.co2_g_per_mi || *r.co2_g_per_mi <= 0.0) return std::nullopt;
+  const double carbon = 0.866 * *r.hc_g_per_mi + 0.429 * *r.co_g_per_mi + 0.273 * *r.co2_g_per_mi;
+  if (carbon <= 0.0) return std::nullopt;
+  return (r.fuel == EpaFuel::diesel ? kCarbonBalanceDiesel : kCarbonBalancePetrol) / carbon;
+}
 
 // ---- what each row is and whether it runs ----
 void classify(const EpaTestRow& r, const std::map<std::string, VehicleFacts>& facts, RowOutcome& o) {
@@ -133,6 +151,9 @@ void classify(const EpaTestRow& r, const std::map<std::string, VehicleFacts>& fa
     if (charge_depleting(r.cycle) || v.charge_depleting_on_fuel)
       return skip(SkipReason::hybrid, "plug-in: charge-depleting tests on a liquid fuel");
     if (name_says_hybrid(r)) return skip(SkipReason::hybrid, "named so: '" + r.model + "'");
+    if (v.four_bag_ftp)
+      return skip(SkipReason::hybrid, "its FTP was run with four bags (FE Bag 4 given), the hybrids' procedure of SAE "
+                                      "J1711 (40 CFR 600.115-11(c)); mild (48 V) hybrids are tested so too");
     if (v.ftp_mpg > 0.0 && v.hwfet_mpg > 0.0 && v.hwfet_mpg < kHybridHighwayOverCity * v.ftp_mpg)
       return skip(SkipReason::hybrid, "city economy as good as highway: HWFET " + format_value(v.hwfet_mpg) +
                                           " mpg < 1.1 x FTP " + format_value(v.ftp_mpg) + " mpg");
@@ -154,6 +175,10 @@ void classify(const EpaTestRow& r, const std::map<std::string, VehicleFacts>& fa
   const bool plausible = r.fuel == EpaFuel::electricity ? o.measured >= 60.0 && o.measured <= 250.0
                                                         : plausible_liquid_mpg(o.measured);
   if (!plausible) return skip(SkipReason::absurd_measured_result, format_value(*r.measured) + " " + o.unit);
+  if (const auto carbon_mpg = carbon_balance_mpg(r); carbon_mpg && std::abs(o.measured / *carbon_mpg - 1.0) > kCarbonBalanceTolerance)
+    return skip(SkipReason::inconsistent_result,
+                format_value(o.measured) + " mpg where its HC, CO and CO2 give " + fixed(*carbon_mpg, 1) +
+                    " mpg (40 CFR 600.113); more than " + format_value(100.0 * kCarbonBalanceTolerance) + " % apart");
   std::string detail;
   if (const SkipReason why = check_car_fields(r, detail); why != SkipReason::none) return skip(why, detail);
 }
@@ -333,7 +358,18 @@ Validation validate_epa_list(const std::vector<EpaTestRow>& rows, unsigned threa
   Validation v;
   v.rows.resize(rows.size());
   const auto facts = vehicle_facts(rows);
-  for (std::size_t i = 0; i < rows.size(); ++i) classify(rows[i], facts, v.rows[i]);
+  // The list repeats a test on one line per aftertreatment device (or averaging group): each counts once.
+  std::map<std::string, std::size_t> first_line;
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    RowOutcome& o = v.rows[i];
+    classify(rows[i], facts, o);
+    const auto [at, first] = first_line.emplace(rows[i].test_number, rows[i].line);
+    if (first || rows[i].test_number.empty()) continue;
+    o.repeat_of_line = at->second;
+    if (o.skip != SkipReason::none) continue;  // a repeat keeps the reason its test is not simulated
+    o.skip = SkipReason::duplicate_test;
+    o.skip_detail = "test " + rows[i].test_number + " is line " + std::to_string(at->second);
+  }
 
   const Cycles cycles = shipped_cycles();
   const EpaDefaults nominal;
@@ -441,7 +477,7 @@ std::vector<SummaryLine> summarise(const Validation& v) {
 Coverage coverage(const Validation& v, bool fitting_half) {
   Coverage c;
   for (const auto& o : v.rows) {
-    if (o.fitting_half != fitting_half || !simulated_kind(o.row->cycle)) continue;
+    if (o.fitting_half != fitting_half || !simulated_kind(o.row->cycle) || o.repeat_of_line != 0) continue;
     ++c.eligible;
     if (o.skip == SkipReason::none) ++c.simulated;
   }

@@ -22,6 +22,8 @@ enum class SkipReason {
   cold_test,              ///< Cold CO and the 20 degF charge-depleting FTP: no cold-ambient model
   other_procedure,        ///< a test procedure rollsim does not know
   hybrid,                 ///< hybrid or plug-in hybrid (identified by rule, see README)
+  duplicate_test,         ///< a test the list already gave on an earlier line (one line per aftertreatment device)
+  inconsistent_result,    ///< the measured economy contradicts the row's own exhaust carbon (the carbon balance)
   fuel_cell,              ///< hydrogen fuel cell
   unsupported_fuel,       ///< E85 and other fuels without properties here
   missing_field,          ///< a field the car needs is empty or not a number
@@ -53,6 +55,11 @@ struct EpaTestRow {
   std::optional<double> road_a_n, road_b_n_s_per_m, road_c_n_s2_per_m2;  ///< target coefficients
   std::optional<double> measured;         ///< RND_ADJ_FE as published (mpg or mpge)
   std::optional<double> bag_mpg[3];       ///< FE Bag 1..3 (FTP rows)
+  /// FE Bag 4: given only where the FTP was run with four bags (the hot start as a whole UDDS), the hybrids'
+  /// procedure of SAE J1711 (40 CFR 600.115-11(c)). Empty where the column is absent.
+  std::optional<double> bag4_mpg;
+  /// THC, CO and CO2 [g/mi] as measured over the row's test; empty where the columns are absent.
+  std::optional<double> hc_g_per_mi, co_g_per_mi, co2_g_per_mi;
   /// "Analytically Derived FE?" Yes: the result was not measured on the vehicle the row describes. EPA derived it
   /// from that vehicle's test (`base_test`) for another configuration, and the ADFE columns hold that
   /// configuration's test weight, N/V ratio and road-load power at 50 mph; the row's own weight, N/V and target

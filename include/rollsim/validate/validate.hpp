@@ -20,6 +20,9 @@ struct RowOutcome {
   SkipReason skip = SkipReason::none;
   std::string skip_detail;
   bool fitting_half = false;
+  /// The line of the test's first row where the list repeats a test (one line per aftertreatment device), else 0.
+  /// A repeat counts nowhere: skipped as `duplicate_test` where it would otherwise be simulated.
+  std::size_t repeat_of_line = 0;
   std::string powertrain;       ///< "petrol", "diesel", "E85", "electric"
   std::string unit;             ///< "mpg" or "mpge"
   double measured = 0.0;        ///< in `unit`
