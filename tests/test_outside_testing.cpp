@@ -824,5 +824,20 @@ TEST_F(OutsideTesting, ATabIndentedYamlLineIsNamed) {
                  tyre + ": line 4: malformed YAML: illegal map value; line 4 is indented with a tab, and YAML allows only spaces");
 }
 
+// Session 19: a tyre file refused 0.21 bar (a pressure in MPa) and 19 bar, but `--pressure-bar`, a pressure sweep
+// and Python's `pressure_bar` simulated them (RRC 0.0149 at a 79 mm deflection). One rule for all of them now.
+TEST_F(OutsideTesting, APressureOptionIsCheckedAsAFilesPressureIs) {
+  expect_refused("tyre 175-70R14 --pressure-bar 0.21", "--pressure-bar: 0.21 bar is not allowed for a passenger tyre");
+  expect_refused("tyre 175-70R14 --pressure-bar 0.21", "is it in MPa? (0.21 MPa = 2.1 bar)");
+  expect_refused("tyre --size '175/70 R14 84T' --pressure-bar 19", "is it in psi?");
+  expect_refused("sweep --tyre 175-70R14 --param pressure --from 0.2 --to 3 --steps 3",
+                 "--param pressure --from: 0.2 bar is not allowed for a passenger tyre");
+  expect_refused("sweep --vehicle ev --tyre 175-70R14 --param pressure --from 2 --to 12 --steps 2 --replay",
+                 "--param pressure --to: 12 bar is not allowed");
+  // Inside the class's range all of them run, and a truck tyre may go higher.
+  EXPECT_EQ(run_rollsim("tyre 175-70R14 --pressure-bar 4.5").exit_code, 0);
+  EXPECT_EQ(run_rollsim("tyre --outer-radius-m 0.5 --width-m 0.3 --pressure-bar 8 --load-n 20000").exit_code, 0);
+}
+
 }  // namespace
 }  // namespace rollsim::test

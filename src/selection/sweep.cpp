@@ -199,6 +199,10 @@ void check_options(const TyreSpec& tyre, const SweepOptions& o) {
       if (load_swept) throw InputError("--param", "load and load-pct cannot both be swept");
       load_swept = true;
     }
+    if (p == SweepParam::Pressure) {
+      check_pressure_plausible(o.axes[i].from, tyre.size, "--param pressure --from");
+      check_pressure_plausible(o.axes[i].to, tyre.size, "--param pressure --to");
+    }
     if (p == SweepParam::LoadPct && !(tyre.max_load_n > 0.0)) {
       throw InputError("--param load-pct", "the tyre's maximum load is unknown (no load index): sweep 'load' in N");
     }

@@ -214,15 +214,6 @@ PressureClass pressure_class(const std::optional<TyreSize>& size) {
 constexpr double kMinPlausibleBar = 1.0;  // below, a road tyre is flat: the sidewall carries the car
 constexpr double kPaPerPsi = 6894.757;
 
-void check_pressure_plausible(double bar, const std::optional<TyreSize>& size, const std::string& where) {
-  const PressureClass c = pressure_class(size);
-  if (bar >= kMinPlausibleBar && bar <= c.max_bar) return;
-  const std::string of = size ? " ('" + size->designation + "')" : "";
-  throw InputError(where, format_value(bar) + " bar is not allowed for " + c.name + of + ": must be in [" + format_value(kMinPlausibleBar) +
-                              ", " + format_value(c.max_bar) + "] bar (such tyres run at " + c.usual + ")" +
-                              unit_slip_hint(bar, Range::closed(kMinPlausibleBar, c.max_bar), "bar", {{"MPa", 10.0}, {"psi", kPaPerPsi / 1e5}}));
-}
-
 constexpr double kKgPerLb = 0.45359237;
 
 // An explicit max_load_kg against the load index of the size: the index is the tyre's rating, so a value more than
@@ -261,6 +252,15 @@ const char* kFormat =
     "[XL|Reinforced])";
 
 }  // namespace
+
+void check_pressure_plausible(double bar, const std::optional<TyreSize>& size, const std::string& where) {
+  const PressureClass c = pressure_class(size);
+  if (bar >= kMinPlausibleBar && bar <= c.max_bar) return;
+  const std::string of = size ? " ('" + size->designation + "')" : "";
+  throw InputError(where, format_value(bar) + " bar is not allowed for " + c.name + of + ": must be in [" + format_value(kMinPlausibleBar) +
+                              ", " + format_value(c.max_bar) + "] bar (such tyres run at " + c.usual + ")" +
+                              unit_slip_hint(bar, Range::closed(kMinPlausibleBar, c.max_bar), "bar", {{"MPa", 10.0}, {"psi", kPaPerPsi / 1e5}}));
+}
 
 double iso28580_passenger_pressure_pa(const TyreSize& size) { return size.extra_load ? 250e3 : 210e3; }
 

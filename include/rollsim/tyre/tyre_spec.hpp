@@ -47,6 +47,11 @@ struct TyreSpec {
   double max_load_n = 0.0;          ///< rated maximum load at reference pressure; 0 when unknown
 };
 
+/// Refuses an inflation pressure [bar] outside what a road tyre of this kind runs at (passenger 1-5 bar, light
+/// truck 1-8, truck rims 1-10), naming `where` and the likely unit slip (MPa, psi). One rule for a tyre file's
+/// `pressure_bar`, `--pressure-bar`, a pressure sweep's ends and Python's `pressure_bar`.
+void check_pressure_plausible(double bar, const std::optional<TyreSize>& size, const std::string& where);
+
 /// Loads and validates a tyre YAML file (strict keys; see tyres/README.md for the format).
 TyreSpec load_tyre_file(const std::string& path);
 /// The same for YAML text in memory (e.g. a Python dict as JSON); `name` stands for the file in errors.
