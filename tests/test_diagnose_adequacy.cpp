@@ -160,7 +160,12 @@ TEST(DiagnoseAdequacy, ScaleOutsideItsPriorIsReportedNotApplied) {
   EXPECT_NEAR(d.channel_scale_prior_high, 1.05, 1e-12);
   EXPECT_LE(d.channel_scale, 1.05 + 1e-9);
   EXPECT_NEAR(d.channel_scale_free, 1.3, 0.05) << diagnosis_text(d);
-  EXPECT_TRUE(d.channel_scale_outside_prior);
+  EXPECT_TRUE(d.calibration_outside_prior);
+  // What is beyond its box is named: the scale (outside testing found the key called a channel scale out of its
+  // box where the RRC level was).
+  ASSERT_FALSE(d.calibration_beyond_prior.empty());
+  EXPECT_EQ(d.calibration_beyond_prior.front(), "channel_scale") << diagnosis_text(d);
+  EXPECT_NE(diagnosis_json(d).find("\"beyond_prior\": [\"channel_scale\""), std::string::npos) << diagnosis_json(d);
   EXPECT_NE(d.verdict, "nothing_missing") << diagnosis_text(d);
   EXPECT_NE(diagnosis_json(d).find("\"channel_scale_prior\""), std::string::npos);
 }
@@ -172,7 +177,7 @@ TEST(DiagnoseAdequacy, ScalePinnedJustBeyondItsBoxIsNotNothingMissing) {
   const Diagnosis d = run(v, recording(v, nullptr, 1.0, 0.0, 1.057, 7), 60.0);
   EXPECT_GT(d.channel_scale_free, 1.05) << diagnosis_text(d);
   EXPECT_LT(d.channel_scale_free, 1.06) << diagnosis_text(d);
-  EXPECT_TRUE(d.channel_scale_outside_prior);
+  EXPECT_TRUE(d.calibration_outside_prior);
   EXPECT_NE(d.verdict, "nothing_missing") << diagnosis_text(d);
 }
 

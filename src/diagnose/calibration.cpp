@@ -89,6 +89,7 @@ Calibration calibrate(const Observations& o, const Variant& base, const Variant&
     const double beyond = std::max(unit * (free.coef[b.column] - b.high), unit * (b.low - free.coef[b.column]));
     if (b.column == 0) scale_pinned = beyond > 0.0;
     else excess = std::max(excess, beyond);
+    if (c.at_bound && beyond > 0.0) c.beyond.push_back(b.column == 0 ? "channel_scale" : b.column == 1 ? "rrc_level" : "drag");
   }
   c.sure = c.at_bound && c.dbic_leave >= bic_threshold;
   c.outside_prior = c.at_bound && (scale_pinned || excess >= 0.01 || c.sure);
@@ -111,10 +112,12 @@ std::string calibration_outside_prior_text(const Calibration& c, const Observati
       could += (could.empty() ? "" : ", ") + to_string(cand.id) + " (" + fixed(amp, 3) + " " + cand.amplitude->unit + ")";
   }
   const Eigen::VectorXd& f = c.free_coef;
+  std::string beyond;
+  for (const auto& term : c.beyond) beyond += (beyond.empty() ? "" : ", ") + term;
   return "the calibration alone wanted a channel scale of " + fixed(f[0], 3) + " (prior [" + fixed(1.0 - c.prior_scale_bound, 2) +
          ", " + fixed(1.0 + c.prior_scale_bound, 2) + "] for a " + to_string(o.channel) + " channel), RRC level " +
-         fixed(100.0 * 0.1 * f[1] / f[0], 0) + " % and aero C " + fixed(100.0 * 0.1 * f[2] / f[0], 0) +
-         " % (Delta BIC " + fixed(c.dbic_leave, 1) + " for leaving its prior: " +
+         fixed(100.0 * 0.1 * f[1] / f[0], 0) + " % and aero C " + fixed(100.0 * 0.1 * f[2] / f[0], 0) + " %" +
+         (beyond.empty() ? std::string() : ", beyond the box: " + beyond) + " (Delta BIC " + fixed(c.dbic_leave, 1) + " for leaving its prior: " +
          (c.sure ? "this data is sure of it" : "this data alone cannot tell") + "); it would have absorbed " +
          fixed(100.0 * c.absorbed_j / std::max(1e-9, std::abs(o.measured_j.sum())), 1) + " % of the measured energy. " +
          (could.empty() ? std::string("No catalogue effect alone explains that energy: a drive efficiency, usable capacity "

@@ -159,7 +159,8 @@ void report_calibration(const diag::Calibration& c, const diag::Observations& o,
   out.rrc_level_change_free = 0.1 * c.free_coef[1] / c.free_coef[0];
   out.drag_change_free = 0.1 * c.free_coef[2] / c.free_coef[0];
   out.calibration_delta_bic_leaving_prior = c.dbic_leave;
-  out.channel_scale_outside_prior = c.outside_prior;
+  out.calibration_outside_prior = c.outside_prior;
+  out.calibration_beyond_prior = c.beyond;
   out.scale_absorbed_energy_pct = 100.0 * c.absorbed_j / std::max(1e-9, std::abs(o.measured_j.sum()));
   out.lag1_autocorrelation = diag::lag1_autocorrelation(Eigen::VectorXd(o.measured_j - c.model.x * k));
   out.effective_windows = c.model.n_eff;

@@ -29,7 +29,9 @@ std::string diagnosis_json(const Diagnosis& d) {
      << ", \"drag_change\": " << jnum(d.drag_change) << ", \"channel_scale_prior\": {\"low\": " << jnum(d.channel_scale_prior_low)
      << ", \"high\": " << jnum(d.channel_scale_prior_high) << "}, \"channel_scale_free\": " << jnum(d.channel_scale_free) << ", \"rrc_level_change_free\": " << jnum(d.rrc_level_change_free)
      << ", \"drag_change_free\": " << jnum(d.drag_change_free) << ", \"delta_bic_leaving_prior\": " << jnum(d.calibration_delta_bic_leaving_prior)
-     << ", \"channel_scale_outside_prior\": " << (d.channel_scale_outside_prior ? "true" : "false")
+     << ", \"outside_prior\": " << (d.calibration_outside_prior ? "true" : "false") << ", \"beyond_prior\": [";
+  for (std::size_t i = 0; i < d.calibration_beyond_prior.size(); ++i) os << (i ? ", " : "") << json_string(d.calibration_beyond_prior[i]);
+  os << "]"
      << ", \"scale_absorbed_energy_pct\": " << jnum(d.scale_absorbed_energy_pct) << "},\n";
   os << "  \"adequacy\": {\"noise_floor_j\": " << jnum(d.noise_floor_j) << ", \"residual_to_noise_ratio\": "
      << jnum(d.residual_to_noise_ratio) << ", \"z\": " << jnum(d.residual_to_noise_z) << ", \"scale_s\": " << jnum(d.adequacy_scale_s)
@@ -133,10 +135,14 @@ std::string diagnosis_text(const Diagnosis& d) {
   os << "uncalibrated trip energy error: " << d.raw_trip_energy_error_pct << " %\n";
   os << "calibration: channel scale " << d.channel_scale << " (prior [" << d.channel_scale_prior_low << ", "
      << d.channel_scale_prior_high << "]), RRC level " << 100 * d.rrc_level_change << " %, aero C " << 100 * d.drag_change << " %\n";
-  if (d.channel_scale_outside_prior)
-    os << "  outside its prior (Delta BIC " << d.calibration_delta_bic_leaving_prior << "): the data alone wanted scale "
+  if (d.calibration_outside_prior) {
+    os << "  outside its prior (";
+    if (!d.calibration_beyond_prior.empty()) os << "beyond the box: ";
+    for (std::size_t i = 0; i < d.calibration_beyond_prior.size(); ++i) os << (i ? ", " : "") << d.calibration_beyond_prior[i];
+    os << (d.calibration_beyond_prior.empty() ? "" : "; ") << "Delta BIC " << d.calibration_delta_bic_leaving_prior << "): the data alone wanted scale "
        << d.channel_scale_free << ", RRC level " << 100 * d.rrc_level_change_free << " %, aero C " << 100 * d.drag_change_free
        << " %; held in the prior, it leaves " << d.scale_absorbed_energy_pct << " % of the measured energy for the effects\n";
+  }
   os << "noise floor: " << d.noise_floor_j / 1e3 << " kJ per noise window; calibrated residual " << d.residual_to_noise_ratio
      << " x the floor (z " << d.residual_to_noise_z << ", " << d.adequacy_scale_s << " s blocks), after the findings "
      << d.final_residual_to_noise_ratio << " x (z " << d.final_residual_to_noise_z << ")\n";

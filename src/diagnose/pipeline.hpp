@@ -170,6 +170,7 @@ struct Calibration {
   double dbic_leave = 0.0;     // how strongly the data want out of the boxes (Delta BIC, free against boxed)
   bool sure = false;           // freeing the boxes passes a discovery's evidence bar
   bool outside_prior = false;  // the scale pinned at its box, RRC level or C beyond theirs by over 1 %, or surely
+  std::vector<std::string> beyond;  // which of "channel_scale", "rrc_level", "drag" the free fit puts beyond its box
   double absorbed_j = 0.0;     // energy the free calibration would have absorbed beyond the boxed one
 };
 Calibration calibrate(const Observations& o, const Variant& base, const Variant& rrc, const Variant& drag,

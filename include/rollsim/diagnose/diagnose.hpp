@@ -210,7 +210,10 @@ struct Diagnosis {
   double channel_scale_prior_low = 0.0, channel_scale_prior_high = 0.0;
   double channel_scale_free = 1.0, rrc_level_change_free = 0.0, drag_change_free = 0.0;  ///< without the boxes
   double calibration_delta_bic_leaving_prior = 0.0;  ///< free against boxed calibration
-  bool channel_scale_outside_prior = false;          ///< a box is active and the data significantly want out of it
+  /// A box is active and the data significantly want out of it; `calibration_beyond_prior` names which of
+  /// "channel_scale", "rrc_level" and "drag" the free calibration puts beyond its box.
+  bool calibration_outside_prior = false;
+  std::vector<std::string> calibration_beyond_prior;
   double scale_absorbed_energy_pct = 0.0;  ///< of the measured energy
   /// Adequacy: the calibrated residual's variance over the noise floor at the worst scale, and that scale.
   double noise_floor_j = 0.0;              ///< sd of one noise window's energy (successive differences)
