@@ -563,6 +563,9 @@ TEST(TyreLabel, ClassBandsOfRegulation2020_740ForC1) {
   EXPECT_NEAR(eu_label_band_c1("D", "x").rrc_min, 9.05e-3, 1e-12);
   EXPECT_NEAR(eu_label_band_c1("D", "x").rrc_max, 10.55e-3, 1e-12);
   EXPECT_TRUE(eu_label_band_c1("E", "x").open_above);
+  // The open classes are closed with their neighbour's declared width: A with B's (7.7 - 6.6), E with D's (10.5 - 9.1).
+  EXPECT_NEAR(eu_label_band_c1("A", "x").rrc_min, 6.55e-3 - (7.7e-3 - 6.6e-3), 1e-12);
+  EXPECT_NEAR(eu_label_band_c1("E", "x").rrc_max, 10.55e-3 + (10.5e-3 - 9.1e-3), 1e-12);
   EXPECT_THROW(eu_label_band_c1("F", "--label F"), InputError);
   EXPECT_THROW(eu_label_band_c1("AB", "--label AB"), InputError);
 }

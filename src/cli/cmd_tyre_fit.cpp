@@ -156,7 +156,7 @@ void print_one_point_table(const J2452Evaluation& ev) {
             << pct(ev.tyres.front().thesis.speed_rise, 1) << " % (" << ev.tyres.front().name << ")\n";
   const CommonShapeBound& b = ev.common_shape;
   std::cout << "best common shape in hindsight (all tyres seen, level set at the one point): worst tyre >= "
-            << pct(b.worst_log_rms) << " % (RMS of the log ratio); the best such shape's RMS error per tyre:";
+            << pct(b.worst_log_rms) << " % (RMS of the log ratio); the best such shape's relative RMS error per tyre, as the table's:";
   for (std::size_t i = 0; i < b.rms.size(); ++i) std::cout << (i ? ", " : " ") << pct(b.rms[i]);
   std::cout << " %\n";
 }

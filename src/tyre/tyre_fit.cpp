@@ -335,12 +335,14 @@ LabelBand eu_label_band_c1(const std::string& label_class, const std::string& wh
   // A: RRC <= 6.5; B: 6.6-7.7; C: 7.8-9.0; D: 9.1-10.5; E: RRC >= 10.6 (https://eur-lex.europa.eu/eli/reg/2020/740/oj).
   // A-C are 1222/2009's bands unchanged; D, empty there, takes its old E, and E its old F and G.
   // Values are declared to 0.1 kg/t, so a band's edges are half a digit outside its printed limits. A and E are
-  // open-ended in the regulation; we close them with the width of the neighbouring band (our assumption).
+  // open-ended in the regulation; we close them with the declared width of the neighbouring band (our assumption):
+  // A with B's 1.1 kg/t, E with D's 1.4 (E was closed with B's width too, 10.55-11.65, until session 19's outside
+  // testing).
   static const LabelBand kBands[] = {{'A', 5.45e-3, 6.55e-3, true, false},
                                      {'B', 6.55e-3, 7.75e-3, false, false},
                                      {'C', 7.75e-3, 9.05e-3, false, false},
                                      {'D', 9.05e-3, 10.55e-3, false, false},
-                                     {'E', 10.55e-3, 11.65e-3, false, true}};
+                                     {'E', 10.55e-3, 11.95e-3, false, true}};
   if (label_class.size() == 1) {
     const char c = static_cast<char>(std::toupper(static_cast<unsigned char>(label_class[0])));
     for (const auto& b : kBands) {
