@@ -839,5 +839,35 @@ TEST_F(OutsideTesting, APressureOptionIsCheckedAsAFilesPressureIs) {
   EXPECT_EQ(run_rollsim("tyre --outer-radius-m 0.5 --width-m 0.3 --pressure-bar 8 --load-n 20000").exit_code, 0);
 }
 
+// Session 19's diagnosis check: a 1 Hz logger whose clock runs 0.05 % slow (or whose stamps jitter by 20 ms) was
+// refused as "1.0005 s, supported 0.01 to 1 s"; a fuel meter reading -0.02 cm3/s at rest (its zero drifting) stopped
+// the run. Both are what real loggers do: read, and the offset said. A clock 3 % off and a flow of -0.5 cm3/s are not.
+TEST_F(OutsideTesting, ALoggersClockAndAFlowMetersZeroOffsetAreRead) {
+  auto clocked = [](double factor) {
+    return camry_edited([factor](int, std::vector<std::string>& f) { f[0] = std::to_string(std::stod(f[0]) * factor); });
+  };
+  const std::string slow = write("slow.csv", clocked(1.0005));
+  CmdResult r = run_rollsim("diagnose --vehicle camry_2018 --preset anl_d3 --recording '" + slow + "'");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  const std::string off = write("off.csv", clocked(1.03));
+  expect_refused("diagnose --vehicle camry_2018 --preset anl_d3 --recording '" + off + "'",
+                 "supported: 0.01 to 1 s (1 to 100 Hz, within 2 % for the logger's clock)");
+
+  auto zero_offset = [](double ccps) {
+    return camry_edited([ccps](int, std::vector<std::string>& f) {
+      if (std::stod(f[1]) == 0.0) f[1] = std::to_string(ccps);
+    });
+  };
+  const std::string drift = write("drift.csv", zero_offset(-0.02));
+  r = run_rollsim("diagnose --vehicle camry_2018 --preset anl_d3 --recording '" + drift + "'");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(has(r.out + r.err, "value(s) below 0 (lowest -0.072 l/h")) << r.out << r.err;
+  EXPECT_TRUE(has(r.out + r.err, "kept as measured: a flow meter's zero offset")) << r.out;
+  // The engine-off standstills at zero flow are still found at the offset (25 s of them in this test).
+  EXPECT_TRUE(has(r.out, "switched off 1 times for 25 s")) << r.out;
+  const std::string negative = write("negative.csv", zero_offset(-0.5));
+  expect_refused("diagnose --vehicle camry_2018 --preset anl_d3 --recording '" + negative + "'", "must be in [-1, 1000]");
+}
+
 }  // namespace
 }  // namespace rollsim::test

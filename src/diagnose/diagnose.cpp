@@ -224,12 +224,13 @@ std::vector<bool> engine_off_samples(const Recording& r, double min_s) {
   const auto& fuel = *r.fuel_rate_m3ps;
   std::size_t i = 0;
   while (i < n) {
-    if (!(r.speed_mps[i] == 0.0 && fuel[i] == 0.0)) {
+    // No flow: zero, or a meter's zero offset below it.
+    if (!(r.speed_mps[i] == 0.0 && fuel[i] <= 0.0)) {
       ++i;
       continue;
     }
     std::size_t j = i;
-    while (j + 1 < n && r.speed_mps[j + 1] == 0.0 && fuel[j + 1] == 0.0) ++j;
+    while (j + 1 < n && r.speed_mps[j + 1] == 0.0 && fuel[j + 1] <= 0.0) ++j;
     if (r.time_s[j] - r.time_s[i] >= min_s)
       for (std::size_t k = i; k <= j; ++k) off[k] = true;
     i = j + 1;
@@ -354,7 +355,11 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
     if (cal.at_bound) f.description += (after.inadequate ? "; " : "") + calibration_outside_prior_text(cal, obs, sig.candidates);
     out.findings.push_back(std::move(f));
   } else if (cal.at_bound) {
-    out.notes.push_back("calibration at its prior's bound, not significantly beyond it: " + calibration_outside_prior_text(cal, obs, sig.candidates));
+    // Beyond the bound with findings, they take what the calibration would have absorbed (the note said "not
+    // significantly beyond it" beside a Delta BIC the data was sure of).
+    out.notes.push_back((cal.outside_prior ? "calibration beyond its prior's bound, beside the findings: "
+                                           : "calibration at its prior's bound, not significantly beyond it: ") +
+                        calibration_outside_prior_text(cal, obs, sig.candidates));
   }
   out.verdict = out.findings.empty() ? "nothing_missing"
                 : out.findings.front().confounded_with.empty() ? "missing_physics" : "confounded";

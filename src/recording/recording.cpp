@@ -8,6 +8,7 @@
 
 #include "rollsim/common/csv.hpp"
 #include "rollsim/common/error.hpp"
+#include "rollsim/common/format.hpp"
 #include "rollsim/common/text.hpp"
 #include "rollsim/common/units.hpp"
 
@@ -302,16 +303,17 @@ Recording load_recording(const std::string& path, const ColumnMapping& mapping) 
                           table.rows[date_disagrees.front()][*col_date] + "'); the clock was used and those dates ignored");
   }
 
-  // Sample interval: the median step must be 0.01-1 s (1-100 Hz).
+  // Sample interval: the median step must be 0.01-1 s (1-100 Hz), with 2 % for a logger's clock (a 1 Hz logger 0.05 %
+  // slow, or one whose stamps jitter by 20 ms, was refused).
   std::vector<double> steps(n - 1);
   for (std::size_t i = 0; i + 1 < n; ++i) steps[i] = rec.time_s[i + 1] - rec.time_s[i];
   std::vector<double> sorted = steps;
   std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
   const double dt = sorted[sorted.size() / 2];
-  if (dt < 0.0099 || dt > 1.0001) {
+  if (dt < 0.0098 || dt > 1.02) {
     throw InputError(path + ": column '" + table.header[col_t] + "'",
                      "the typical (median) sample interval is " + format_value(dt) +
-                         " s; supported: 0.01 to 1 s (1 to 100 Hz)");
+                         " s; supported: 0.01 to 1 s (1 to 100 Hz, within 2 % for the logger's clock)");
   }
   if (rec.duration_s() < kMinRecordingDuration_s) {
     throw InputError(path, "lasts " + format_value(rec.duration_s()) + " s (" + lines_text(table, 0, n - 1) +
@@ -484,7 +486,22 @@ Recording load_recording(const std::string& path, const ColumnMapping& mapping) 
   rec.battery_voltage_v = optional_channel("battery_voltage_v", 1e-9, 2000.0, "V", 1.0);
   rec.battery_current_a = optional_channel("battery_current_a", -big, big, "A", 1.0);
   rec.soc_fraction = optional_channel("soc_pct", 0.0, 100.0, "%", 0.01);
-  rec.fuel_rate_m3ps = optional_channel("fuel_rate_lph", 0.0, 1000.0, "l/h", units::kM3PerLitre / units::kSPerHour);
+  // A flow meter reads a little below zero when its zero drifts: down to kFuelZeroOffset_lph it is kept as measured
+  // (a run stopped at -0.07 l/h) and said; below, it is not a fuel flow.
+  if (const auto col = find("fuel_rate_lph")) {
+    const Channel ch = read_channel("fuel_rate_lph", *col);
+    std::size_t below = 0, lowest_row = 0;
+    for (std::size_t r = 0; r < n; ++r) {
+      if (!(ch.values[r] < 0.0)) continue;
+      if (below++ == 0 || ch.values[r] < ch.values[lowest_row]) lowest_row = r;
+    }
+    if (below)
+      rec.repairs.push_back("fuel_rate_lph: " + std::to_string(below) + " value(s) below 0 (lowest " +
+                            significant(ch.values[lowest_row], 3) + " l/h, line " +
+                            std::to_string(table.row_line[lowest_row]) + "), kept as measured: a flow meter's zero offset; below " + format_value(kFuelZeroOffset_lph) +
+                            " l/h is refused");
+  }
+  rec.fuel_rate_m3ps = optional_channel("fuel_rate_lph", kFuelZeroOffset_lph, 1000.0, "l/h", units::kM3PerLitre / units::kSPerHour);
   rec.elevation_m = optional_channel("elevation_m", -500.0, 9000.0, "m", 1.0);
   rec.grade = optional_channel("grade_pct", -30.0, 30.0, "%", 0.01);
   rec.ambient_temp_k = optional_channel("ambient_temp_c", -60.0, 70.0, "C", 1.0, units::kKelvinOffset);

@@ -235,7 +235,7 @@ std::string separating_test(const std::string& a, const std::string& b);
 
 /// The trace a recording is replayed on: its speed, time from the recording's start (effects that decay from
 /// the start of a trip read it), and its grade, or one derived robustly from its elevation, quantised to 0.05 %.
-/// With `engine_off_min_s` > 0, a fuel-rate recording's engine-off runs (standing with exactly zero fuel flow
+/// With `engine_off_min_s` > 0, a fuel-rate recording's engine-off runs (standing with no fuel flow, zero or a meter's zero offset below it
 /// for at least that long) become the cycle's engine_off segments; `start` sets its engine_hot_start.
 DriveCycle cycle_of_recording(const Recording& r, double engine_off_min_s = 0.0, EngineStart start = EngineStart::cold);
 /// Per sample: the direction of travel clockwise from north [rad], from recorded latitude and longitude [deg]: the
@@ -243,7 +243,7 @@ DriveCycle cycle_of_recording(const Recording& r, double engine_off_min_s = 0.0,
 /// metres turns a shorter chord at random), held at the end of the route.
 std::vector<double> heading_from_gps(const std::vector<double>& latitude_deg, const std::vector<double>& longitude_deg,
                                      double baseline_m = 20.0);
-/// Per sample of `r`: standing with exactly zero fuel flow in a run lasting at least `min_s` (all false without a
+/// Per sample of `r`: standing with no fuel flow (zero or below) in a run lasting at least `min_s` (all false without a
 /// fuel channel).
 std::vector<bool> engine_off_samples(const Recording& r, double min_s);
 

@@ -85,13 +85,15 @@ inline constexpr double kMaxBridgedRun_s = 5.0;
 inline constexpr double kReportedGap_s = 5.0;
 /// Shortest recording accepted.
 inline constexpr double kMinRecordingDuration_s = 60.0;
+/// Lowest fuel rate read as a flow meter's zero offset and kept (listed in Recording::repairs); lower is refused.
+inline constexpr double kFuelZeroOffset_lph = -1.0;
 /// Most samples in one recording: a loaded sample takes about 600 bytes (channels, replay and diagnosis
 /// arrays), so this bounds one recording near 600 MB (28 h at 10 Hz); longer logs are split into trips.
 inline constexpr std::size_t kMaxRecordingSamples = 1000000;
 
 /// Reads a recording CSV (header line, RFC 4180 quoting) through `mapping`. Needs time_s, speed_kmh and at
 /// least one energy channel (battery_power_kw, battery_voltage_v with battery_current_a, soc_pct or
-/// fuel_rate_lph). Sample interval 0.01 to 1 s (1 to 100 Hz, median). Throws InputError naming file, line
+/// fuel_rate_lph). Sample interval 0.01 to 1 s (1 to 100 Hz, median; 2 % more for a logger's clock). Throws InputError naming file, line
 /// and column for: a missing column (found columns listed, --column suggested), text in a number column,
 /// infinite or out-of-range values, time repeating or going backwards, NaN runs longer than
 /// kMaxBridgedRun_s, a recording shorter than kMinRecordingDuration_s, no energy channel, more than
