@@ -869,5 +869,29 @@ TEST_F(OutsideTesting, ALoggersClockAndAFlowMetersZeroOffsetAreRead) {
   expect_refused("diagnose --vehicle camry_2018 --preset anl_d3 --recording '" + negative + "'", "must be in [-1, 1000]");
 }
 
+// Session 19's diagnosis check: the Camry's HWFET with its fuel channel x1.10 named aux_load 301 W [-108, 710] at
+// Delta BIC -0.21, on the standing residual's evidence alone (1119 W at rest). A load is named so only where the fit's
+// own amplitude is a load too; on this case nothing is named then, and no named aux_load's interval reaches zero.
+TEST_F(OutsideTesting, AStandingResidualNamesALoadOnlyWhereTheFitsAmplitudeIsOne) {
+  std::ifstream in(std::string(ROLLSIM_SHARED_DIR) + "/data/recordings/anl_d3_2018_toyota_camry/61811013_test_data.csv");
+  std::ostringstream out;
+  std::string line;
+  std::getline(in, line);
+  out << line << "\n";
+  while (std::getline(in, line)) {
+    std::vector<std::string> f;
+    std::stringstream ss(line);
+    for (std::string cell; std::getline(ss, cell, ',');) f.push_back(cell);
+    f.at(1) = std::to_string(1.10 * std::stod(f.at(1)));
+    out << f.at(0) << "," << f.at(1) << "," << f.at(2) << "\n";
+  }
+  const std::string scaled = write("hwfet_x110.csv", out.str());
+  const fs::path json = dir_ / "x110.json";
+  const CmdResult r = run_rollsim("diagnose --vehicle camry_2018 --preset anl_d3 --recording '" + scaled + "' --json '" +
+                                  json.string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_FALSE(has(r.out, "  aux_load (delta BIC -")) << r.out;
+}
+
 }  // namespace
 }  // namespace rollsim::test

@@ -214,7 +214,10 @@ std::vector<Passing> passing_candidates(const SelectionContext& sc, const std::v
     Passing p{k, score_column(m, c.signature)};
     const double amp = p.score.amplitude();
     p.wrong_sign = c.min() >= 0.0 && amp < 0.0;
-    p.standing = c.id == EffectId::aux_load && !p.wrong_sign && standing_bic(sc) >= sc.opt.standing_bic_threshold;
+    // The standing evidence names a load only where the fit's own amplitude is a load too: the HWFET with its fuel
+    // x1.10 named aux_load 301 W [-108, 710] at Delta BIC -0.21 on a standing residual of 1119 W.
+    p.standing = c.id == EffectId::aux_load && !p.wrong_sign && standing_bic(sc) >= sc.opt.standing_bic_threshold &&
+                 amp - 1.96 * p.score.amplitude_se(m.inflate) > 0.0;
     if (p.score.dbic < sc.opt.bic_threshold && !p.standing) continue;
     if (!p.wrong_sign && (amp < c.min() || amp > c.max())) continue;
     if (c.across_trips != Candidate::TripLaw::none) {
