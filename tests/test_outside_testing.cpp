@@ -21,10 +21,10 @@ bool has(const std::string& text, const std::string& part) { return text.find(pa
 const std::string kCamryUdds =
     std::string(ROLLSIM_SHARED_DIR) + "/data/recordings/anl_d3_2018_toyota_camry/61811012_test_data.csv";
 
-// The shipped hot UDDS, each data line rewritten by `edit(line number from 1, fields)`.
+// A recording's text with each data line rewritten by `edit(line number from 1, fields)`.
 template <class Edit>
-std::string camry_edited(Edit edit) {
-  std::ifstream in(kCamryUdds);
+std::string recording_edited(const std::string& path, Edit edit) {
+  std::ifstream in(path);
   std::ostringstream out;
   std::string line;
   std::getline(in, line);
@@ -34,9 +34,16 @@ std::string camry_edited(Edit edit) {
     std::stringstream ss(line);
     for (std::string cell; std::getline(ss, cell, ',');) f.push_back(cell);
     edit(n, f);
-    out << f.at(0) << "," << f.at(1) << "," << f.at(2) << "\n";
+    for (std::size_t i = 0; i < f.size(); ++i) out << (i ? "," : "") << f[i];
+    out << "\n";
   }
   return out.str();
+}
+
+// The shipped hot UDDS, edited so.
+template <class Edit>
+std::string camry_edited(Edit edit) {
+  return recording_edited(kCamryUdds, edit);
 }
 
 // A shipped vehicle file's text with `from` replaced by `to` (`from` must be in it).
@@ -693,20 +700,8 @@ TEST_F(OutsideTesting, ACarThatCannotDriveItsTracePrintsNoPerDistanceFigure) {
 
 // A shipped Twizy trip with column `column` (0-based) of every data line divided by `divisor`.
 std::string twizy_scaled(std::size_t column, double divisor) {
-  std::ifstream in(std::string(ROLLSIM_SHARED_DIR) + "/data/recordings/rsk_renault_twizy/T1_07_01_2021.csv");
-  std::ostringstream out;
-  std::string line;
-  std::getline(in, line);
-  out << line << "\n";
-  while (std::getline(in, line)) {
-    std::vector<std::string> f;
-    std::stringstream ss(line);
-    for (std::string cell; std::getline(ss, cell, ',');) f.push_back(cell);
-    f.at(column) = std::to_string(std::stod(f.at(column)) / divisor);
-    for (std::size_t i = 0; i < f.size(); ++i) out << (i ? "," : "") << f[i];
-    out << "\n";
-  }
-  return out.str();
+  return recording_edited(std::string(ROLLSIM_SHARED_DIR) + "/data/recordings/rsk_renault_twizy/T1_07_01_2021.csv",
+                          [&](int, std::vector<std::string>& f) { f.at(column) = std::to_string(std::stod(f.at(column)) / divisor); });
 }
 
 // Unit slips in a recording were diagnosed as physics: speed logged in m/s named a 19 % grade, and a SOC logged as a
@@ -873,19 +868,10 @@ TEST_F(OutsideTesting, ALoggersClockAndAFlowMetersZeroOffsetAreRead) {
 // Delta BIC -0.21, on the standing residual's evidence alone (1119 W at rest). A load is named so only where the fit's
 // own amplitude is a load too; on this case nothing is named then, and no named aux_load's interval reaches zero.
 TEST_F(OutsideTesting, AStandingResidualNamesALoadOnlyWhereTheFitsAmplitudeIsOne) {
-  std::ifstream in(std::string(ROLLSIM_SHARED_DIR) + "/data/recordings/anl_d3_2018_toyota_camry/61811013_test_data.csv");
-  std::ostringstream out;
-  std::string line;
-  std::getline(in, line);
-  out << line << "\n";
-  while (std::getline(in, line)) {
-    std::vector<std::string> f;
-    std::stringstream ss(line);
-    for (std::string cell; std::getline(ss, cell, ',');) f.push_back(cell);
-    f.at(1) = std::to_string(1.10 * std::stod(f.at(1)));
-    out << f.at(0) << "," << f.at(1) << "," << f.at(2) << "\n";
-  }
-  const std::string scaled = write("hwfet_x110.csv", out.str());
+  const std::string scaled = write(
+      "hwfet_x110.csv",
+      recording_edited(std::string(ROLLSIM_SHARED_DIR) + "/data/recordings/anl_d3_2018_toyota_camry/61811013_test_data.csv",
+                       [](int, std::vector<std::string>& f) { f.at(1) = std::to_string(1.10 * std::stod(f.at(1))); }));
   const fs::path json = dir_ / "x110.json";
   const CmdResult r = run_rollsim("diagnose --vehicle camry_2018 --preset anl_d3 --recording '" + scaled + "' --json '" +
                                   json.string() + "'");
