@@ -879,5 +879,28 @@ TEST_F(OutsideTesting, AStandingResidualNamesALoadOnlyWhereTheFitsAmplitudeIsOne
   EXPECT_FALSE(has(r.out, "  aux_load (delta BIC -")) << r.out;
 }
 
+// Session 19's diagnosis check: a state of charge printed "channel lag: 0.000 s [0.000, 0.000]", which reads as an
+// estimate and is none; and a fuel channel that leads the speed read 0 s without saying that 0 is where the search
+// starts.
+TEST_F(OutsideTesting, TheChannelLagSaysWhatItIsNot) {
+  const CmdResult soc = run_rollsim("diagnose --vehicle twizy --preset rsk_twizy --recording '" + std::string(ROLLSIM_SHARED_DIR) +
+                                    "/data/recordings/rsk_renault_twizy/T1_03_29_2021.csv' --json '" + (dir_ / "soc.json").string() + "'");
+  ASSERT_EQ(soc.exit_code, 0) << soc.err;
+  EXPECT_TRUE(has(soc.out, "channel lag: not estimated (a state of charge integrates the power")) << soc.out;
+  EXPECT_TRUE(has(slurp((dir_ / "soc.json").string()), "\"estimated\": false"));
+  // The hot UDDS with its fuel one sample ahead of the speed.
+  std::vector<std::vector<std::string>> rows;
+  const std::string text = camry_edited([&rows](int, std::vector<std::string>& f) { rows.push_back(f); });
+  std::string ahead = text.substr(0, text.find('\n') + 1);
+  for (std::size_t i = 0; i + 1 < rows.size(); ++i) ahead += rows[i][0] + "," + rows[i + 1][1] + "," + rows[i][2] + "\n";
+  const CmdResult lead = run_rollsim("diagnose --vehicle camry_2018 --preset anl_d3 --recording '" + write("ahead.csv", ahead) + "'");
+  ASSERT_EQ(lead.exit_code, 0) << lead.err;
+  EXPECT_TRUE(has(lead.out, "channel lag: 0.00 s [0.00,")) << lead.out;
+  EXPECT_TRUE(has(lead.out, "0 is the search's lower end: a channel that leads the speed")) << lead.out;
+  // The unshifted test's lag is inside the search and says nothing of it.
+  const CmdResult base = run_rollsim("diagnose --vehicle camry_2018 --preset anl_d3 --recording '" + kCamryUdds + "'");
+  EXPECT_TRUE(has(base.out, "channel lag: 0.25 s [0.15, 0.30] (interpolated channel)\n")) << base.out;
+}
+
 }  // namespace
 }  // namespace rollsim::test

@@ -170,6 +170,7 @@ void report_calibration(const diag::Calibration& c, const diag::Observations& o,
   out.lag_s = lag.seconds;
   out.lag_ci_low_s = lag.low_s;
   out.lag_ci_high_s = lag.high_s;
+  out.lag_estimated = lag.estimated;
 }
 
 // The path the GPS fixes trace [m], a fix that jumps farther than the car could go since the last one skipped (a

@@ -38,7 +38,8 @@ std::string diagnosis_json(const Diagnosis& d) {
      << ", \"after_findings_ratio\": " << jnum(d.final_residual_to_noise_ratio) << ", \"after_findings_z\": "
      << jnum(d.final_residual_to_noise_z) << "},\n";
   os << "  \"lag_samples\": " << d.lag_samples << ",\n";
-  os << "  \"lag_s\": {\"value\": " << jnum(d.lag_s) << ", \"ci_low\": " << jnum(d.lag_ci_low_s) << ", \"ci_high\": " << jnum(d.lag_ci_high_s) << "},\n";
+  os << "  \"lag_s\": {\"value\": " << jnum(d.lag_s) << ", \"ci_low\": " << jnum(d.lag_ci_low_s) << ", \"ci_high\": " << jnum(d.lag_ci_high_s)
+     << ", \"estimated\": " << (d.lag_estimated ? "true" : "false") << "},\n";
   os << "  \"engine_starts\": [";
   for (std::size_t i = 0; i < d.engine_starts.size(); ++i) {
     const auto& e = d.engine_starts[i];
@@ -120,6 +121,12 @@ std::string diagnosis_json(const Diagnosis& d) {
   return os.str();
 }
 
+std::string lag_text(const Diagnosis& d) {
+  if (!d.lag_estimated) return "not estimated (a state of charge integrates the power: a lag of seconds does not show in it)";
+  return fixed(d.lag_s, 2) + " s [" + fixed(d.lag_ci_low_s, 2) + ", " + fixed(d.lag_ci_high_s, 2) + "] (interpolated channel" +
+         (d.lag_ci_low_s <= 0.0 ? "; 0 is the search's lower end: a channel that leads the speed, its clock ahead, reads 0 too" : "") + ")";
+}
+
 std::string diagnosis_text(const Diagnosis& d) {
   std::ostringstream os;
   os.setf(std::ios::fixed);
@@ -127,7 +134,7 @@ std::string diagnosis_text(const Diagnosis& d) {
   os << "channel " << d.channel << ", " << d.windows << " windows (effective " << d.effective_windows
      << ", lag-1 autocorrelation " << d.lag1_autocorrelation << ")\n";
   for (const auto& note : d.notes) os << note << "\n";
-  os << "channel lag: " << d.lag_s << " s [" << d.lag_ci_low_s << ", " << d.lag_ci_high_s << "] (interpolated channel)\n";
+  os << "channel lag: " << lag_text(d) << "\n";
   if (d.channel != "soc")
     os << "channel sampling: " << (d.channel_sampling == "instantaneous" ? "read at each sample's instant" : "mean over each sample's interval")
        << " (squared residual as interval means over as instants: " << d.channel_sampling_sse_ratio

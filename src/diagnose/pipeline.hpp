@@ -83,6 +83,7 @@ Eigen::VectorXd window_energies(const std::vector<std::vector<double>>& power_w,
 /// Channel lag (calibration): the continuous shift of the simulated power, 0-10 samples, that best matches the
 /// measured one (interpolated channel), with its profile interval.
 struct LagEstimate {
+  bool estimated = false;  ///< not for a state of charge, which integrates the power
   double samples = 0.0, low = 0.0, high = 0.0;
   double seconds = 0.0, low_s = 0.0, high_s = 0.0;
   double sse_w2 = 0.0;  ///< sum of squared sample residuals at the best lag (comparable across channel samplings)

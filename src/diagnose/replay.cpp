@@ -128,6 +128,7 @@ Eigen::VectorXd window_energies(const std::vector<std::vector<double>>& power_w,
 LagEstimate estimate_lag(const std::vector<std::vector<double>>& sim_w, const Observations& o) {
   LagEstimate l;
   if (o.channel == ChannelKind::soc) return l;
+  l.estimated = true;
   std::vector<double> dts(o.dt_s.front());
   std::nth_element(dts.begin(), dts.begin() + static_cast<std::ptrdiff_t>(dts.size() / 2), dts.end());
   const double dt = dts.empty() ? 1.0 : dts[dts.size() / 2];

@@ -110,7 +110,7 @@ void calibration_table(std::ostream& os, const Diagnosis& d) {
   os << "<h2 id=\"calibration\">Calibration and noise</h2>\n<div class=\"scroll\"><table>\n";
   row("measured channel", d.channel);
   row("energy windows (effective)", std::to_string(d.windows) + " (" + fixed(d.effective_windows, 1) + ") of " + fixed(d.window_s, 0) + " s");
-  row("channel lag [s], 95 %", fixed(d.lag_s, 2) + " [" + fixed(d.lag_ci_low_s, 2) + ", " + fixed(d.lag_ci_high_s, 2) + "]");
+  row("channel lag, 95 %", lag_text(d));
   if (d.channel != "soc")
     row("channel sampling (residual as means / as instants)",
         (d.channel_sampling == "instantaneous" ? "at each sample's instant" : "mean over each interval") + std::string(" (") +

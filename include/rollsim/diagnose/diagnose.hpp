@@ -195,6 +195,9 @@ struct Diagnosis {
   double lag1_autocorrelation = 0.0;
   int lag_samples = 0;                     ///< calibration: the lag rounded to whole samples
   double lag_s = 0.0, lag_ci_low_s = 0.0, lag_ci_high_s = 0.0;  ///< continuous lag and its 95 % profile interval
+  /// False for a state of charge (the lag is not estimated: the figures above are 0). The search runs from 0 up, so
+  /// a channel that leads the speed (its clock ahead) reads 0 too.
+  bool lag_estimated = false;
   /// How the logger sampled the channel, as the data chose: "interval_mean" (each sample integrates its interval,
   /// the replay's segment means) or "instantaneous" (read at the sample's instant, the replay's point values).
   std::string channel_sampling = "interval_mean";
@@ -253,6 +256,9 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
 
 std::string diagnosis_json(const Diagnosis& d);
 std::string diagnosis_text(const Diagnosis& d);
+/// The channel lag as the text and the report say it: its value and 95 % interval [s], where 0 is also what a channel
+/// leading the speed reads, or that a state of charge's lag is not estimated.
+std::string lag_text(const Diagnosis& d);
 
 /// The vehicle file at `vehicle_path` with an `effects:` block holding the findings' fitted effects.
 /// Throws InputError naming the file when the vehicle file already has an effects block (which --write-vehicle
