@@ -72,13 +72,10 @@ TEST(CliSimulate, TraceColumnsAreTheCarsOwnAndItsTotalsEndAtTheRunsTotals) {
     EXPECT_EQ(header.find("fuel_l,") != std::string::npos || header.ends_with("fuel_l"), !electric) << header;
     // The last cell is the running total (battery_energy_kwh or fuel_l), against the JSON's total.
     const double total = std::stod(last.substr(last.rfind(',') + 1));
-    const std::string key = electric ? "\"battery_terminals\": " : "\"fuel_l_per_100km\": ";
-    const auto at = out.text.find(key);
-    ASSERT_NE(at, std::string::npos) << out.text;
-    const double json_value = std::stod(out.text.substr(at + key.size()));
-    const auto km_at = out.text.find("\"distance_km\": ");
-    const double km = std::stod(out.text.substr(km_at + 15));
-    const double expected = electric ? json_value : json_value * km / 100.0;
+    using rollsim::test::json_number;
+    const double expected = electric ? json_number(out.text, "battery_terminals")
+                                     : json_number(out.text, "fuel_l_per_100km") * json_number(out.text, "distance_km") / 100.0;
+    ASSERT_TRUE(std::isfinite(expected)) << out.text;
     EXPECT_NEAR(total / expected, 1.0, 1e-6) << car;
   }
   std::filesystem::remove_all(dir);

@@ -19,6 +19,7 @@
 namespace {
 
 using rollsim::test::CmdResult;
+using rollsim::test::json_number;
 using rollsim::test::slurp;
 using rollsim::test::temp_dir;
 
@@ -28,12 +29,6 @@ using rollsim::test::lines;
 
 bool has(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 
-// The number after "key": in a one-line JSON object written by rollsim.
-double json_number(const std::string& line, const std::string& key) {
-  const auto pos = line.find("\"" + key + "\": ");
-  if (pos == std::string::npos) return std::nan("");
-  return std::strtod(line.c_str() + pos + key.size() + 4, nullptr);
-}
 
 // One clear error: non-zero exit, nothing on stdout, exactly one line on stderr mentioning every part.
 void expect_one_error(const std::string& args, const std::vector<std::string>& mentions) {

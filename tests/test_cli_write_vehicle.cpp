@@ -16,6 +16,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
+using rollsim::test::json_number;
+
 // A null recording of ev.yaml on WLTC x 2 (no lag, so the diagnosis compares like with like), as a CSV with GPS
 // columns; `glitch` puts a longitude of 1555.6 deg on one line.
 fs::path write_recording(const fs::path& dir, bool glitch) {
@@ -34,11 +36,6 @@ fs::path write_recording(const fs::path& dir, bool glitch) {
   return path;
 }
 
-double json_number(const std::string& json, const std::string& key) {
-  const auto at = json.find("\"" + key + "\": ");
-  if (at == std::string::npos) return std::nan("");
-  return std::stod(json.substr(at + key.size() + 4));
-}
 
 }  // namespace
 

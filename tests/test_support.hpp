@@ -1,10 +1,12 @@
-// Test support: a per-test folder for input files, and running the built rollsim binary with its streams captured.
+// Test support: a per-test folder for input files, running the built rollsim binary with its streams captured, and
+// reading what it writes.
 #pragma once
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -79,6 +81,13 @@ class FileFixture : public ::testing::Test {
   }
   std::filesystem::path dir_;
 };
+
+/// The number after `"key": ` in JSON as rollsim writes it (NaN where the key is absent).
+inline double json_number(const std::string& json, const std::string& key) {
+  const auto at = json.find("\"" + key + "\": ");
+  if (at == std::string::npos) return std::nan("");
+  return std::strtod(json.c_str() + at + key.size() + 4, nullptr);
+}
 
 /// The non-empty lines of `text`.
 inline std::vector<std::string> lines(const std::string& text) {

@@ -23,6 +23,7 @@
 
 using namespace rollsim;
 using rollsim::test::CmdResult;
+using rollsim::test::json_number;
 using rollsim::test::lines;
 using rollsim::test::temp_dir;
 
@@ -77,11 +78,6 @@ CmdResult fit(const std::string& args) { return rollsim::test::run_rollsim("tyre
 
 bool has(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 
-double json_number(const std::string& line, const std::string& key) {
-  const auto pos = line.find("\"" + key + "\": ");
-  if (pos == std::string::npos) return std::nan("");
-  return std::strtod(line.c_str() + pos + key.size() + 4, nullptr);
-}
 
 }  // namespace
 
