@@ -325,6 +325,18 @@ DriveCycle sampled(const std::vector<std::pair<double, double>>& points_kmh, dou
   return c;
 }
 
+// A trace of the given points [km/h] alone: each ramp between them one segment, as a coarse log or table has it.
+DriveCycle points_only(const std::vector<std::pair<double, double>>& points_kmh) {
+  DriveCycle c;
+  c.name = "points";
+  for (const auto& [t, v] : points_kmh) {
+    c.time_s.push_back(t);
+    c.speed_mps.push_back(v / 3.6);
+    c.grade.push_back(0.0);
+  }
+  return c;
+}
+
 }  // namespace
 
 // The regen fade (full above 15 km/h, none below 5) only splits the braking force, so the speed does not feel it:
@@ -335,11 +347,7 @@ TEST(Simulation, RegenFadeIsBookedOnADecelerationWhateverItsSampling) {
   const auto m = model_of("vehicles/ev.yaml");
   const std::vector<std::pair<double, double>> decel{{0.0, 60.0}, {20.0, 60.0}, {36.0, 0.0}, {76.0, 0.0}};
   const double reference_j = simulate_replay(m, sampled(decel, 0.02)).energy.regen_wheel_j;
-  DriveCycle points_only = sampled(decel, 4.0);
-  points_only.time_s = {0.0, 20.0, 36.0, 76.0};
-  points_only.speed_mps = {60.0 / 3.6, 60.0 / 3.6, 0.0, 0.0};
-  points_only.grade.assign(4, 0.0);
-  for (const DriveCycle& c : {sampled(decel, 1.0), sampled(decel, 4.0), points_only}) {
+  for (const DriveCycle& c : {sampled(decel, 1.0), sampled(decel, 4.0), points_only(decel)}) {
     const std::string samples = std::to_string(c.time_s.size()) + " samples";
     for (const auto& r : {simulate_forward(m, c), simulate_replay(m, c)}) {
       EXPECT_NEAR(r.energy.regen_wheel_j / reference_j, 1.0, 1e-4) << r.mode << ", " << samples;
@@ -388,10 +396,7 @@ TEST(Simulation, ReplayOfACoarseTraceAgreesWithTheSameTraceSampledFinely) {
   const std::vector<std::pair<double, double>> coast{{0.0, 60.0}, {30.0, 0.0}, {40.0, 0.0}};
   for (const char* file : {"vehicles/ice.yaml", "vehicles/camry_2018_map.yaml"}) {
     const auto m = model_of(file);
-    DriveCycle coarse = sampled(coast, 10.0);
-    coarse.time_s = {0.0, 30.0, 40.0};
-    coarse.speed_mps = {60.0 / 3.6, 0.0, 0.0};
-    coarse.grade.assign(3, 0.0);
+    const DriveCycle coarse = points_only(coast);
     const double fine_j = simulate_replay(m, sampled(coast, 0.05)).energy.fuel_j;
     EXPECT_NEAR(simulate_replay(m, coarse).energy.fuel_j / fine_j, 1.0, 0.01) << file;
     EXPECT_NEAR(simulate_forward(m, coarse).energy.fuel_j / fine_j, 1.0, 0.01) << file;
