@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <iterator>
 #include <iostream>
 #include <map>
 #include <numbers>
@@ -16,6 +17,7 @@
 #include "rollsim/common/units.hpp"
 #include "rollsim/powertrain/conventional.hpp"
 #include "rollsim/powertrain/electric.hpp"
+#include "rollsim/report/gnuplot.hpp"
 #include "rollsim/sim/simulation.hpp"
 #include "rollsim/validate/validate.hpp"
 #include "test_support.hpp"
@@ -799,6 +801,47 @@ TEST(CliValidate, JsonRowsAndANamedErrorForAFileWithoutTheColumns) {
   const auto hj = test::run_rollsim("validate --json --epa-test-car-list " + held_out.string());
   ASSERT_EQ(hj.exit_code, 0) << hj.err;
   for (const auto& row : test::lines(hj.out)) EXPECT_NE(row.find("\"maker_factor\": 1,"), std::string::npos) << row;
+}
+
+// Each series of the --plot figure holds its own powertrain's points: gnuplot's SVG puts a series' title and its
+// points in one group. Until session 20 the data files were numbered by first appearance in the list and titled in
+// alphabetical order, so the list's petrol cars were drawn under "E85 (mpg)" and its electric ones under "diesel".
+TEST(CliValidate, ThePlotsSeriesAreTitledByTheirOwnPoints) {
+  if (report::find_gnuplot().empty()) GTEST_SKIP() << "gnuplot not installed";
+  const auto dir = test::temp_dir();
+  const auto part = first_lines_of_list(dir / "petrol_and_electric.csv", 130);  // the BMW i4 rows are from line 107
+  const auto svg = dir / "pred.svg";
+  const auto r = test::run_rollsim("validate --json --threads 2 --epa-test-car-list " + part.string() + " --plot " + svg.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::map<std::string, int> expected;
+  for (const auto& row : test::lines(r.out)) {
+    if (row.find("\"error_pct\": ") == std::string::npos) continue;
+    const auto fuel_at = row.find("\"fuel\": \"") + 9;
+    const auto unit_at = row.find("\"unit\": \"") + 9;
+    ++expected[row.substr(fuel_at, row.find('"', fuel_at) - fuel_at) + " (" + row.substr(unit_at, row.find('"', unit_at) - unit_at) + ")"];
+  }
+  ASSERT_GE(expected.size(), 2u);
+  ASSERT_TRUE(expected.count("petrol (mpg)") && expected.count("electric (mpge)"));
+  std::ifstream in(svg);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::map<std::string, int> drawn;
+  for (std::size_t at = text.find("<g id=\"gnuplot_plot_"); at != std::string::npos;) {
+    const std::size_t next = text.find("<g id=\"gnuplot_plot_", at + 1);
+    const std::string group = text.substr(at, next == std::string::npos ? std::string::npos : next - at);
+    const auto t0 = group.find("<text>"), t1 = group.find("</text>");
+    if (t0 != std::string::npos && t1 != std::string::npos) {
+      int points = 0;
+      for (std::size_t p = group.find("<use xlink:href='#gpPt"); p != std::string::npos; p = group.find("<use xlink:href='#gpPt", p + 1)) ++points;
+      drawn[group.substr(t0 + 6, t1 - t0 - 6)] = points;
+    }
+    at = next;
+  }
+  for (const auto& [title, n] : expected) {
+    ASSERT_TRUE(drawn.count(title)) << title;
+    // A series' key may carry one sample point beside its data.
+    EXPECT_GE(drawn[title], n) << title;
+    EXPECT_LE(drawn[title], n + 1) << title;
+  }
 }
 
 }  // namespace

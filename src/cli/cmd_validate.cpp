@@ -1,11 +1,14 @@
 // `rollsim validate`: the EPA Test Car List simulated row by row and compared with its measured results.
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <map>
+#include <sstream>
 #include <memory>
 #include <string>
 
@@ -108,12 +111,16 @@ void plot(const validate::Validation& v, const std::string& file) {
   if (!fs::is_directory(dir, ec) || access(dir.c_str(), W_OK) != 0) throw InputError("--plot " + file, "cannot write here (folder missing or not writable)");
   const fs::path work = fs::temp_directory_path() / ("rollsim_validate_" + std::to_string(getpid()));
   fs::create_directories(work);
-  std::map<std::string, std::ofstream> series;
+  // Each series' points, in the legend's (alphabetical) order; a file is named by its place in that order, so the
+  // title given to a file is its own (until session 20 the files were numbered by first appearance in the list and
+  // the titles alphabetically: the petrol cars were drawn as "E85").
+  std::map<std::string, std::ostringstream> series;
+  double lo = std::numeric_limits<double>::infinity(), hi = 0.0;
   for (const auto& o : v.rows) {
     if (o.skip != validate::SkipReason::none) continue;
-    const std::string name = o.powertrain + " (" + o.unit + ")";
-    if (!series.count(name)) series.emplace(name, std::ofstream(work / ("s" + std::to_string(series.size()) + ".dat")));
-    series[name] << o.measured << " " << o.predicted << "\n";
+    series[o.powertrain + " (" + o.unit + ")"] << o.measured << " " << o.predicted << "\n";
+    lo = std::min({lo, o.measured, o.predicted});
+    hi = std::max({hi, o.measured, o.predicted});
   }
   const fs::path tmp_out = dir / ("." + target.filename().string() + ".tmp" + std::to_string(getpid()) + ext);
   std::ofstream gp(work / "plot.gp");
@@ -122,12 +129,14 @@ void plot(const validate::Validation& v, const std::string& file) {
      << "set title 'EPA Test Car List 2022: rollsim from certification data against the dynamometer'\n"
      << "set xlabel 'measured [mpg or mpge]'\nset ylabel 'predicted [mpg or mpge]'\n"
      << "set logscale xy\nset grid\nset key top left\nset size square\n";
+  // Both axes over the data's own span (gnuplot's log autoscale widens to whole decades: 1-1000 for 9-200 mpg).
+  if (lo > 0.0 && hi > lo) gp << "set xrange [" << lo / 1.1 << ":" << hi * 1.1 << "]\nset yrange [" << lo / 1.1 << ":" << hi * 1.1 << "]\n";
   gp << "plot x title 'predicted = measured' lc rgb 'black'";
   std::size_t i = 0;
-  for (auto& [name, out] : series) {
-    out.close();
-    gp << ", " << report::gnuplot_string((work / ("s" + std::to_string(i++) + ".dat")).string()) << " with points pt 7 ps 0.4 title "
-       << report::gnuplot_string(name);
+  for (const auto& [name, points] : series) {
+    const fs::path data = work / ("s" + std::to_string(i++) + ".dat");
+    std::ofstream(data) << points.str();
+    gp << ", " << report::gnuplot_string(data.string()) << " with points pt 7 ps 0.4 title " << report::gnuplot_string(name);
   }
   gp << "\n";
   gp.close();
