@@ -139,3 +139,21 @@ TEST(Fleet, TheSummaryDoesNotDependOnTheManifestsOrder) {
   EXPECT_DOUBLE_EQ(ab[0].median_value, (5.383 + 2.0) / 2.0);
   EXPECT_DOUBLE_EQ(ba[0].median_value, ab[0].median_value);
 }
+
+// One diagnosis can name an effect twice (two unexplained findings, each with its own figure). Keyed by effect, the
+// fleet's JSON wrote the key twice and every parser kept only the last (outside testing, session 20): it is a list.
+TEST(Fleet, JsonKeepsEveryFindingOfADiagnosis) {
+  FleetResult r;
+  FleetEntry e;
+  e.group = "g";
+  e.findings = {{"unexplained", "opposite_power_w", "W", -184.4, 0.0}, {"unexplained", "residual_to_noise_variance_ratio", "1", 2.5, 0.0}};
+  r.entries.push_back(e);
+  const auto json = fleet_json(r);
+  ASSERT_EQ(json.size(), 1u);
+  const std::string line = json[0].str();
+  const auto list = line.find("\"findings\": [{\"effect\": \"unexplained\", \"parameter\": \"opposite_power_w\", \"value\": -184.4");
+  EXPECT_NE(list, std::string::npos) << line;
+  EXPECT_NE(line.find("}, {\"effect\": \"unexplained\", \"parameter\": \"residual_to_noise_variance_ratio\", \"value\": 2.5", list),
+            std::string::npos) << line;
+  EXPECT_EQ(line.find("\"unexplained\": {"), std::string::npos) << line;
+}

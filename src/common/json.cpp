@@ -67,4 +67,11 @@ JsonObject& JsonObject::add(const std::string& key, const JsonObject& value) {
   return *this;
 }
 
+JsonObject& JsonObject::add(const std::string& key, const std::vector<JsonObject>& values) {
+  std::string list = "[";
+  for (std::size_t i = 0; i < values.size(); ++i) list += (i ? ", " : "") + values[i].str();
+  add_raw(key, list + "]");
+  return *this;
+}
+
 }  // namespace rollsim

@@ -224,11 +224,14 @@ std::vector<JsonObject> fleet_json(const FleetResult& r) {
     JsonObject j;
     j.add("group", e.group).add("vehicle", e.vehicle).add("recordings", static_cast<int>(e.recordings));
     j.add("channel", e.channel).add("verdict", e.verdict);
-    JsonObject findings;
+    // A list, as the single diagnosis' JSON has it: one diagnosis can name an effect twice (two `unexplained`
+    // findings), and keyed by effect the second overwrote the first in every parser (session 20).
+    std::vector<JsonObject> findings;
     for (const auto& f : e.findings) {
       JsonObject fj;
-      fj.add("parameter", f.parameter).add("value", f.value).add("unit", f.unit).add("energy_share_pct", f.energy_share_pct);
-      findings.add(f.effect, fj);
+      fj.add("effect", f.effect).add("parameter", f.parameter).add("value", f.value).add("unit", f.unit);
+      fj.add("energy_share_pct", f.energy_share_pct);
+      findings.push_back(fj);
     }
     j.add("findings", findings);
     out.push_back(j);

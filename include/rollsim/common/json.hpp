@@ -2,6 +2,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 namespace rollsim {
 
@@ -20,6 +21,9 @@ class JsonObject {
   JsonObject& add_null(const std::string& key);
   /// A nested object as the value of `key`.
   JsonObject& add(const std::string& key, const JsonObject& value);
+  /// An array of objects as the value of `key` (a key may appear only once in an object: RFC 8259 leaves a repeat
+  /// to the parser, and most keep the last).
+  JsonObject& add(const std::string& key, const std::vector<JsonObject>& values);
   /// "{...}" without a trailing newline.
   std::string str() const;
 
