@@ -171,6 +171,23 @@ TEST(SelectionCompare, OversizeAndOverloadedTyresAreMarkedNotRanked) {
   EXPECT_TRUE(has(c.unfit[1].fit.reason, "capacity")) << c.unfit[1].fit.reason;
 }
 
+// An own tyre that is overloaded at its pressure is the reference of the differences but is not ranked, as a
+// candidate that does not fit is not (session 20: it was ranked first while a stronger candidate was left out).
+TEST(SelectionCompare, AnOwnTyreThatDoesNotFitIsTheReferenceButNotRanked) {
+  Vehicle heavy = vehicle("ev");
+  TyreSpec own = tyre("nominal");
+  own.max_load_n = 3000.0;  // below the car's ~4000 N per wheel
+  fit_tyres(heavy, own);
+  const Comparison c = compare_tyres(heavy, {tyre("175-65R15")}, load_cycle("nedc"));
+  ASSERT_EQ(c.ranked.size(), 1u);
+  EXPECT_EQ(c.ranked[0].tyre.name, "175-65R15");
+  ASSERT_EQ(c.unfit.size(), 1u);
+  EXPECT_TRUE(c.unfit[0].is_own);
+  EXPECT_TRUE(has(c.unfit[0].fit.reason, "capacity")) << c.unfit[0].fit.reason;
+  EXPECT_DOUBLE_EQ(c.unfit[0].diff_pct, 0.0);
+  EXPECT_NEAR(c.ranked[0].diff_pct, (c.ranked[0].value / c.own_value - 1.0) * 100.0, 1e-12);
+}
+
 namespace {
 
 // A trace that ramps to `top_kmh` at 2 m/s^2, holds it for 60 s and stops: nothing beyond a car's top speed.

@@ -134,7 +134,10 @@ Comparison compare_tyres(const Vehicle& vehicle, const std::vector<TyreSpec>& ca
   for (auto& c : all) {
     c.diff_pct = (c.value / cmp.own_value - 1.0) * 100.0;
     c.range_change_km = c.range_km - cmp.own_range_km;
-    const bool rankable = c.simulated && (c.fit.fits || c.is_own);
+    // The car's own tyre is the reference of every difference, but it is ranked only if it fits as a candidate
+    // must: an own tyre overloaded at its pressure was ranked beside the tyres that fit while a candidate that
+    // carried more was not (outside testing, session 20).
+    const bool rankable = c.simulated && c.fit.fits;
     if (!c.simulated && c.fit.fits) c.fit = {false, c.fit.wheel_load_n, c.fit.capacity_n, c.fit.diameter_change_pct,
                                             "does not fit: " + c.error};
     (rankable ? cmp.ranked : cmp.unfit).push_back(c);
