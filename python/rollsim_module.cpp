@@ -60,7 +60,12 @@ T arg_as(py::handle x, const std::string& where, const std::string& expected) {
 
 // A dict's values as json.dumps takes them: numpy scalars become Python numbers and arrays lists (what a script
 // computes with numpy; json refused them with a TypeError naming no key). Anything else is named by its key path.
-py::object plain(py::handle x, const std::string& what, const std::string& path) {
+py::object plain(py::handle x, const std::string& what, const std::string& path, int depth = 0) {
+  // As deep as a YAML file may nest (the loader's check_keys): a dict that holds itself, or one nested thousands deep,
+  // recursed until the interpreter's stack overflowed (session 20).
+  if (depth > 64)
+    throw InputError(what + ": key '" + path.substr(0, 80) + (path.size() > 80 ? "..." : "") + "'",
+                     "nested more than 64 levels deep (a dict or list that holds itself?)");
   if (x.is_none() || py::isinstance<py::str>(x) || py::isinstance<py::bool_>(x) || py::isinstance<py::int_>(x) ||
       py::isinstance<py::float_>(x))
     return py::reinterpret_borrow<py::object>(x);
@@ -68,7 +73,7 @@ py::object plain(py::handle x, const std::string& what, const std::string& path)
   if (py::isinstance(x, np.attr("generic")) || py::isinstance<py::array>(x)) {
     if (py::isinstance(x, np.attr("ma").attr("MaskedArray")))
       throw InputError(what + ": key '" + path + "'", "a masked array is not allowed: give plain numbers");
-    return plain(x.attr("tolist")(), what, path);  // np.float32(2.5) -> 2.5, an array -> a list
+    return plain(x.attr("tolist")(), what, path, depth);  // np.float32(2.5) -> 2.5, an array -> a list
   }
   if (py::isinstance<py::dict>(x)) {
     py::dict out;
@@ -77,14 +82,14 @@ py::object plain(py::handle x, const std::string& what, const std::string& path)
       const std::string key = py::str(item.first).cast<std::string>();
       const std::string at = path.empty() ? key : path + "." + key;
       if (!named) throw InputError(what + ": key '" + at + "'", "a key must be text (str)");
-      out[py::str(key)] = plain(item.second, what, at);
+      out[py::str(key)] = plain(item.second, what, at, depth + 1);
     }
     return out;
   }
   if (py::isinstance<py::list>(x) || py::isinstance<py::tuple>(x)) {
     py::list out;
     std::size_t i = 0;
-    for (auto item : x) out.append(plain(item, what, path + "[" + std::to_string(i++) + "]"));
+    for (auto item : x) out.append(plain(item, what, path + "[" + std::to_string(i++) + "]", depth + 1));
     return out;
   }
   throw InputError(what + ": key '" + path + "'",
@@ -108,8 +113,12 @@ py::array_t<double> number_array(py::handle x, const std::string& where) {
   } catch (const py::error_already_set&) {  // e.g. a ragged list
     throw InputError(where, "expected a number or an array of numbers");
   }
-  if (data.attr("dtype").attr("kind").cast<std::string>() == "b")
-    throw InputError(where, "a bool array is not allowed: expected numbers");
+  const std::string kind = data.attr("dtype").attr("kind").cast<std::string>();
+  if (kind == "b") throw InputError(where, "a bool array is not allowed: expected numbers");
+  // Only integers and reals: numpy's cast reads '80' as 80, a complex number as its real part and a date as a
+  // count of days (session 20), where a number option given text is an error.
+  if (kind != "i" && kind != "u" && kind != "f")
+    throw InputError(where, "expected a number or an array of numbers, not " + py::str(data.attr("dtype")).cast<std::string>());
   auto a = py::array_t<double, py::array::forcecast>::ensure(data);
   if (!a) throw InputError(where, "expected a number or an array of numbers");
   return a;
@@ -288,11 +297,12 @@ py::list api_sweep(py::object tyre, py::object axes_arg, py::object load_n, py::
   req.speed_kmh = number_text(speed_kmh, "speed_kmh");
   req.threads = number_text(threads, "threads");
   const selection::SweepOptions so = selection::sweep_options_from_request(req);
+  if (!cycle.is_none() && vehicle.is_none()) throw InputError("cycle", "needs vehicle: a tyre alone drives no cycle");
   const TyreSpec t = *tyre_from(tyre);
   selection::SweepResult r;
   if (!vehicle.is_none()) {
     const Vehicle v = vehicle_from(vehicle);
-    const DriveCycle c = cycle_from(cycle);
+    const DriveCycle c = cycle_from(cycle.is_none() ? py::str("nedc") : cycle);
     py::gil_scoped_release released;
     r = selection::sweep_vehicle(v, t, c, so);
   } else {
@@ -401,6 +411,10 @@ py::dict api_tyre_fit(py::object size_arg, py::object points, py::object label, 
                       py::object name_arg, py::object output) {
   const auto size = arg_as<std::string>(size_arg, "size", "a size designation (str)");
   const auto name = arg_as<std::string>(name_arg, "name", "the tyre's name (str)");
+  // Checked before the fit, as `tyre fit --output` is: an existing, writable folder, no folders made (session 20:
+  // the module made missing folders where the command line refuses).
+  const std::string output_path = output.is_none() ? "" : arg_as<std::string>(output, "output", "a file path (str)");
+  if (!output_path.empty()) check_output_file(output_path, "output");
   TyreFitInputs in;
   in.size = parse_tyre_size(size, "size");
   if (!points.is_none()) {
@@ -450,10 +464,7 @@ py::dict api_tyre_fit(py::object size_arg, py::object points, py::object label, 
   out["params"] = params;
   out["residuals"] = residuals;
   out["tyre"] = py::module_::import("yaml").attr("safe_load")(yaml.str());
-  if (!output.is_none()) {
-    write_file_atomically(arg_as<std::string>(output, "output", "a file path (str)"), "output",
-                          [&](std::ostream& o) { o << yaml.str(); });
-  }
+  if (!output_path.empty()) write_file_atomically(output_path, "output", [&](std::ostream& o) { o << yaml.str(); });
   return out;
 }
 
@@ -465,7 +476,8 @@ py::dict api_sensitivity(py::object tyre, py::object vehicle, py::object cycle, 
   const std::optional<TyreSpec> t = tyre_from(tyre);
   std::optional<double> at_n;
   if (!load_n.is_none()) at_n = parse_option_number(number_text(load_n, "load_n"), "--load-n", Range::open_low(0.0, 1e6));
-  const DriveCycle c = v ? cycle_from(cycle) : DriveCycle{};
+  if (!cycle.is_none() && !v) throw InputError("cycle", "needs vehicle: a tyre alone drives no cycle");
+  const DriveCycle c = v ? cycle_from(cycle.is_none() ? py::str("nedc") : cycle) : DriveCycle{};
   selection::Sensitivity s;
   {
     py::gil_scoped_release released;
@@ -545,12 +557,12 @@ files are skipped with a warning. followed_trace is False (with max_deficit_kmh 
 could not follow the cycle on that tyre: its figure is then for a slower drive.)");
 
   m.def("sweep", &api_sweep, "tyre"_a, "axes"_a, py::kw_only(), "load_n"_a = py::none(), "speed_kmh"_a = 80.0,
-        "vehicle"_a = py::none(), "cycle"_a = "nedc", "threads"_a = py::none(),
+        "vehicle"_a = py::none(), "cycle"_a = py::none(), "threads"_a = py::none(),
         R"(A sweep of one or two tyre parameters (`rollsim sweep --json`).
 
 tyre: file, shipped name or dict. axes: [(param, from, to[, steps])], param one of pressure [bar], diameter [mm],
 width [mm], load [N], load-pct [%], speed [km/h]; steps default 11. load_n [N] (default 80 % of the maximum
-load), speed_kmh [km/h]. With vehicle (and cycle) each point is a forward simulation of the car (on `threads`
+load), speed_kmh [km/h]. With vehicle (and cycle, default 'nedc'; a cycle without a vehicle is an error) each point is a forward simulation of the car (on `threads`
 threads, default every core). Returns a list of dicts, one per point: the swept values (pressure_bar,
 diameter_mm, width_mm, load_n, load_pct, speed_kmh), the load_n and speed_kmh evaluated at when not swept, rrc,
 rr_force_n, rr_power_w, deflection_m, and the car's kwh_per_10km or l_per_100km with followed_trace (False, and a
@@ -572,11 +584,11 @@ point], 'tyre': the tyre file as a dict, which tyre(...) and simulate(tyre=...) 
 as the command line.)");
 
   m.def("sensitivity", &api_sensitivity, "tyre"_a = py::none(), py::kw_only(), "vehicle"_a = py::none(),
-        "cycle"_a = "nedc", "load_n"_a = py::none(), "speed_kmh"_a = 80.0,
+        "cycle"_a = py::none(), "load_n"_a = py::none(), "speed_kmh"_a = 80.0,
         R"(Elasticities of a tyre's RR power and RRC, and with a car of its energy or fuel (`rollsim sensitivity --json`).
 
 tyre: file, shipped name or dict (default: the car's own); vehicle: file, shipped name or dict (its energy
-elasticities on cycle, by forward simulation); load_n [N] (default: the car's heaviest wheel load, else 80 % of
+elasticities on cycle, default 'nedc', by forward simulation; a cycle without a vehicle is an error); load_n [N] (default: the car's heaviest wheel load, else 80 % of
 the tyre's maximum load) and speed_kmh [km/h]: the tyre's operating point. Returns one dict: elasticity_rr_power_<key>
 and, with a car, elasticity_<kwh_per_10km or l_per_100km>_<key> for outer_diameter, section_width, pressure and
 load (% per %), the dominant parameters, and the car's figure with followed_trace.)");

@@ -440,5 +440,55 @@ class Session17Inputs(unittest.TestCase):
         self.assertTrue(any("column 'gear' not read" in str(w.message) for w in caught), [str(w.message) for w in caught])
 
 
+class Session20Inputs(unittest.TestCase):
+    """Session 20's outside testing of the module; each failed on the module of the session's start."""
+
+    def test_a_dict_that_holds_itself_is_an_input_error_not_a_crash(self):
+        # It recursed until the interpreter's stack overflowed (exit 139); a 1000-deep one gave a RecursionError.
+        d = {"size": "175/70 R14 84T"}
+        d["x"] = d
+        with self.assertRaisesRegex(rollsim.InputError, "tyre dict: key 'x.x.x.*nested more than 64 levels deep"):
+            rollsim.tyre(d)
+        deep = {}
+        cur = deep
+        for _ in range(30000):
+            cur["a"] = {}
+            cur = cur["a"]
+        with self.assertRaisesRegex(rollsim.InputError, "nested more than 64 levels deep"):
+            rollsim.tyre({"size": "175/70 R14 84T", "pressure_bar": 2.1, "description": deep})
+
+    def test_text_complex_and_dates_are_not_numbers(self):
+        # numpy's cast read '80' as 80, 1+2j as 1 and a date as a count of days.
+        for value in ("80", b"80", np.array(["50"]), 1 + 2j, np.datetime64("2020-01-01")):
+            with self.subTest(value=repr(value)):
+                with self.assertRaisesRegex(rollsim.InputError, "--speed-kmh: expected a number or an array of numbers"):
+                    rollsim.tyre("175-70R14", speed_kmh=value)
+
+    def test_tyre_fit_output_is_checked_first_and_makes_no_folder(self):
+        # The module made the missing folders (and wrote there) where `tyre fit --output` refuses.
+        with tempfile.TemporaryDirectory() as tmp:
+            target = Path(tmp) / "missing" / "sub" / "t.yaml"
+            with self.assertRaisesRegex(rollsim.InputError, "output"):
+                rollsim.tyre_fit("205/55 R16 91V", label="B", output=str(target))
+            self.assertFalse((Path(tmp) / "missing").exists())
+            _, err, code = cli("tyre", "fit", "--size", "205/55 R16 91V", "--label", "B", "--output", str(target),
+                               expect_ok=False)
+            self.assertEqual(code, 2, err)
+            self.assertFalse((Path(tmp) / "missing").exists())
+
+    def test_a_cycle_without_a_vehicle_is_refused_as_on_the_command_line(self):
+        # sweep and sensitivity computed the tyre alone and dropped the cycle in silence.
+        _, err, code = cli("sweep", "--tyre", "175-70R14", "--param", "pressure", "--from", "1.5", "--to", "3.5",
+                           "--cycle", "wltc", expect_ok=False)
+        self.assertEqual(code, 2)
+        self.assertIn("needs --vehicle: a tyre alone drives no cycle", err)
+        with self.assertRaisesRegex(rollsim.InputError, "cycle: needs vehicle: a tyre alone drives no cycle"):
+            rollsim.sweep("175-70R14", [("pressure", 1.5, 3.5, 3)], cycle="wltc")
+        with self.assertRaisesRegex(rollsim.InputError, "cycle: needs vehicle: a tyre alone drives no cycle"):
+            rollsim.sensitivity("175-70R14", cycle="wltc")
+        # With a vehicle the default cycle is still NEDC.
+        self.assertEqual(rollsim.sensitivity(vehicle="ev"), rollsim.sensitivity(vehicle="ev", cycle="nedc"))
+
+
 if __name__ == "__main__":
     unittest.main()
