@@ -291,7 +291,7 @@ py::list api_sweep(py::object tyre, py::object axes_arg, py::object load_n, py::
     req.params.push_back(arg_as<std::string>(a[0], "axes", "(param, from, to[, steps]) with param a name (str)"));
     req.from.push_back(number_text(a[1], "axes (from)"));
     req.to.push_back(number_text(a[2], "axes (to)"));
-    if (a.size() == 4) req.steps.push_back(number_text(a[3], "axes (steps)"));
+    req.steps.push_back(a.size() == 4 ? number_text(a[3], "axes (steps)") : "");  // each axis its own, or the default
   }
   req.load_n = number_text(load_n, "load_n");
   req.speed_kmh = number_text(speed_kmh, "speed_kmh");

@@ -131,6 +131,38 @@ TEST(CliSelection, SweepPlotNeedsGnuplotAndSaysSo) {
   }
 }
 
+// Session 20's outside testing: one --steps with two --param went to the first; a sweep with no valid point left a
+// header-only CSV, and with --plot said only "no valid point to draw"; --base100 on an RRC of 0 passed gnuplot's own
+// error through.
+TEST(CliSelection, SweepStepsPerParamAndNoValidPointWritesNothing) {
+  const CmdResult one = run("sweep --tyre 175-70R14 --param pressure --from 2 --to 3 --param speed --from 40 --to 80 --steps 5");
+  EXPECT_EQ(one.exit_code, 2);
+  EXPECT_TRUE(one.out.empty()) << one.out;
+  EXPECT_TRUE(has(one.err, "--steps: give one --steps per --param (2), or none for 11 each; 1 given")) << one.err;
+  const CmdResult both = run("sweep --tyre 175-70R14 --param pressure --from 2 --to 3 --param speed --from 40 --to 80 --steps 2 --steps 5");
+  ASSERT_EQ(both.exit_code, 0) << both.err;
+  EXPECT_EQ(lines(both.out).size(), 1u + 2u * 5u);
+
+  const auto dir = temp_dir() / "novalid";
+  fs::create_directories(dir);
+  const std::string none = "sweep --tyre 175-70R14 --param diameter --from 300 --to 700 --steps 3";
+  for (const std::string& out : {" --output '" + (dir / "x.csv").string() + "'", " --plot '" + (dir / "x.svg").string() + "'"}) {
+    const CmdResult r = run(none + out);
+    EXPECT_EQ(r.exit_code, 2) << out;
+    EXPECT_TRUE(has(r.err, "rim")) << out << ": " << r.err;
+    EXPECT_TRUE(has(r.err, "no valid point of 3; nothing written")) << out << ": " << r.err;
+  }
+  if (std::system("command -v gnuplot >/dev/null 2>&1") == 0) {
+    const CmdResult zero = run("sweep --tyre 175-70R14 --param speed --from 0 --to 100 --steps 3 --base100 --output '" +
+                               (dir / "s.csv").string() + "' --plot '" + (dir / "s.svg").string() + "'");
+    EXPECT_EQ(zero.exit_code, 2);
+    EXPECT_TRUE(has(zero.err, "--base100: the first point's RRC is 0 (at 0 km/h)")) << zero.err;
+    EXPECT_FALSE(has(zero.err, "gnuplot")) << zero.err;
+  }
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator{}), 0);
+  fs::remove_all(dir);
+}
+
 TEST(CliSelection, VehicleSweepWritesEnergyPerPoint) {
   const CmdResult r = run("sweep --tyre nominal --vehicle ev --cycle nedc --param width --from 175 --to 235 --steps 4");
   ASSERT_EQ(r.exit_code, 0) << r.err;

@@ -66,11 +66,19 @@ std::string render_plot(const selection::SweepResult& r, const std::string& tyre
   const std::string ext = fs::path(file).extension().string();
   const std::string gnuplot = report::find_gnuplot();
   if (gnuplot.empty()) throw InputError("--plot " + file, gnuplot_missing);
-  const fs::path work = fs::temp_directory_path() / ("rollsim_plot_" + std::to_string(getpid()));
-  fs::create_directories(work);
   // Series: one per value of the second axis (or one), x = first axis, y = RRC (or base 100 of its first point).
   std::map<double, std::vector<std::pair<double, double>>> series;
   for (const auto& p : r.points) series[p.values.size() > 1 ? p.values[1] : 0.0].push_back({p.values[0], p.rr.rrc});
+  for (const auto& [key, pts] : series) {
+    // An RRC of 0 (at 0 km/h) as the base: gnuplot's own "all points y value undefined" reached the user (session 20).
+    if (base100 && !(pts.front().second > 0.0)) {
+      throw InputError("--base100", "the first point's RRC is " + format_value(pts.front().second) + " (at " +
+                                        format_value(pts.front().first) + " " + display_unit(r.axes[0].param) +
+                                        "): there is no base to divide by; start the range elsewhere");
+    }
+  }
+  const fs::path work = fs::temp_directory_path() / ("rollsim_plot_" + std::to_string(getpid()));
+  fs::create_directories(work);
   std::ofstream data(work / "data.dat");
   for (auto& [key, pts] : series) {
     const double ref = pts.front().second;
@@ -157,6 +165,11 @@ void run_sweep(const SweepOptionsText& o, const ProcessGroup& group) {
   const selection::SweepResult r =
       vehicle ? selection::sweep_vehicle(*vehicle, tyre, *drive, so) : selection::sweep_tyre(tyre, so);
 
+  // Nothing valid: the reason, and no file (a header-only CSV was left, and --plot said only "no valid point").
+  if (r.points.empty()) {
+    throw InputError("--param", (r.stopped ? *r.stopped : std::string("no point was computed")) +
+                                    " (no valid point of " + std::to_string(r.planned_points) + "; nothing written)");
+  }
   std::string table;
   if (o.json) {
     std::ostringstream out;

@@ -148,7 +148,12 @@ SweepOptions sweep_options_from_request(const SweepRequest& o) {
   if (o.from.size() != o.params.size() || o.to.size() != o.params.size()) {
     throw InputError("--from/--to", "give one --from and one --to per --param");
   }
-  if (o.steps.size() > o.params.size()) throw InputError("--steps", "more --steps than --param");
+  // One --steps per --param or none: a single --steps with two --param went to the first, whichever it was
+  // written after (session 20).
+  if (!o.steps.empty() && o.steps.size() != o.params.size()) {
+    throw InputError("--steps", "give one --steps per --param (" + std::to_string(o.params.size()) + "), or none for " +
+                                    std::to_string(SweepAxis{}.steps) + " each; " + std::to_string(o.steps.size()) + " given");
+  }
   SweepOptions so;
   for (std::size_t i = 0; i < o.params.size(); ++i) {
     const auto p = parse_sweep_param(o.params[i]);
@@ -158,7 +163,7 @@ SweepOptions sweep_options_from_request(const SweepRequest& o) {
     a.param = *p;
     a.from = parse_option_number(o.from[i], "--from", Range{});
     a.to = parse_option_number(o.to[i], "--to", Range{});
-    if (i < o.steps.size()) {
+    if (i < o.steps.size() && !o.steps[i].empty()) {  // empty: the default (an axis given without steps in Python)
       a.steps = parse_option_count(o.steps[i], "--steps", Range::closed(2, 1e6));
     }
     check_axis(a, opt);
