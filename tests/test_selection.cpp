@@ -188,6 +188,24 @@ TEST(SelectionCompare, AnOwnTyreThatDoesNotFitIsTheReferenceButNotRanked) {
   EXPECT_NEAR(c.ranked[0].diff_pct, (c.ranked[0].value / c.own_value - 1.0) * 100.0, 1e-12);
 }
 
+// A light-truck size's load index is rated at its load range's pressure, which its designation does not give: at a
+// car's 2.5 bar the passenger reference gave an LT245/75 R16 120/116S its full 1400 kg (session 20).
+TEST(SelectionCompare, ALightTruckTyresCapacityIsUnknownNotThePassengerRating) {
+  TyreSpec lt = tyre("nominal");
+  lt.size = parse_tyre_size("LT245/75 R16 120/116S", "size");
+  lt.max_load_n = 1400.0 * 9.80665;
+  EXPECT_EQ(load_capacity_at_pressure_n(lt), 0.0);
+  const FitCheck f = check_fit(vehicle("ev"), tyre("nominal"), lt, 50.0);
+  EXPECT_FALSE(f.fits);
+  EXPECT_TRUE(has(f.reason, "light-truck (LT)")) << f.reason;
+  // A passenger size keeps its rating scaled from 2.5 bar.
+  TyreSpec p = tyre("nominal");
+  p.size = parse_tyre_size("245/75 R16 111T", "size");
+  p.max_load_n = 1090.0 * 9.80665;
+  p.state.pressure_pa = 2.1e5;
+  EXPECT_NEAR(load_capacity_at_pressure_n(p), p.max_load_n * std::pow(2.1 / 2.5, 0.585), 1e-9);
+}
+
 namespace {
 
 // A trace that ramps to `top_kmh` at 2 m/s^2, holds it for 60 s and stops: nothing beyond a car's top speed.

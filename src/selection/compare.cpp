@@ -17,8 +17,14 @@ double reference_pressure_pa(const TyreSpec& tyre) {
   return units::bar_to_pa(xl ? 2.9 : 2.5);
 }
 
+namespace {
+// A light-truck tyre's load index holds at its load range's inflation (TRA: C 350, D 450, E 550 kPa), which the size
+// designation does not carry; the passenger reference overstated its capacity at car pressures by ~60 % (session 20).
+bool light_truck(const TyreSpec& tyre) { return tyre.size && tyre.size->prefix == SizePrefix::light_truck; }
+}  // namespace
+
 double load_capacity_at_pressure_n(const TyreSpec& tyre) {
-  if (!(tyre.max_load_n > 0.0)) return 0.0;
+  if (!(tyre.max_load_n > 0.0) || light_truck(tyre)) return 0.0;
   const double ratio = tyre.state.pressure_pa / reference_pressure_pa(tyre);
   // Above the reference pressure the rating does not grow: the load index is the tyre's ceiling.
   return ratio >= 1.0 ? tyre.max_load_n : tyre.max_load_n * std::pow(ratio, 0.585);
@@ -35,7 +41,9 @@ FitCheck check_fit(const Vehicle& vehicle, const TyreSpec& own, const TyreSpec& 
   f.diameter_change_pct = (d_new / d_own - 1.0) * 100.0;
   std::vector<std::string> reasons;
   if (f.capacity_n <= 0.0) {
-    reasons.push_back("load capacity unknown (no load index or max load)");
+    reasons.push_back(light_truck(candidate) ? "load capacity unknown: a light-truck (LT) tyre's load index holds at its "
+                                               "load range's pressure (C 350, D 450, E 550 kPa), which the size does not give"
+                                             : "load capacity unknown (no load index or max load)");
   } else if (f.wheel_load_n > f.capacity_n) {
     reasons.push_back("load " + fixed(f.wheel_load_n, 0) + " N > " + fixed(f.capacity_n, 0) +
                       " N capacity at " + fixed(units::pa_to_bar(candidate.state.pressure_pa), 1) + " bar");

@@ -18,7 +18,8 @@ double reference_pressure_pa(const TyreSpec& tyre);
 
 /// Load capacity [N] at the tyre's own inflation pressure: the rated maximum load scaled by
 /// (p / p_ref)^0.585 below the reference pressure (the load-inflation exponent of the TRA/ETRTO passenger
-/// tables, which these tables follow within a few per cent) and not raised above it. 0 when the rating is unknown.
+/// tables, which these tables follow within a few per cent) and not raised above it. 0 when the rating is unknown,
+/// and for a light-truck (LT) size, whose reference pressure is its load range's and not in the designation.
 double load_capacity_at_pressure_n(const TyreSpec& tyre);
 
 /// Does `candidate` fit the car whose own tyre is `own`?
