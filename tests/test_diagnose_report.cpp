@@ -105,8 +105,11 @@ TEST(DiagnoseUnexplained, ConcealedForceProportionalToSpeedIsDescribedBySignatur
   EXPECT_NE(diagnosis_json(d).find("\"effect\": \"unexplained\""), std::string::npos);
   // An unexplained finding is a description, not a module: the fitted vehicle file must stay loadable.
   const std::string out = ::testing::TempDir() + "/ev_unexplained.yaml";
-  std::ofstream(out) << fitted_vehicle_yaml(src("vehicles/ev.yaml"), d);
+  const std::string fitted = fitted_vehicle_yaml(src("vehicles/ev.yaml"), d);
+  std::ofstream(out) << fitted;
   EXPECT_NO_THROW(load_vehicle_file(out));
+  // ... and it says so under its heading, which stood empty as if nothing had been found (session 20).
+  EXPECT_NE(fitted.find(")\n# found, not written: unexplained (a signature no catalogue effect fits)\n"), std::string::npos) << fitted;
 }
 
 TEST(DiagnoseUnexplained, EnergyShareIsTheConcealedForcesShareOfTheRecordedEnergy) {

@@ -219,11 +219,16 @@ std::string fitted_vehicle_yaml(const std::string& vehicle_path, const Diagnosis
   // YAML, not of the text, so that "effects :" or "\"effects\":" is one too.
   check_no_effects_block(YamlMap::load_text(text, vehicle_path), vehicle_path);
   std::vector<std::pair<std::string, EffectParameters>> eff;
-  for (const auto& f : d.findings)
-    // unexplained: described, not a module; road_profile: its knots are the diagnosis' output, not parameters
-    if (f.effect != "unexplained" && f.effect != "road_profile") eff.emplace_back(f.effect, f.fitted);
+  std::string not_written;
+  for (const auto& f : d.findings) {
+    // unexplained: described, not a module; road_profile: its knots are the diagnosis' output, not parameters. Each
+    // is named, so a file with nothing under its heading does not read as "nothing found" (session 20).
+    if (f.effect == "road_profile") not_written += "# found, not written: road_profile (a property of the route, not the car)\n";
+    else if (f.effect == "unexplained") not_written += "# found, not written: unexplained (a signature no catalogue effect fits)\n";
+    else eff.emplace_back(f.effect, f.fitted);
+  }
   if (!text.empty() && text.back() != '\n') text += '\n';
-  text += "# effects fitted by rollsim diagnose (verdict: " + d.verdict + ")\n";
+  text += "# effects fitted by rollsim diagnose (verdict: " + d.verdict + ")\n" + not_written;
   if (eff.empty()) return text;
   return text + effects_yaml(eff);
 }
