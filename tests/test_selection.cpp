@@ -328,6 +328,38 @@ TEST(RegressLibrary, MissingVehicleNamesTheCase) {
   std::filesystem::remove_all(dir);
 }
 
+// Session 20's outside testing: a case without `expected` was told its `tolerance_pct` might be a misspelling (every
+// key not yet read was named), and a tyre not found did not say it had been looked for beside the baseline.
+TEST(RegressLibrary, AMissingKeySuggestsOnlyKeysSpeltLikeItAndNotFoundSaysWhereItLooked) {
+  const auto dir = std::filesystem::temp_directory_path() / ("rollsim_test_regress_keys_" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string head = "cases:\n  - name: a\n    vehicle: ev\n    tyre: nominal\n    cycle: nedc\n    unit: kwh_per_10km\n";
+  auto message = [&](const std::string& body) {
+    std::ofstream(dir / "b.yaml") << head << body;
+    try {
+      run_baseline(load_baseline((dir / "b.yaml").string()));
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const std::string missing = message("    tolerance_pct: 0.5\n");
+  EXPECT_TRUE(has(missing, "key 'cases[0].expected': required key is missing")) << missing;
+  EXPECT_FALSE(has(missing, "tolerance_pct")) << missing;
+  const std::string typo = message("    expcted: 1.6\n    tolerance_pct: 0.5\n");
+  EXPECT_TRUE(has(typo, "required key is missing (misspelt as 'expcted'?)")) << typo;
+  std::ofstream(dir / "b.yaml") << "cases:\n  - name: a\n    vehicle: ev\n    tyre: nosuch\n    cycle: nedc\n"
+                                   "    unit: kwh_per_10km\n    expected: 1.6\n    tolerance_pct: 0.5\n";
+  const Baseline b = load_baseline((dir / "b.yaml").string());
+  try {
+    run_baseline(b);
+    FAIL() << "expected an error";
+  } catch (const InputError& e) {
+    EXPECT_TRUE(has(e.what(), "file not found (looked in the referring file's folder " + dir.string() + ", the current folder and ")) << e.what();
+  }
+  std::filesystem::remove_all(dir);
+}
+
 // A case whose car cannot follow its cycle still guards its figure, but the outcome says it is a slower drive's
 // (regress prints it under its table; session 14).
 TEST(RegressLibrary, ACaseWhoseCarFellBehindSaysSo) {

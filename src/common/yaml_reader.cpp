@@ -1,6 +1,7 @@
 #include "rollsim/common/yaml_reader.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -104,6 +105,26 @@ YamlMap YamlMap::load_text(const std::string& text, const std::string& path) {
   return YamlMap(root, path, "");
 }
 
+namespace {
+// Two keys a typing slip apart: an edit distance (insert, delete, substitute, case ignored) of at most a quarter of
+// the longer one's length, and at least 1.
+bool spelt_alike(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t above = row[j];
+      const bool same = std::tolower(static_cast<unsigned char>(a[i - 1])) == std::tolower(static_cast<unsigned char>(b[j - 1]));
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (same ? 0 : 1)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()] <= std::max<std::size_t>(1, std::max(a.size(), b.size()) / 4);
+}
+}  // namespace
+
 YamlMap::YamlMap(YAML::Node node, std::string file, std::string prefix)
     : node_(std::move(node)), file_(std::move(file)), prefix_(std::move(prefix)) {}
 
@@ -118,17 +139,18 @@ YAML::Node YamlMap::get(const std::string& key, bool required) {
   YAML::Node n = node_[key];
   if (!n.IsDefined() || n.IsNull()) {
     if (required) {
-      // A misspelt key shows up here first as a missing one: name the present keys that nobody asked for.
+      // A misspelt key shows up here first as a missing one: name the present keys that nobody asked for and that
+      // are spelt like it. Every unread key was named before, so a case missing `expected` suggested its
+      // `tolerance_pct`, which is read later (session 20).
       std::string unknown;
       if (node_.IsMap()) {
         for (const auto& kv : node_) {
           const std::string k = kv.first.as<std::string>();
-          if (k != key && std::find(read_keys_.begin(), read_keys_.end(), k) == read_keys_.end())
+          if (k != key && std::find(read_keys_.begin(), read_keys_.end(), k) == read_keys_.end() && spelt_alike(k, key))
             unknown += (unknown.empty() ? "" : ", ") + ("'" + k + "'");
         }
       }
-      throw InputError(where(key), "required key is missing" +
-                                       (unknown.empty() ? std::string() : " (present and not yet known here: " + unknown + "; misspelt?)"));
+      throw InputError(where(key), "required key is missing" + (unknown.empty() ? std::string() : " (misspelt as " + unknown + "?)"));
     }
     return YAML::Node();
   }
@@ -258,8 +280,26 @@ std::optional<std::string> shipped_data_file(const std::string& name, const std:
   return std::nullopt;
 }
 
+namespace {
+std::string resolve_data_file_in(const std::string& name, const std::string& shipped_dir, const std::string& extension,
+                                 const std::string& option, const std::string& looked_beside);
+}  // namespace
+
 std::string resolve_data_file(const std::string& name, const std::string& shipped_dir,
                               const std::string& extension, const std::string& option) {
+  return resolve_data_file_in(name, shipped_dir, extension, option, "");
+}
+
+std::string resolve_data_file_beside(const std::string& name, const std::string& referring_file,
+                                     const std::string& shipped_dir, const std::string& extension, const std::string& option) {
+  if (auto beside = file_beside(name, referring_file)) return *beside;
+  const std::string folder = std::filesystem::path(referring_file).parent_path().string();
+  return resolve_data_file_in(name, shipped_dir, extension, option, folder.empty() ? "." : folder);
+}
+
+namespace {
+std::string resolve_data_file_in(const std::string& name, const std::string& shipped_dir, const std::string& extension,
+                                 const std::string& option, const std::string& looked_beside) {
   namespace fs = std::filesystem;
   const fs::path given(name);
   // A bare name ("nedc", "155-70R19") names shipped data: a file of that name in the current folder must not
@@ -283,9 +323,12 @@ std::string resolve_data_file(const std::string& name, const std::string& shippe
   if (fs::exists(given, ec)) {
     throw InputError(option + " '" + name + "'", "is not a regular file (a device, pipe or socket?)");
   }
-  throw InputError(option + " '" + name + "'",
-                   "file not found (looked in the current folder and in " + shipped.string() + ")");
+  // Every place looked in: a baseline's tyre beside it was found but the error did not say it looked there (session 20).
+  throw InputError(option + " '" + name + "'", "file not found (looked in " +
+                                                   (looked_beside.empty() ? "" : "the referring file's folder " + looked_beside + ", ") +
+                                                   "the current folder and " + shipped.string() + ")");
 }
+}  // namespace
 
 double parse_option_number(const std::string& text, const std::string& option, Range range) {
   char* end = nullptr;

@@ -31,7 +31,7 @@ std::vector<std::string> split_list(const std::string& cell) {
 std::string resolve(const std::string& cell, const std::string& manifest, const char* shipped, const char* ext,
                     const std::string& where) {
   try {
-    return resolve_data_file(path_beside(cell, manifest), shipped, ext, where);
+    return resolve_data_file_beside(cell, manifest, shipped, ext, where);
   } catch (const InputError& e) {
     throw InputError(where, "'" + cell + "' not found (relative to the manifest's folder, or a shipped name)");
   }

@@ -64,8 +64,8 @@ std::vector<RegressOutcome> run_baseline(const Baseline& b) {
     const std::string where = b.file + ": case '" + c.name + "'";
     try {
       // A baseline's own files travel with it: names resolve beside the baseline first, as a fleet manifest's do.
-      Vehicle v = load_vehicle_file(resolve_data_file(path_beside(c.vehicle, b.file), "vehicles", ".yaml", "vehicle"));
-      fit_tyres(v, load_tyre_file(resolve_data_file(path_beside(c.tyre, b.file), "tyres", ".yaml", "tyre")));
+      Vehicle v = load_vehicle_file(resolve_data_file_beside(c.vehicle, b.file, "vehicles", ".yaml", "vehicle"));
+      fit_tyres(v, load_tyre_file(resolve_data_file_beside(c.tyre, b.file, "tyres", ".yaml", "tyre")));
       const DriveCycle cycle = load_cycle(path_beside(c.cycle, b.file), "cycle");
       require_distance(cycle);
       if (energy_unit(v) != c.unit) {

@@ -105,6 +105,11 @@ class YamlMap {
 std::string resolve_data_file(const std::string& name, const std::string& shipped_dir,
                               const std::string& extension, const std::string& option);
 
+/// resolve_data_file for a name written in another file (a baseline, a manifest): the file of that name beside
+/// `referring_file` first, and the not-found error names that folder among the places looked in.
+std::string resolve_data_file_beside(const std::string& name, const std::string& referring_file,
+                                     const std::string& shipped_dir, const std::string& extension, const std::string& option);
+
 /// The shipped file `name` (or `name` + `extension`) in `<data root>/<shipped_dir>/`, if there is one.
 std::optional<std::string> shipped_data_file(const std::string& name, const std::string& shipped_dir,
                                              const std::string& extension);
