@@ -332,6 +332,8 @@ py::object api_diagnose(py::object vehicle, py::object recording_paths, py::obje
                              : YamlMap::load_file(vehicle_path(vehicle));
   Vehicle v = load_vehicle(vehicle_file);
   if (const auto t = tyre_from(tyre)) fit_tyres(v, *t);
+  DiagnoseOptions options;
+  options.priors = calibration_priors_from_yaml(vehicle_file);
   std::vector<std::string> column_options, scale_options;
   const std::string column_pairs = "a dict of canonical name (str) to source column (str)";
   for (auto item : columns) {
@@ -351,7 +353,7 @@ py::object api_diagnose(py::object vehicle, py::object recording_paths, py::obje
   std::string json;
   {
     py::gil_scoped_release released;
-    json = diagnosis_json(diagnose(v, recs, DiagnoseOptions{}));
+    json = diagnosis_json(diagnose(v, recs, options));
   }
   return from_json(json);
 }

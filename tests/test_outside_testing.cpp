@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <regex>
 #include <sstream>
@@ -900,6 +901,25 @@ TEST_F(OutsideTesting, TheChannelLagSaysWhatItIsNot) {
   // The unshifted test's lag is inside the search and says nothing of it.
   const CmdResult base = run_rollsim("diagnose --vehicle camry_2018 --preset anl_d3 --recording '" + kCamryUdds + "'");
   EXPECT_TRUE(has(base.out, "channel lag: 0.25 s [0.15, 0.30] (interpolated channel)\n")) << base.out;
+}
+
+// Session 20's vehicle-file check: the `calibration_priors:` block was accepted and never read (a bound of 0.01 left
+// the channel scale's box at 0.95-1.05) nor checked (a misspelt key, a negative sd passed).
+TEST_F(OutsideTesting, AVehicleFilesCalibrationPriorsAreReadAndChecked) {
+  std::ifstream in(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/camry_2018.yaml");
+  const std::string camry((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string tight = write("tight.yaml", camry + "\ncalibration_priors:\n  fuel_scale_bound: 0.02\n");
+  const fs::path json = dir_ / "tight.json";
+  const CmdResult r = run_rollsim("diagnose --vehicle '" + tight + "' --preset anl_d3 --recording '" + kCamryUdds + "' --json '" +
+                                  json.string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(has(slurp(json.string()), "\"channel_scale_prior\": {\"low\": 0.98, \"high\": 1.02}")) << slurp(json.string());
+  expect_refused("diagnose --vehicle '" + write("typo.yaml", camry + "\ncalibration_priors:\n  fuel_scale_bund: 0.02\n") +
+                     "' --preset anl_d3 --recording '" + kCamryUdds + "'",
+                 "fuel_scale_bund");
+  expect_refused("diagnose --vehicle '" + write("negative.yaml", camry + "\ncalibration_priors:\n  drag_sd: -1\n") +
+                     "' --preset anl_d3 --recording '" + kCamryUdds + "'",
+                 "calibration_priors.drag_sd");
 }
 
 }  // namespace

@@ -51,6 +51,8 @@ void run_diagnose(const DiagnoseCliOptions& o) {
   for (const auto& r : recs)
     for (const auto& rep : r.repairs) (rep.rfind("warning:", 0) == 0 ? std::cerr : std::cout) << r.source << ": " << rep << "\n";
   DiagnoseOptions dopt;
+  // The vehicle file's calibration bounds (until session 20 the block was accepted and never read).
+  dopt.priors = calibration_priors_from_yaml(vehicle_file);
   if (!o.window_s.empty()) dopt.window_s = window_s_of(o.window_s);
   dopt.infer_road_profile = o.road_profile;
   if (!o.engine_start.empty() && !v.fuel()) {

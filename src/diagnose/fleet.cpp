@@ -95,7 +95,10 @@ FleetEntry diagnose_group(const FleetGroup& g, const DiagnoseOptions& o) {
   if (!g.tyre_path.empty()) fit_tyres(v, load_tyre_file(g.tyre_path));
   std::vector<Recording> recs;
   for (const auto& r : g.recordings) recs.push_back(load_recording(r.path, r.mapping));
-  const Diagnosis d = diagnose(v, recs, o);
+  DiagnoseOptions group_options = o;
+  YamlMap vehicle_file = YamlMap::load_file(g.vehicle_path);
+  group_options.priors = calibration_priors_from_yaml(vehicle_file);  // each car's own calibration bounds
+  const Diagnosis d = diagnose(v, recs, group_options);
   FleetEntry e{g.name, v.name, d.verdict, d.channel, recs.size(), {}};
   for (const auto& f : d.findings) {
     FleetFinding ff{f.effect, "", "", 0.0, f.energy_share_pct};

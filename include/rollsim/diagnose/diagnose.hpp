@@ -18,7 +18,7 @@ namespace rollsim {
 enum class ChannelKind { battery_power, battery_voltage_x_current, fuel_rate, soc };
 std::string to_string(ChannelKind k);
 
-/// Physical priors of the calibration, per channel kind (docs/diagnose.md, "Calibration with priors"). The channel
+/// Physical priors of the calibration, per channel kind (docs/diagnose.md, "Calibration"). The channel
 /// scale is bounded (a hard box about 1): a battery's terminal voltage and current, or a dynamometer's direct fuel
 /// meter, are calibrated to a few per cent; a state of charge carries the usable capacity's uncertainty. RRC level
 /// and aero C carry Gaussian penalties at their published uncertainty. Settable in a vehicle file's
