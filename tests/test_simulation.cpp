@@ -392,6 +392,29 @@ TEST(Simulation, AKickDownNeverTakesTheEnginePastItsTopSpeed) {
 // The replay integrated a ramp with two Gauss points however long it was: across a 30 s coast from 60 km/h to rest
 // they missed the gear shifts and the fuel cut-off, and ice.yaml booked 116 kJ of fuel where the forward simulation
 // (and the same coast sampled at 0.05 s) book 73 kJ. A ramp is now integrated in pieces of at most a second.
+// A traced replay gives each ramp's end at the ramp's own acceleration (what an instantaneous logger lagging by a
+// fraction of a sample reads; session 20). On a steady ramp that is the next sample's start; where the ramp ends in a
+// cruise it is not (the acceleration jumps there), and a cruise's end is its start.
+TEST(Simulation, ATracedReplayGivesEachRampsEndAtItsOwnAcceleration) {
+  SimulationOptions traced;
+  traced.record_trace = true;
+  for (const char* vehicle : {"vehicles/ev.yaml", "vehicles/ice.yaml"}) {
+    SCOPED_TRACE(vehicle);
+    const auto m = model_of(vehicle);
+    const auto r = simulate_replay(m, points_only({{0.0, 0.0}, {1.0, 10.0}, {2.0, 20.0}, {3.0, 30.0}, {4.0, 30.0}, {5.0, 30.0}}), traced);
+    ASSERT_EQ(r.trace.size(), 5u);
+    for (std::size_t k : {0u, 1u}) {  // within the steady ramp
+      EXPECT_NEAR(r.trace[k].end_battery_power_w, r.trace[k + 1].battery_power_w, 1e-9 * std::abs(r.trace[k + 1].battery_power_w) + 1e-9);
+      EXPECT_NEAR(r.trace[k].end_fuel_rate_m3_per_s, r.trace[k + 1].fuel_rate_m3_per_s, 1e-9 * r.trace[k + 1].fuel_rate_m3_per_s + 1e-15);
+    }
+    // The ramp's last second ends at 30 km/h still accelerating: more than the cruise that follows draws.
+    if (r.trace[3].battery_power_w != 0.0) EXPECT_GT(r.trace[2].end_battery_power_w, r.trace[3].battery_power_w);
+    else EXPECT_GT(r.trace[2].end_fuel_rate_m3_per_s, r.trace[3].fuel_rate_m3_per_s);
+    EXPECT_EQ(r.trace[3].end_battery_power_w, r.trace[3].battery_power_w);  // a cruise
+    EXPECT_EQ(r.trace[3].end_fuel_rate_m3_per_s, r.trace[3].fuel_rate_m3_per_s);
+  }
+}
+
 TEST(Simulation, ReplayOfACoarseTraceAgreesWithTheSameTraceSampledFinely) {
   const std::vector<std::pair<double, double>> coast{{0.0, 60.0}, {30.0, 0.0}, {40.0, 0.0}};
   for (const char* file : {"vehicles/ice.yaml", "vehicles/camry_2018_map.yaml"}) {

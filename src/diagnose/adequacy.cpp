@@ -171,9 +171,9 @@ NoiseFloor calibrated_noise_floor(const Observations& o, const std::vector<Recor
   const Observations shortw = rewindow(o, recs, std::min(std::max(opt.noise_window_s, 2.0 * dt), o.window_s));
   if (shortw.n() < 4) return {};
   const Eigen::VectorXd& k = cal.model.fit.coef;
-  const Eigen::VectorXd b = window_energies(s.base.power_w, shortw, lag_samples);
-  const Eigen::VectorXd sim = k[0] * b + k[1] * (window_energies(s.rrc.power_w, shortw, lag_samples) - b) +
-                              k[2] * (window_energies(s.drag.power_w, shortw, lag_samples) - b);
+  const Eigen::VectorXd b = window_energies(s.base, shortw, lag_samples);
+  const Eigen::VectorXd sim = k[0] * b + k[1] * (window_energies(s.rrc, shortw, lag_samples) - b) +
+                              k[2] * (window_energies(s.drag, shortw, lag_samples) - b);
   return noise_floor(shortw, shortw.measured_j - sim);
 }
 

@@ -50,6 +50,9 @@ Observations rewindow(const Observations& o, const std::vector<Recording>& recor
 /// Simulated channel power of one model variant: per recording, per sample, and per window (lag applied).
 struct Variant {
   std::vector<std::vector<double>> power_w;
+  /// A channel read at instants only: per segment, its value at its end at its own acceleration (the point value
+  /// at the start is power_w). Empty for interval means, whose lagged window is exactly (1-f) p[k] + f p[k+1].
+  std::vector<std::vector<double>> end_w;
   Eigen::VectorXd window_j;
 };
 
@@ -61,7 +64,7 @@ inline bool headings_known(const std::vector<DriveCycle>& cycles) {
 
 /// The simulated channel per recording and sample, read both ways a logger may sample it.
 struct ChannelPowers {
-  std::vector<std::vector<double>> interval_mean, instantaneous;
+  std::vector<std::vector<double>> interval_mean, instantaneous, instantaneous_end;
 };
 
 /// Replays model variants (the base model plus extra effects) on the recordings' traces, in parallel.
@@ -72,13 +75,17 @@ struct Replayer {
   bool cells = false;        // SOC: the cells' internal loss counts
   unsigned threads = 0;
   bool point_values = false;  // the channel read at each sample's instant (else its mean over the sample's interval)
-  std::vector<std::vector<double>> power(const EffectList& extra) const;  ///< as `point_values` says
+  void sample(const EffectList& extra, Variant& out) const;               ///< power_w (and end_w) as `point_values` says
   ChannelPowers both_samplings(const EffectList& extra) const;           ///< one replay, both readings
   std::vector<Variant> run(const std::vector<EffectList>& extras, const Observations& o, double lag_samples) const;
 };
 
-/// Window energies of per-sample powers, shifted by a (fractional) channel lag, interpolated linearly.
-Eigen::VectorXd window_energies(const std::vector<std::vector<double>>& power_w, const Observations& o, double lag_samples);
+/// Window energies of per-sample powers, shifted by a (fractional) channel lag: interval means interpolated linearly
+/// between samples; instants, where `end_w` is given, within their segment (start to end at its own acceleration).
+Eigen::VectorXd window_energies(const std::vector<std::vector<double>>& power_w, const Observations& o, double lag_samples,
+                                const std::vector<std::vector<double>>* end_w = nullptr);
+/// The variant's window energies, read as it was sampled (its end_w when it has them).
+Eigen::VectorXd window_energies(const Variant& v, const Observations& o, double lag_samples);
 
 /// Channel lag (calibration): the continuous shift of the simulated power, 0-10 samples, that best matches the
 /// measured one (interpolated channel), with its profile interval.
@@ -88,7 +95,8 @@ struct LagEstimate {
   double seconds = 0.0, low_s = 0.0, high_s = 0.0;
   double sse_w2 = 0.0;  ///< sum of squared sample residuals at the best lag (comparable across channel samplings)
 };
-LagEstimate estimate_lag(const std::vector<std::vector<double>>& sim_w, const Observations& o);
+LagEstimate estimate_lag(const std::vector<std::vector<double>>& sim_w, const Observations& o,
+                         const std::vector<std::vector<double>>* end_w = nullptr);
 
 // ---- engine start (engine_start.cpp) ---------------------------------------------------------------------------
 

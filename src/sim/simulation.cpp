@@ -314,6 +314,9 @@ TracePoint trace_point(const VehicleModel& m, double t, double target_mps, doubl
   p.segment_battery_power_w = p.battery_power_w;
   p.segment_battery_loss_w = p.battery_loss_w;
   p.segment_fuel_rate_m3_per_s = p.fuel_rate_m3_per_s;
+  p.end_battery_power_w = p.battery_power_w;
+  p.end_battery_loss_w = p.battery_loss_w;
+  p.end_fuel_rate_m3_per_s = p.fuel_rate_m3_per_s;
   const double normal_n = m.mass_kg * units::kStandardGravity_mps2 / std::sqrt(1.0 + grade * grade);
   p.rrc = s.rolling_n / normal_n;
   p.machine_speed_radps = s.flow.machine_speed_radps;
@@ -993,6 +996,18 @@ SimulationResult simulate_replay(const VehicleModel& m, const DriveCycle& c, con
       p.segment_battery_power_w = seg(kTerminal);
       p.segment_battery_loss_w = seg(kBatteryLoss);
       p.segment_fuel_rate_m3_per_s = seg(kFuelVolume);
+      if (a != 0.0) {
+        // The ramp's end at its own acceleration (a cruise's end is its start). Scratch evaluation: the gear
+        // schedule is restored, and the rates it overwrites were booked above.
+        const int scheduled = scheduled_gear, g = gear;
+        const double v1 = c.speed_mps[i + 1];
+        evaluate_at(t0 + dt, v1, a, grade, rl, distance_m + (v0 + v1) / 2.0 * dt);
+        p.end_battery_power_w = s.flow.battery_terminal_power_w;
+        p.end_battery_loss_w = s.flow.battery_loss_w;
+        p.end_fuel_rate_m3_per_s = s.flow.fuel_rate_m3_per_s;
+        scheduled_gear = scheduled;
+        gear = g;
+      }
     }
     // Hidden effect states advance with the segment-mean rate (time constants are minutes, segments seconds).
     for (int j = 0; j < eval.effect_states; ++j) x[j] += dt * xdot_sum[j];

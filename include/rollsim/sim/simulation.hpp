@@ -112,6 +112,10 @@ struct TracePoint {
   /// quadrature / its length; forward and the last sample: the point values). A channel summed as mean x dt over
   /// the trace adds up to the run's energy totals; the point values, a left-end rule, do not.
   double segment_battery_power_w, segment_battery_loss_w, segment_fuel_rate_m3_per_s;
+  /// Point values at the segment's end, at the segment's own acceleration (replay; forward and the last sample: the
+  /// point values). Over a ramp the trace's acceleration jumps at each sample, so an instant read a fraction f into
+  /// a segment lies between this sample's point value and these, not between two samples' point values.
+  double end_battery_power_w, end_battery_loss_w, end_fuel_rate_m3_per_s;
   double rrc;  ///< rolling force / total normal load
   double machine_speed_radps;  ///< engine or motor speed (0 with the engine off)
   double gear_ratio;           ///< the powertrain's engaged gear ratio (0: none, or a powertrain without gears)
