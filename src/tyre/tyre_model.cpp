@@ -41,9 +41,11 @@ struct LeverSums {
 
 LeverSums lever_sums(const Patch& p, int n) {
   LeverSums s;
-  const double dtheta = 2.0 * p.half_angle_rad / n;
   for (int i = 0; i <= n; ++i) {
-    const double theta = -p.half_angle_rad + i * dtheta;
+    // From the element's index, so the centre element (n even, i = n / 2) is at exactly 0: as -theta_max + i dtheta
+    // it came out as +-5e-17 in ~1 % of operating points, its sign was +-1 and a Coulomb force Cc / n appeared there
+    // (RRC jumps of up to 3.6e-4 relative between neighbouring loads; --explain's elasticities off by 0.2; session 20).
+    const double theta = (2.0 * i / n - 1.0) * p.half_angle_rad;
     const double x_abs = std::abs(p.loaded_radius_m * std::tan(theta));
     const double sin_abs = std::abs(std::sin(theta));
     if (sin_abs > 0.0) s.coulomb_m += x_abs;  // sign(0) = 0: the centre element carries no force
@@ -168,9 +170,8 @@ RollingResistance evaluate_rolling_resistance(const TyreState& tyre, double load
 
   // The element sum exactly as the spec writes it, keeping the three moment parts apart.
   double m_coulomb = 0.0, m_viscous = 0.0, f_sum = 0.0;
-  const double dtheta = 2.0 * p.half_angle_rad / n;
   for (int i = 0; i <= n; ++i) {
-    const double theta = -p.half_angle_rad + i * dtheta;
+    const double theta = (2.0 * i / n - 1.0) * p.half_angle_rad;  // the centre exactly 0, as in lever_sums
     const double zdot = -w * r * std::sin(theta);
     const double sgn = (zdot > 0.0) - (zdot < 0.0);
     const double f_visc = -cv * zdot;
