@@ -131,7 +131,16 @@ TyreExplanation explain_tyre(const TyreState& tyre, double load_n, double speed_
     p.name = name;
     p.key = key;
     p.value_si = value;
-    const Responses e = log_slopes(at_scale, h);
+    Responses e;
+    try {
+      e = log_slopes(at_scale, h);
+    } catch (const ModelDomainError& err) {
+      // The point itself was evaluated above; a step of the difference left the domain. Said as such: the message
+      // described the stepped tyre as if it were the user's (session 20).
+      throw ModelDomainError("the elasticity to " + std::string(name) + " steps it by +-" + format_value(100.0 * h) +
+                             " %, and the stepped point leaves the model's domain (the point itself is inside it; move " +
+                             "it away from the edge): " + err.what());
+    }
     p.rrc_elasticity = e.rrc;
     p.power_elasticity = e.power;
     p.deflection_elasticity = e.deflection;

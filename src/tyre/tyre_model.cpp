@@ -98,10 +98,15 @@ void check_operating_point(const TyreState& tyre, double load_n, double speed_mp
   const double kz = vertical_stiffness_n_per_m(tyre);
   if (!(kz > 0.0) || !std::isfinite(kz)) throw ModelDomainError("vertical stiffness " + v(kz) + " N/m: must be > 0");
   const double deflection_m = load_n / kz;
-  const double limit_m = g.outer_radius_m - g.rim_radius_m;
+  // Without a rim the sidewall is unknown, and the outer radius alone let a tyre deflect to its axle (299.8 of
+  // 300 mm at an RRC of 5.5e-5, session 20). A third of the outer radius is beyond any passenger or light-truck
+  // sidewall (aspect ratio 80 on a 13" rim: 0.38 R) and far beyond a working deflection (a tenth of it).
+  const bool rim_known = g.rim_radius_m > 0.0;
+  const double limit_m = rim_known ? g.outer_radius_m - g.rim_radius_m : g.outer_radius_m / 3.0;
   if (!(deflection_m < limit_m)) {
     throw ModelDomainError("load " + v(load_n) + " N deflects the tyre by " + v(deflection_m * 1e3) + " mm, which " +
-                           (g.rim_radius_m > 0.0 ? "reaches the rim (sidewall height " : "exceeds the outer radius (") +
+                           (rim_known ? "reaches the rim (sidewall height "
+                                      : "is over a third of the outer radius, beyond any tyre's sidewall (no rim given; ") +
                            v(limit_m * 1e3) + " mm at stiffness " + v(kz) + " N/m); the model has no solution: " +
                            "load must be below " + v(kz * limit_m) + " N at this pressure");
   }
@@ -121,9 +126,11 @@ void check_rrc_level(double rrc, const TyreState& tyre, double load_n, const std
     constants = "damping constants (coulomb_damping_n " + v(c.coulomb_damping_n) + ", viscous_damping_ns_per_m " +
                 v(c.viscous_damping_ns_per_m) + ", rotational_drag_kg_per_m2 " + v(c.rotational_drag_kg_per_m2) + ")";
   }
+  // The sentence ended at "outside any tyre's" (session 20), and said nothing of the load, which is as often the cause.
   throw ModelDomainError(what + " " + v(rrc) + " at " + v(load_n) + " N and " + v(units::pa_to_bar(tyre.pressure_pa)) +
-                         " bar is beyond " + v(kMaxRrc) + " (no pneumatic tyre loses that much): the model's " +
-                         constants + " are outside any tyre's");
+                         " bar is beyond " + v(kMaxRrc) + " (no pneumatic tyre loses that much): the model extrapolates "
+                         "here; its " + constants + " describe a tyre at its working loads, a few kN, and either the load " +
+                         "is far below that or the constants are outside any tyre's range");
 }
 
 // The loaded-patch figures both models report.
@@ -148,7 +155,7 @@ RollingResistance evaluate_hysteresis(const TyreState& tyre, double load_n, doub
     out.rrc_rotational_drag = k.k2_s2_per_m2 * speed_mps * speed_mps;
   }
   out.rrc = out.rrc_coulomb + out.rrc_viscous + out.rrc_rotational_drag;
-  check_rrc_level(std::max(out.rrc, k.k0), tyre, load_n, "RRC");
+  check_rrc_level(std::max(out.rrc, k.k0), tyre, load_n, "RRC at " + v(units::mps_to_kmh(speed_mps)) + " km/h");
   out.offset_e_m = out.rrc * r;
   out.rr_force_n = out.rrc * load_n;
   out.rr_power_w = out.rr_force_n * speed_mps;
@@ -193,7 +200,7 @@ RollingResistance evaluate_rolling_resistance(const TyreState& tyre, double load
   out.rrc_rotational_drag = m_drag / f_total / r;
   out.rr_force_n = out.rrc * load_n;
   out.rr_power_w = out.rr_force_n * speed_mps;
-  check_rrc_level(out.rrc, tyre, load_n, "RRC");
+  check_rrc_level(out.rrc, tyre, load_n, "RRC at " + v(units::mps_to_kmh(speed_mps)) + " km/h");
   return out;
 }
 
