@@ -166,6 +166,12 @@ TEST(CliTyre, LoadsWithoutSolutionNameTheSourceAndTheLimit) {
   expect_one_error("--outer-radius-m 0.3 --width-m 0.175 --pressure-bar 2.1 --load-n 56900",
                    {"--load-n 56900", "over a third of the outer radius", "no rim given", "load must be below 18"});
   EXPECT_EQ(tyre("--outer-radius-m 0.3 --width-m 0.175 --pressure-bar 2.1 --load-n 6000").exit_code, 0);
+  // A point inside the domain whose elasticity's step leaves it: said as the step's, not as the user's tyre's; and an
+  // RRC beyond 0.1 names its speed and the light load (the sentence was cut off after "any tyre's"; session 20).
+  expect_one_error("175-70R14 --pressure-bar 1 --load-n 13230 --explain",
+                   {"the elasticity to outer diameter steps it by +-0.1 %", "the point itself is inside it"});
+  expect_one_error("185-65R15 --load-n 200 --pressure-bar 1.0 --speed-kmh 180",
+                   {"RRC at 180 km/h 0.1007 at 200 N", "either the load is far below that or the constants are outside any tyre's range"});
 }
 
 TEST(CliTyre, BadSizesAndMissingInputs) {
