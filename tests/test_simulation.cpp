@@ -154,6 +154,23 @@ TEST(Simulation, UnderpoweredCarReportsShortfallAndFinishes) {
   EXPECT_GT(r.distance_m, 5000.0);
 }
 
+// A lock-up gear above the top gear: the converter never locked and slipped all the way (NEDC +11 % fuel), in silence
+// (session 20).
+TEST(Simulation, ALockUpGearAboveTheTopGearIsRefused) {
+  std::ifstream in(shipped("vehicles/camry_2018_map.yaml"));
+  std::string text((std::istreambuf_iterator<char>(in)), {});
+  const auto at = text.find("lockup_min_gear: 2");
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, std::string("lockup_min_gear: 2").size(), "lockup_min_gear: 9");
+  const auto path = temp_file("lockup9.yaml", text);
+  try {
+    load_vehicle_file(path);
+    FAIL() << "accepted lockup_min_gear 9 on an 8-speed";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("lockup_min_gear': 9 is not allowed: must be in [1, 8]"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Simulation, BadVehicleFilesAreRejectedWithTheKey) {
   const std::string good = [] {
     std::ifstream in(shipped("vehicles/ev.yaml"));
@@ -182,6 +199,8 @@ TEST(Simulation, BadVehicleFilesAreRejectedWithTheKey) {
   expect_error("max_torque_nm: 254", "max_torque_nm: .nan", "max_torque_nm");
   expect_error("    ratio: 7.94", "    ratio_: 7.94", "reduction");                // missing required key
   expect_error("type: electric", "type: steam", "powertrain.type");
+  // An axle carrying (almost) nothing: named by the key, not by a tyre file's domain error (session 20).
+  expect_error("front_axle_load_fraction: 0.5", "front_axle_load_fraction: 0.999", "body.front_axle_load_fraction");
   EXPECT_THROW(load_vehicle_file("/no/such/vehicle.yaml"), InputError);
 }
 

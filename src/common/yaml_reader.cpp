@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <limits>
 #include <sstream>
 
 #include "rollsim/common/error.hpp"
@@ -157,20 +158,35 @@ YAML::Node YamlMap::get(const std::string& key, bool required) {
   return n;
 }
 
+namespace {
+// A number as a person writes it in decimal: strtod also reads hexadecimal ("0x10" ran at 16 km/h) and skips leading
+// blanks (" 2.1" was taken, "2.1 " refused; session 20).
+bool plain_decimal(const std::string& text) {
+  if (text.empty() || std::isspace(static_cast<unsigned char>(text.front()))) return false;
+  return text.find_first_of("xX") == std::string::npos;
+}
+}  // namespace
+
 double YamlMap::to_number(const YAML::Node& n, const std::string& key, Range range) const {
-  if (!n.IsScalar()) throw InputError(where(key), "expected a number");
+  if (!n.IsScalar()) throw InputError(where(key), "expected a number; " + range.describe());
   const std::string text = n.Scalar();
   double v = 0.0;
   try {
     std::size_t used = 0;
+    if (!plain_decimal(text)) throw std::invalid_argument(text);
     v = std::stod(text, &used);
     if (used != text.size()) throw std::invalid_argument(text);
   } catch (const std::exception&) {
-    // yaml-cpp spells NaN as .nan; anything else that is not a number is a typo.
+    // yaml-cpp spells NaN and infinity .nan and .inf: the range then says what is allowed. Anything else that is
+    // not a number is a typo.
     if (text == ".nan" || text == ".NaN" || text == ".NAN") {
       v = std::nan("");
+    } else if (text == ".inf" || text == ".Inf" || text == ".INF" || text == "+.inf" || text == "+.Inf" || text == "+.INF") {
+      v = std::numeric_limits<double>::infinity();
+    } else if (text == "-.inf" || text == "-.Inf" || text == "-.INF") {
+      v = -std::numeric_limits<double>::infinity();
     } else {
-      throw InputError(where(key), "'" + text + "' is not a number");
+      throw InputError(where(key), "'" + text + "' is not a number; " + range.describe());
     }
   }
   return checked_number(v, where(key), range);
@@ -332,10 +348,11 @@ std::string resolve_data_file_in(const std::string& name, const std::string& shi
 
 double parse_option_number(const std::string& text, const std::string& option, Range range) {
   char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  if (text.empty() || end != text.c_str() + text.size()) {
+  double v = std::strtod(text.c_str(), &end);
+  if (!plain_decimal(text) || end != text.c_str() + text.size()) {
     throw InputError(option, "'" + text + "' is not a number; " + range.describe());
   }
+  if (v == 0.0) v = 0.0;  // -0 printed "-0.0" speeds and powers
   return checked_number(v, option, range);
 }
 

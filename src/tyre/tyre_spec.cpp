@@ -259,7 +259,8 @@ void check_pressure_plausible(double bar, const std::optional<TyreSize>& size, c
   const std::string of = size ? " ('" + size->designation + "')" : "";
   throw InputError(where, format_value(bar) + " bar is not allowed for " + c.name + of + ": must be in [" + format_value(kMinPlausibleBar) +
                               ", " + format_value(c.max_bar) + "] bar (such tyres run at " + c.usual + ")" +
-                              unit_slip_hint(bar, Range::closed(kMinPlausibleBar, c.max_bar), "bar", {{"MPa", 10.0}, {"psi", kPaPerPsi / 1e5}}));
+                              unit_slip_hint(bar, Range::closed(kMinPlausibleBar, c.max_bar), "bar",
+                                             {{"MPa", 10.0}, {"psi", kPaPerPsi / 1e5}, {"kPa", 0.01}, {"Pa", 1e-5}}));
 }
 
 double iso28580_passenger_pressure_pa(const TyreSize& size) { return size.extra_load ? 250e3 : 210e3; }
@@ -407,7 +408,9 @@ TyreSpec load_tyre(YamlMap y) {
                                        format_value(g.outer_radius_m) + " m: the rim must be inside the tyre");
   }
 
-  const double pressure_bar = y.number("pressure_bar", Range::open_low(0.0, 20.0));
+  // Any positive number reaches the plausibility check, which knows the tyre's class and the units a value may
+  // have been typed in: 210 (kPa) met a bare "(0, 20]" before (session 20).
+  const double pressure_bar = y.number("pressure_bar", Range::positive());
   check_pressure_plausible(pressure_bar, spec.size, y.where("pressure_bar"));
   spec.state.pressure_pa = units::bar_to_pa(pressure_bar);
 

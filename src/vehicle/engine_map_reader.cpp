@@ -97,7 +97,15 @@ TransmissionParams read_transmission(YamlMap m, double max_torque_nm) {
   } else {
     if (m.has("launch_engine_speed_rpm"))
       throw InputError(m.where("launch_engine_speed_rpm"), "only a manual or dual-clutch gearbox launches on a slipping clutch");
-    t.converter = read_converter(m.map("converter"), max_torque_nm);
+    YamlMap converter = m.map("converter");
+    t.converter = read_converter(converter, max_torque_nm);
+    // A lock-up gear above the top gear never locks: the converter slips all the way (NEDC +11 % fuel, accepted in
+    // silence until session 20). A CVT has one "gear".
+    const int top = t.kind == TransmissionKind::cvt ? 1 : static_cast<int>(gears.size());
+    if (t.converter.lockup_min_gear > top)
+      throw InputError(converter.where("lockup_min_gear"), std::to_string(t.converter.lockup_min_gear) +
+                                                              " is not allowed: must be in [1, " + std::to_string(top) +
+                                                              "], the gearbox's gears");
   }
   m.finish();
   return t;

@@ -274,6 +274,12 @@ Vehicle load_vehicle(YamlMap root) {
     t->finish();
   }
   if (v.front_tyre && body.has("wheel_radius_m")) reject_wheel_radius_beside_tyres(v, body.where("wheel_radius_m"));
+  // The tyre model rolls each axle's tyres at their share of the weight: an axle carrying (almost) nothing was refused
+  // by the tyre model, naming a tyre file and not this key (session 20). Real cars put 35-65 % on the front axle.
+  if (v.front_tyre && (v.body.front_axle_load_fraction < 0.1 || v.body.front_axle_load_fraction > 0.9))
+    throw InputError(body.where("front_axle_load_fraction"),
+                     format_value(v.body.front_axle_load_fraction) + " is not allowed with tyres: must be in [0.1, 0.9] (each "
+                     "axle's tyres roll under their share of the weight; 0 and 1 are for a coast-down car)");
   if (auto c = root.optional_map("coastdown")) v.coastdown = read_coastdown(*c);
   if (!v.front_tyre && !v.coastdown)
     throw InputError(root.where("tyres"), "a vehicle needs tyres (tyres: {all: FILE}) or coastdown coefficients");
