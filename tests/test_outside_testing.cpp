@@ -889,6 +889,9 @@ TEST_F(OutsideTesting, TheChannelLagSaysWhatItIsNot) {
   ASSERT_EQ(soc.exit_code, 0) << soc.err;
   EXPECT_TRUE(has(soc.out, "channel lag: not estimated (a state of charge integrates the power")) << soc.out;
   EXPECT_TRUE(has(slurp((dir_ / "soc.json").string()), "\"estimated\": false"));
+  // A state of charge is located by window, and its counts say so (they said "samples"; session 20).
+  EXPECT_TRUE(has(soc.out, " windows)\n")) << soc.out;
+  EXPECT_FALSE(has(soc.out, " samples)\n")) << soc.out;
   // The hot UDDS with its fuel one sample ahead of the speed.
   std::vector<std::vector<std::string>> rows;
   const std::string text = camry_edited([&rows](int, std::vector<std::string>& f) { rows.push_back(f); });

@@ -200,7 +200,9 @@ std::string diagnosis_text(const Diagnosis& d) {
   os << "located (measured - calibrated model, mean power, 95 %):\n";
   os.precision(0);
   for (const auto& l : d.located)
-    os << "  " << l.regime << ": " << l.mean_w << " W [" << l.ci_low_w << ", " << l.ci_high_w << "] (" << l.samples << " samples)\n";
+    // A state of charge gives energy per window, so it is located by window (session 20: "samples" there).
+    os << "  " << l.regime << ": " << l.mean_w << " W [" << l.ci_low_w << ", " << l.ci_high_w << "] (" << l.samples
+       << (d.channel == "soc" ? " windows)\n" : " samples)\n");
   return os.str();
 }
 

@@ -119,7 +119,8 @@ std::vector<Figure> regime_figures(const Diagnosis& d, const fs::path& work) {
          << "set arrow from 0, graph 0 to 0, graph 1 nohead lc 'black'\n"
          << "plot " << dat << " u ($5 > 0 ? $2 : 1/0):1:3:4 w xerrorbars pt 7 ps 1 lw 2 lc rgb '#b03a2e' t 'interval excludes 0', "
          << dat << " u ($5 > 0 ? 1/0 : $2):1:3:4 w xerrorbars pt 6 ps 1 lw 2 lc rgb '#666666' t 'interval includes 0'\n";
-  return {{"regimes.svg", "Residual by driving regime (samples in brackets): mean and 95 % interval", script.str(), 120 + 34 * n}};
+  return {{"regimes.svg", std::string("Residual by driving regime (") + (d.channel == "soc" ? "windows" : "samples") +
+                              " in brackets): mean and 95 % interval", script.str(), 120 + 34 * n}};
 }
 
 // Each road_profile finding's recovered elevation along distance, with its 95 % band where the finding has one.
