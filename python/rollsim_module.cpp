@@ -250,6 +250,7 @@ py::dict api_simulate(py::object vehicle, py::object tyre, py::object cycle, py:
     run = run_vehicle(base, tyre_set, c, replay, opt);
   }
   for (const auto& w : run.warnings) warn(w);
+  for (const auto& c : report::run_caveats(run.result)) warn(c);  // as the command line's text and --json say them
   py::dict out;
   out["summary"] = from_json(report::to_json(run.result, run.tyre_label).str());
   py::dict columns;

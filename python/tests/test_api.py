@@ -476,6 +476,22 @@ class Session20Inputs(unittest.TestCase):
             self.assertEqual(code, 2, err)
             self.assertFalse((Path(tmp) / "missing").exists())
 
+    def test_a_battery_run_empty_is_warned_in_python_and_in_json(self):
+        # The text said so; the JSON and the module returned a negative state of charge without a word.
+        import yaml
+        with open(REPO / "vehicles" / "ev.yaml") as f:
+            ev = yaml.safe_load(f)
+        ev["powertrain"]["battery"]["initial_soc_pct"] = 0
+        with self.assertWarnsRegex(UserWarning, "the usable battery ran empty after 0.000 km"):
+            summary = rollsim.simulate(vehicle=ev, trace=False)["summary"]
+        self.assertTrue(summary["battery_empty"])
+        with tempfile.TemporaryDirectory() as tmp:
+            path = Path(tmp) / "ev0.yaml"
+            path.write_text(yaml.safe_dump(ev))  # its tyre, nominal.yaml, is not beside it: the shipped one
+            _, err, code = cli("simulate", "--vehicle", str(path), "--json")
+            self.assertEqual(code, 0, err)
+            self.assertIn("warning: nedc, nominal: the usable battery ran empty after 0.000 km", err)
+
     def test_a_cycle_without_a_vehicle_is_refused_as_on_the_command_line(self):
         # sweep and sensitivity computed the tyre alone and dropped the cycle in silence.
         _, err, code = cli("sweep", "--tyre", "175-70R14", "--param", "pressure", "--from", "1.5", "--to", "3.5",

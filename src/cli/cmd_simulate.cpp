@@ -79,6 +79,11 @@ void run_simulate(const SimulateOptions& o) {
   }
   if (o.json) {
     for (const auto& run : runs) std::cout << report::to_json(run.result, run.tyre_label).str() << "\n";
+    // The text's warnings (a battery run empty, a trace not followed) go where warnings go: the JSON alone gave a
+    // negative state of charge without a word (session 20).
+    for (const auto& run : runs)
+      for (const auto& c : report::run_caveats(run.result))
+        std::cerr << "warning: " << run.result.cycle << ", " << run.tyre_label << ": " << c << "\n";
     return;
   }
   if (runs.size() == 1) {

@@ -136,12 +136,14 @@ ElectricPowertrainParams read_electric(YamlMap& pt, std::vector<std::string>& wa
     for_road_vehicle(m, "usable_capacity_kwh", capacity_kwh, Range::closed(0.1, 1e4), "kWh",
                      "below any traction battery (a hybrid car's holds 0.5-2 kWh, a light quadricycle's 6)", {{"MWh", 1e3}});
     p.battery.usable_capacity_j = units::kwh_to_j(capacity_kwh);
-    p.battery.initial_soc = m.number_or("initial_soc_pct", 100.0, Range::closed(0.0, 100.0)) / 100.0;
-    // A start below 1 % is possible (a drive to empty) but is far more often a fraction typed for a percentage.
-    if (p.battery.initial_soc > 0.0 && p.battery.initial_soc <= 0.01)
-      warnings.push_back(m.where("initial_soc_pct") + ": " + format_value(100.0 * p.battery.initial_soc) +
-                         " % is a battery all but empty at the start; is it a fraction? (" +
-                         format_value(100.0 * p.battery.initial_soc) + " = " + format_value(1e4 * p.battery.initial_soc) + " %)");
+    const double initial_pct = m.number_or("initial_soc_pct", 100.0, Range::closed(0.0, 100.0));
+    p.battery.initial_soc = initial_pct / 100.0;
+    // A start below 1 % is possible (a drive to empty) but is far more often a fraction typed for a percentage. (The
+    // figures are the value as given: 0.9 printed as 0.9000000000000001 through the fraction.)
+    if (initial_pct > 0.0 && initial_pct <= 1.0)
+      warnings.push_back(m.where("initial_soc_pct") + ": " + format_value(initial_pct) +
+                         " % is a battery all but empty at the start; is it a fraction? (" + format_value(initial_pct) +
+                         " = " + format_value(100.0 * initial_pct) + " %)");
     m.finish();
   }
   {
