@@ -4,7 +4,6 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
-#include <limits>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -378,16 +377,14 @@ py::dict api_engine_map(py::object engine, py::object speed_rpm, py::object torq
   const auto block = arg_as<py::dict>(engine, "engine", "a dict with the powertrain.engine block's keys");
   const EngineMap map(read_engine_block(YamlMap::load_text(dict_json(block, "engine dict"), "engine dict")));
   const Range rpm_range = Range::closed(0.0, 3e4), torque_range = Range::closed(0.0, 1e5);
-  // Beyond full load the map has no operating point: NaN there (a grid over a map's plane is masked as numpy masks),
-  // and a warning; a fuel figure was returned there without a word (session 20).
+  // Beyond full load the engine has no operating point; the map's formula still gives a figure there, which a fit to
+  // a published map's top rows uses (scripts/fit_engine_map.py). It was returned without a word (session 20): now
+  // with a warning counting such points.
   std::size_t beyond_full_load = 0;
   auto fuel = py::vectorize([&](double rpm, double torque) {
     const double w = checked_number(rpm, "speed_rpm", rpm_range) * units::kRadpsPerRpm;
     const double t = checked_number(torque, "torque_nm", torque_range);
-    if (t > map.max_torque_nm(w) * (1.0 + 1e-12)) {
-      ++beyond_full_load;
-      return std::numeric_limits<double>::quiet_NaN();
-    }
+    if (t > map.max_torque_nm(w) * (1.0 + 1e-12)) ++beyond_full_load;
     return map.fuel_power_w(w, t);
   });
   auto full_load = py::vectorize([&](double rpm) {
@@ -400,7 +397,8 @@ py::dict api_engine_map(py::object engine, py::object speed_rpm, py::object torq
   out["fuel_power_w"] = fuel(speeds, torques);
   out["max_torque_nm"] = full_load(speeds);
   if (beyond_full_load > 0)
-    warn(std::to_string(beyond_full_load) + " point(s) beyond the engine's full-load torque (max_torque_nm): fuel_power_w is NaN there");
+    warn(std::to_string(beyond_full_load) + " point(s) beyond the engine's full-load torque (max_torque_nm): no operating "
+         "point there; fuel_power_w is the map's formula extrapolated");
   return out;
 }
 
@@ -624,7 +622,7 @@ calibration explains nothing (README, "Validation").)");
 
 engine: a dict with that block's keys (displacement_l, gross_indicated_efficiency, friction_mep_bar, ...), read by
 the vehicle file's own reader (same defaults, bounds and errors). speed_rpm [rpm] and torque_nm [N m, brake, >= 0]:
-numbers or arrays (broadcast); beyond the full-load torque fuel_power_w is NaN, with a warning. Returns {'fuel_power_w': fuel power [W] at the fuel's lower heating value (at or
+numbers or arrays (broadcast); beyond the full-load torque fuel_power_w is the formula extrapolated, with a warning. Returns {'fuel_power_w': fuel power [W] at the fuel's lower heating value (at or
 below idle speed the idle controller's torque reserve is burnt too), 'max_torque_nm': full-load torque [N m] at
 speed_rpm}.)");
 
