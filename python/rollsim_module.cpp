@@ -574,9 +574,10 @@ could not follow the cycle on that tyre: its figure is then for a slower drive.)
 
 tyre: file, shipped name or dict. axes: [(param, from, to[, steps])], param one of pressure [bar], diameter [mm],
 width [mm], load [N], load-pct [%], speed [km/h]; steps default 11. load_n [N] (default 80 % of the maximum
-load), speed_kmh [km/h]. With vehicle (and cycle, default 'nedc'; a cycle without a vehicle is an error) each point is a forward simulation of the car (on `threads`
-threads, default every core). Returns a list of dicts, one per point: the swept values (pressure_bar,
-diameter_mm, width_mm, load_n, load_pct, speed_kmh), the load_n and speed_kmh evaluated at when not swept, rrc,
+load), speed_kmh [km/h]. With vehicle (and cycle, default 'nedc'; a cycle without a vehicle is an error) each
+point is a forward simulation of the car (on `threads` threads, default every core). Returns a list of dicts, one
+per point: the swept values (pressure_bar, diameter_mm, width_mm, load_n, load_pct, speed_kmh), the load_n and
+speed_kmh evaluated at when not swept, rrc,
 rr_force_n, rr_power_w, deflection_m, and the car's kwh_per_10km or l_per_100km with followed_trace (False, and a
 warning, where the car could not follow the cycle). A range leaving the
 model's domain stops with a warning and returns the valid points.)");
@@ -600,8 +601,9 @@ as the command line.)");
         R"(Elasticities of a tyre's RR power and RRC, and with a car of its energy or fuel (`rollsim sensitivity --json`).
 
 tyre: file, shipped name or dict (default: the car's own); vehicle: file, shipped name or dict (its energy
-elasticities on cycle, default 'nedc', by forward simulation; a cycle without a vehicle is an error); load_n [N] (default: the car's heaviest wheel load, else 80 % of
-the tyre's maximum load) and speed_kmh [km/h]: the tyre's operating point. Returns one dict: elasticity_rr_power_<key>
+elasticities on cycle, default 'nedc', by forward simulation; a cycle without a vehicle is an error); load_n [N]
+(default: the car's heaviest wheel load, else 80 % of the tyre's maximum load) and speed_kmh [km/h]: the tyre's
+operating point. Returns one dict: elasticity_rr_power_<key>
 and, with a car, elasticity_<kwh_per_10km or l_per_100km>_<key> for outer_diameter, section_width, pressure and
 load (% per %), the dominant parameters, and the car's figure with followed_trace.)");
 
@@ -622,9 +624,9 @@ calibration explains nothing (README, "Validation").)");
 
 engine: a dict with that block's keys (displacement_l, gross_indicated_efficiency, friction_mep_bar, ...), read by
 the vehicle file's own reader (same defaults, bounds and errors). speed_rpm [rpm] and torque_nm [N m, brake, >= 0]:
-numbers or arrays (broadcast); beyond the full-load torque fuel_power_w is the formula extrapolated, with a warning. Returns {'fuel_power_w': fuel power [W] at the fuel's lower heating value (at or
-below idle speed the idle controller's torque reserve is burnt too), 'max_torque_nm': full-load torque [N m] at
-speed_rpm}.)");
+numbers or arrays (broadcast); beyond the full-load torque fuel_power_w is the formula extrapolated, with a
+warning. Returns {'fuel_power_w': fuel power [W] at the fuel's lower heating value (at or below idle speed the idle
+controller's torque reserve is burnt too), 'max_torque_nm': full-load torque [N m] at speed_rpm}.)");
 
   m.def("diagnose", &api_diagnose, "vehicle"_a, "recordings"_a, "columns"_a = py::dict(), "scales"_a = py::dict(),
         "preset"_a = "", "tyre"_a = py::none(),
