@@ -158,9 +158,18 @@ TEST(CliSelection, SweepStepsPerParamAndNoValidPointWritesNothing) {
     EXPECT_EQ(zero.exit_code, 2);
     EXPECT_TRUE(has(zero.err, "--base100: the first point's RRC is 0 (at 0 km/h)")) << zero.err;
     EXPECT_FALSE(has(zero.err, "gnuplot")) << zero.err;
+    // On a grid the line at 0 km/h is named by its speed (it said "at 1.5 bar").
+    const CmdResult grid = run("sweep --tyre 175-70R14 --param pressure --from 1.5 --to 3.5 --steps 3 --param speed --from 0 "
+                               "--to 100 --steps 3 --base100 --plot '" + (dir / "g.svg").string() + "'");
+    EXPECT_EQ(grid.exit_code, 2);
+    EXPECT_TRUE(has(grid.err, "(at 1.5 bar, speed 0 km/h)")) << grid.err;
   }
   EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator{}), 0);
   fs::remove_all(dir);
+  // A pressure range typed in kPa gets its hint, as --pressure-bar does.
+  const CmdResult kpa = run("sweep --tyre 175-70R14 --param pressure --from 150 --to 300");
+  EXPECT_EQ(kpa.exit_code, 2);
+  EXPECT_TRUE(has(kpa.err, "is it in kPa? (300 kPa = 3 bar)")) << kpa.err;
 }
 
 TEST(CliSelection, VehicleSweepWritesEnergyPerPoint) {

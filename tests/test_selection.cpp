@@ -186,6 +186,10 @@ TEST(SelectionCompare, AnOwnTyreThatDoesNotFitIsTheReferenceButNotRanked) {
   EXPECT_TRUE(has(c.unfit[0].fit.reason, "capacity")) << c.unfit[0].fit.reason;
   EXPECT_DOUBLE_EQ(c.unfit[0].diff_pct, 0.0);
   EXPECT_NEAR(c.ranked[0].diff_pct, (c.ranked[0].value / c.own_value - 1.0) * 100.0, 1e-12);
+  // The wheel load the table's header names is the car's, whether or not any tyre fits (it read the ranked front's,
+  // and 0 N when none fitted).
+  EXPECT_DOUBLE_EQ(c.wheel_load_n, c.unfit[0].fit.wheel_load_n);
+  EXPECT_GT(c.wheel_load_n, 3900.0);
 }
 
 // A light-truck size's load index is rated at its load range's pressure, which its designation does not give: at a

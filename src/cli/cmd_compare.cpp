@@ -34,7 +34,7 @@ void print_table(const selection::Comparison& c, bool replay) {
   const std::string unit = selection::energy_unit_label(c.unit);
   std::cout << c.vehicle << " on " << c.cycle << ": tyres ranked by " << (c.shows_range ? "battery energy" : "fuel")
             << " (" << selection::run_mode_label(replay) << ", tyre on all four wheels; RRC and RR power at 80 km/h and "
-            << fixed(c.ranked.empty() ? 0.0 : c.ranked.front().fit.wheel_load_n, 0) << " N per wheel)\n";
+            << fixed(c.wheel_load_n, 0) << " N per wheel)\n";  // the ranked front's said 0 N when none fit
   std::vector<std::string> h{"#", "tyre", "size", "p [bar]", "RRC x1000", "P_RR [W]", unit, "vs own [%]"};
   if (c.shows_range) h.push_back("range chg [km]");
   h.push_back("fit");

@@ -72,8 +72,12 @@ std::string render_plot(const selection::SweepResult& r, const std::string& tyre
   for (const auto& [key, pts] : series) {
     // An RRC of 0 (at 0 km/h) as the base: gnuplot's own "all points y value undefined" reached the user (session 20).
     if (base100 && !(pts.front().second > 0.0)) {
+      // On a grid the line's own value names it (the 0 km/h line of a pressure x speed grid said "at 1.5 bar").
+      const std::string line = r.axes.size() > 1 ? ", " + selection::sweep_param_key(r.axes[1].param) + " " + format_value(key) +
+                                                       " " + display_unit(r.axes[1].param)
+                                                 : std::string();
       throw InputError("--base100", "the first point's RRC is " + format_value(pts.front().second) + " (at " +
-                                        format_value(pts.front().first) + " " + display_unit(r.axes[0].param) +
+                                        format_value(pts.front().first) + " " + display_unit(r.axes[0].param) + line +
                                         "): there is no base to divide by; start the range elsewhere");
     }
   }

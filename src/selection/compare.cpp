@@ -126,6 +126,7 @@ Comparison compare_tyres(const Vehicle& vehicle, const std::vector<TyreSpec>& ca
   // Case 0 is the car's own tyre, case k the k-th candidate.
   const VehicleModel base = VehicleModel::assemble(vehicle);
   const double wheel_load_n = check_fit(vehicle, own, own, o.diameter_tolerance_pct).wheel_load_n;
+  cmp.wheel_load_n = wheel_load_n;
   auto tyre_of = [&](std::size_t k) -> const TyreSpec& { return k == 0 ? own : candidates[k - 1]; };
   const auto results = map_cases(
       o.map_cases, candidates.size() + 1, o.threads,

@@ -11,6 +11,7 @@
 #include "rollsim/common/error.hpp"
 #include "rollsim/common/parallel.hpp"
 #include "rollsim/common/units.hpp"
+#include "rollsim/common/yaml_reader.hpp"
 #include "rollsim/report/simulation_report.hpp"
 #include "rollsim/report/table.hpp"
 #include "rollsim/selection/common.hpp"
@@ -96,7 +97,10 @@ void check_axis(const SweepAxis& a, const std::string& option) {
   if (a.to > most) {
     throw InputError(option, "--to " + format_value(a.to) + " " + sweep_param_unit(a.param) + " is not allowed: " +
                                  sweep_param_key(a.param) + " must be <= " + format_value(most) + " (as a tyre file or "
-                                 "rollsim tyre takes it)");
+                                 "rollsim tyre takes it)" +
+                                 (a.param == SweepParam::Pressure  // 150-300 typed in kPa (session 20)
+                                      ? unit_slip_hint(a.to, Range::closed(1.0, 10.0), "bar", {{"kPa", 0.01}, {"psi", 6894.757e-5}})
+                                      : std::string()));
   }
 }
 

@@ -57,6 +57,7 @@ struct Comparison {
   std::string unit;
   double own_value = 0.0;
   double own_range_km = 0.0;
+  double wheel_load_n = 0.0;  ///< the heavier axle's static wheel load, at which RRC and RR power are given
   std::vector<CandidateResult> ranked;
   std::vector<CandidateResult> unfit;
 };
