@@ -417,6 +417,7 @@ TEST(Simulation, AKickDownNeverTakesTheEnginePastItsTopSpeed) {
 TEST(Simulation, ATracedReplayGivesEachRampsEndAtItsOwnAcceleration) {
   SimulationOptions traced;
   traced.record_trace = true;
+  traced.record_segment_ends = true;
   for (const char* vehicle : {"vehicles/ev.yaml", "vehicles/ice.yaml"}) {
     SCOPED_TRACE(vehicle);
     const auto m = model_of(vehicle);
@@ -431,6 +432,11 @@ TEST(Simulation, ATracedReplayGivesEachRampsEndAtItsOwnAcceleration) {
     else EXPECT_GT(r.trace[2].end_fuel_rate_m3_per_s, r.trace[3].fuel_rate_m3_per_s);
     EXPECT_EQ(r.trace[3].end_battery_power_w, r.trace[3].battery_power_w);  // a cruise
     EXPECT_EQ(r.trace[3].end_fuel_rate_m3_per_s, r.trace[3].fuel_rate_m3_per_s);
+    // Not asked for, the ends are the point values: no extra evaluation.
+    SimulationOptions plain;
+    plain.record_trace = true;
+    const auto q = simulate_replay(m, points_only({{0.0, 0.0}, {1.0, 10.0}, {2.0, 20.0}}), plain);
+    EXPECT_EQ(q.trace[0].end_battery_power_w, q.trace[0].battery_power_w);
   }
 }
 

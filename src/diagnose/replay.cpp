@@ -72,6 +72,7 @@ void for_each_replay(const Replayer& rp, const EffectList& extra, Use use) {
   if (const FuelParams* f = rp.vehicle.fuel()) reading.fuel_j_per_m3 = f->energy_j_per_m3();
   SimulationOptions so;
   so.record_trace = true;
+  so.record_segment_ends = rp.point_values;  // an instant's channel needs them (one more evaluation per ramp)
   for (std::size_t ci = 0; ci < rp.cycles.size(); ++ci) {
     const bool own = ci < rp.per_recording.size() && rp.per_recording[ci];
     if (own) model.effects.push_back(rp.per_recording[ci]);

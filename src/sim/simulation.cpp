@@ -996,7 +996,7 @@ SimulationResult simulate_replay(const VehicleModel& m, const DriveCycle& c, con
       p.segment_battery_power_w = seg(kTerminal);
       p.segment_battery_loss_w = seg(kBatteryLoss);
       p.segment_fuel_rate_m3_per_s = seg(kFuelVolume);
-      if (a != 0.0) {
+      if (opt.record_segment_ends && a != 0.0) {
         // The ramp's end at its own acceleration (a cruise's end is its start). Scratch evaluation: the gear
         // schedule is restored, and the rates it overwrites were booked above.
         const int scheduled = scheduled_gear, g = gear;

@@ -49,6 +49,9 @@ struct SimulationOptions {
   double driver_kp_per_s = 0.5;        ///< proportional gain [1/s]
   double driver_ki_per_s2 = 0.1;       ///< integral gain [1/s^2]
   bool record_trace = false;           ///< one row per cycle sample
+  /// Replay with a trace: each ramp's end at its own acceleration too (TracePoint::end_*), one more evaluation per
+  /// ramp; otherwise the ends are the point values. The diagnosis asks for them once it reads a channel as instants.
+  bool record_segment_ends = false;
   /// A shortfall is reported where the car falls behind the trace by more than this (the regulation's
   /// speed tolerance is 2 km/h).
   double shortfall_threshold_mps = units::kmh_to_mps(2.0);
