@@ -30,7 +30,9 @@ double window_s_of(const std::string& text) { return parse_option_number(text, "
 
 void run_diagnose(const DiagnoseCliOptions& o) {
   const std::string vehicle_path = resolve_data_file(o.vehicle, "vehicles", ".yaml", "--vehicle");
-  Vehicle v = load_vehicle_file(vehicle_path);
+  // Read once: the car, and (below) the logger mapping and calibration bounds the same file holds.
+  YamlMap vehicle_file = YamlMap::load_file(vehicle_path);
+  Vehicle v = load_vehicle(vehicle_file);
   const std::string tyre_path = o.tyre.empty() ? "" : resolve_data_file(o.tyre, "tyres", ".yaml", "--tyre");
   if (!o.tyre.empty()) fit_tyres(v, load_tyre_file(tyre_path));
   // Every destination is checked before the diagnosis, and all are written together after it.
@@ -42,7 +44,6 @@ void run_diagnose(const DiagnoseCliOptions& o) {
   if (!o.json.empty()) check_output_file(o.json, "--json", inputs);
   if (!o.write_vehicle.empty()) check_output_file(o.write_vehicle, "--write-vehicle", inputs);
   // Column mapping: a preset, then the vehicle file's own logger mapping, then the command line's options.
-  YamlMap vehicle_file = YamlMap::load_file(vehicle_path);
   if (!o.write_vehicle.empty()) check_no_effects_block(vehicle_file, vehicle_path);
   ColumnMapping mapping = assemble_mapping(o.preset, vehicle_file, o.columns, o.scales);
   mapping.how_to_map = "with --column CANONICAL=SOURCE";

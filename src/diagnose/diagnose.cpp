@@ -148,11 +148,9 @@ void choose_channel_sampling(diag::Replayer& rp, const diag::Observations& o, di
   // Chosen instants are then read within their segments: a fractional lag puts an instant between a segment's start
   // and its end at its own acceleration, not between two samples' point values (session 20's outside check: a 1 Hz
   // instantaneous logger with a 0.3-0.9 s lag had its lag read as whole samples and effects named on 13 of 20 nulls).
-  // The ends are replayed only now that they are needed.
-  diag::ChannelPowers instants = rp.both_samplings({});
-  lag = diag::estimate_lag(instants.instantaneous, o, &instants.instantaneous_end);
-  base.power_w = std::move(instants.instantaneous);
-  base.end_w = std::move(instants.instantaneous_end);
+  // The ends are replayed only now that they are needed (point_values set: the replay records them).
+  rp.sample({}, base);
+  lag = diag::estimate_lag(base.power_w, o, &base.end_w);
 }
 
 void report_calibration(const diag::Calibration& c, const diag::Observations& o, const diag::LagEstimate& lag, Diagnosis& out) {

@@ -91,12 +91,12 @@ FleetManifest read_fleet_manifest(const std::string& path) {
 namespace {
 
 FleetEntry diagnose_group(const FleetGroup& g, const DiagnoseOptions& o) {
-  Vehicle v = load_vehicle_file(g.vehicle_path);
+  YamlMap vehicle_file = YamlMap::load_file(g.vehicle_path);
+  Vehicle v = load_vehicle(vehicle_file);
   if (!g.tyre_path.empty()) fit_tyres(v, load_tyre_file(g.tyre_path));
   std::vector<Recording> recs;
   for (const auto& r : g.recordings) recs.push_back(load_recording(r.path, r.mapping));
   DiagnoseOptions group_options = o;
-  YamlMap vehicle_file = YamlMap::load_file(g.vehicle_path);
   group_options.priors = calibration_priors_from_yaml(vehicle_file);  // each car's own calibration bounds
   const Diagnosis d = diagnose(v, recs, group_options);
   FleetEntry e{g.name, v.name, d.verdict, d.channel, recs.size(), {}};

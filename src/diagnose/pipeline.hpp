@@ -64,7 +64,7 @@ inline bool headings_known(const std::vector<DriveCycle>& cycles) {
 
 /// The simulated channel per recording and sample, read both ways a logger may sample it.
 struct ChannelPowers {
-  std::vector<std::vector<double>> interval_mean, instantaneous, instantaneous_end;
+  std::vector<std::vector<double>> interval_mean, instantaneous;
 };
 
 /// Replays model variants (the base model plus extra effects) on the recordings' traces, in parallel.

@@ -99,15 +99,13 @@ void Replayer::sample(const EffectList& extra, Variant& out) const {
 ChannelPowers Replayer::both_samplings(const EffectList& extra) const {
   ChannelPowers out;
   for_each_replay(*this, extra, [&](const std::vector<TracePoint>& trace, const ChannelReading& c) {
-    std::vector<double> mean(trace.size()), point(trace.size()), end(trace.size());
+    std::vector<double> mean(trace.size()), point(trace.size());
     for (std::size_t i = 0; i < trace.size(); ++i) {
       mean[i] = sim_power_w(trace[i], c.electric, c.fuel_j_per_m3, c.cells, false);
       point[i] = sim_power_w(trace[i], c.electric, c.fuel_j_per_m3, c.cells, true);
-      end[i] = sim_end_power_w(trace[i], c.electric, c.fuel_j_per_m3, c.cells);
     }
     out.interval_mean.push_back(std::move(mean));
     out.instantaneous.push_back(std::move(point));
-    out.instantaneous_end.push_back(std::move(end));
   });
   return out;
 }
