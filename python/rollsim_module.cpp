@@ -42,9 +42,25 @@ void warn(const std::string& text) {
   if (PyErr_WarnEx(PyExc_UserWarning, text.c_str(), 1) != 0) throw py::error_already_set();
 }
 
+// A path-like object (pathlib.Path, os.DirEntry) as the str os.fspath gives; anything else as it is. A script builds
+// its paths with pathlib, and a Path was refused as "expected ... (str)".
+py::object fspath_or_self(py::handle x) {
+  if (py::isinstance<py::str>(x) || !py::hasattr(x, "__fspath__")) return py::reinterpret_borrow<py::object>(x);
+  return py::module_::import("os").attr("fspath")(x);
+}
+
 // A keyword argument as T, or the named error a command-line user would get for a malformed option.
 template <class T>
-T arg_as(py::handle x, const std::string& where, const std::string& expected) {
+T arg_as(py::handle arg, const std::string& where, const std::string& expected) {
+  py::object x = py::reinterpret_borrow<py::object>(arg);
+  if constexpr (std::is_same_v<T, std::string>) x = fspath_or_self(arg);
+  if constexpr (std::is_same_v<T, std::vector<std::string>>) {
+    if (py::isinstance<py::list>(arg) || py::isinstance<py::tuple>(arg)) {
+      py::list paths;
+      for (py::handle item : arg) paths.append(fspath_or_self(item));
+      x = paths;
+    }
+  }
   // A Python type wrapper's cast converts (py::dict from a list of pairs, or from "camry" with a ValueError): check.
   if constexpr (std::is_base_of_v<py::object, T>) {
     if (!py::isinstance<T>(x)) throw InputError(where, "expected " + expected);
@@ -158,7 +174,8 @@ std::optional<TyreSpec> tyre_from(py::handle t) {
 // file's checks, their errors naming the sample index as the "line".
 DriveCycle cycle_arrays(py::handle c);
 DriveCycle cycle_from(py::handle c) {
-  const DriveCycle cycle = py::isinstance<py::str>(c) ? load_cycle(c.cast<std::string>(), "--cycle") : cycle_arrays(c);
+  const py::object path = fspath_or_self(c);
+  const DriveCycle cycle = py::isinstance<py::str>(path) ? load_cycle(path.cast<std::string>(), "--cycle") : cycle_arrays(c);
   // What the trace holds that a user should hear of, as warnings, as the CLI's load_cycle_noted says it on stderr.
   if (const std::string note = ignored_columns_note(cycle); !note.empty()) warn(note);
   for (const auto& n : cycle.notes) warn(n);

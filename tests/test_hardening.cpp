@@ -278,5 +278,27 @@ TEST_F(Hardening, NoOutputIsLeftBehindWhenAnotherFails) {
   for (const auto& e : fs::directory_iterator(dir_)) EXPECT_FALSE(has(e.path().filename().string(), ".tmp")) << e.path();
 }
 
+// A YAML boolean as any YAML reader takes it: True and TRUE were "not allowed: must be true or false" (session 21).
+TEST_F(Hardening, YamlBooleansAreReadInEverySpellingYamlHas) {
+  const std::string base = shipped("vehicles/camry_2018_map.yaml");
+  const std::string key = "neutral_at_standstill: true";
+  ASSERT_TRUE(has(base, key));
+  auto with = [&](const std::string& value) {
+    std::string text = base;
+    text.replace(text.find(key), key.size(), "neutral_at_standstill: " + value);
+    return run_rollsim("simulate --vehicle '" + write("car.yaml", text) + "' --cycle udds --replay --json");
+  };
+  const CmdResult lower = with("true"), off = with("false");
+  ASSERT_EQ(lower.exit_code, 0) << lower.err;
+  ASSERT_EQ(off.exit_code, 0) << off.err;
+  EXPECT_NE(lower.out, off.out);  // the key matters on the UDDS's stops
+  for (const std::string v : {"True", "TRUE", "yes", "On"}) EXPECT_EQ(with(v).out, lower.out) << v;
+  for (const std::string v : {"False", "FALSE", "no", "Off"}) EXPECT_EQ(with(v).out, off.out) << v;
+  const CmdResult bad = with("tRuE");
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_TRUE(has(bad.err, "neutral_at_standstill")) << bad.err;
+  EXPECT_TRUE(has(bad.err, "'tRuE' is not allowed")) << bad.err;
+}
+
 }  // namespace
 }  // namespace rollsim::test

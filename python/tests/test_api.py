@@ -506,5 +506,27 @@ class Session20Inputs(unittest.TestCase):
         self.assertEqual(rollsim.sensitivity(vehicle="ev"), rollsim.sensitivity(vehicle="ev", cycle="nedc"))
 
 
+class Session21Inputs(unittest.TestCase):
+    """Session 21; each failed on the module of the session's start."""
+
+    def test_a_path_object_is_taken_where_a_path_is(self):
+        # A pathlib.Path was refused as "expected a shipped name or a file path (str)".
+        repo = Path(__file__).resolve().parents[2]
+        by_path = rollsim.simulate(vehicle=repo / "vehicles" / "ev.yaml", cycle=repo / "cycles" / "udds.csv")
+        by_str = rollsim.simulate(vehicle=str(repo / "vehicles" / "ev.yaml"), cycle=str(repo / "cycles" / "udds.csv"))
+        self.assertEqual(by_path["summary"], by_str["summary"])
+        np.testing.assert_array_equal(by_path["trace"]["speed_kmh"], by_str["trace"]["speed_kmh"])
+        rec = SHARED / "data" / "recordings" / "rsk_renault_twizy" / "T1_07_01_2021.csv"
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            self.assertEqual(rollsim.diagnose(vehicle="twizy", recordings=[rec], preset="rsk_twizy"),
+                             rollsim.diagnose(vehicle="twizy", recordings=[str(rec)], preset="rsk_twizy"))
+        with tempfile.TemporaryDirectory() as d:
+            rollsim.tyre_fit("205/55 R16 91V", label="B", output=Path(d) / "t.yaml")
+            self.assertTrue((Path(d) / "t.yaml").exists())
+            self.assertEqual(rollsim.tyre(Path(d) / "t.yaml"), rollsim.tyre(str(Path(d) / "t.yaml")))
+        with self.assertRaisesRegex(rollsim.InputError, "vehicle.*expected a shipped name or a file path"):
+            rollsim.simulate(vehicle=3.5)
+
 if __name__ == "__main__":
     unittest.main()

@@ -227,8 +227,16 @@ bool YamlMap::boolean_or(const std::string& key, bool fallback) {
   YAML::Node n = get(key, false);
   if (!has(key)) return fallback;
   const std::string s = n.IsScalar() ? n.Scalar() : "";
-  if (s == "true" || s == "yes" || s == "on") return true;
-  if (s == "false" || s == "no" || s == "off") return false;
+  // YAML's spellings: lower case, capitalised or upper case (True and TRUE were refused, though any YAML reader,
+  // yaml-cpp's own included, takes them).
+  const auto spelt = [&s](const std::string& word) {
+    std::string capitalised = word, upper = word;
+    capitalised[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(word[0])));
+    for (char& ch : upper) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
+    return s == word || s == capitalised || s == upper;
+  };
+  if (spelt("true") || spelt("yes") || spelt("on")) return true;
+  if (spelt("false") || spelt("no") || spelt("off")) return false;
   throw InputError(where(key), "'" + s + "' is not allowed: must be true or false");
 }
 
