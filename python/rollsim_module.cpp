@@ -437,13 +437,14 @@ RrcPoint fit_point(py::handle p, const TyreSize& size, const std::string& where)
 // simulate(tyre=...)); the file itself only when `output` is given.
 py::dict api_tyre_fit(py::object size_arg, py::object points, py::object label, py::object j2452,
                       py::object drum_radius_m, py::object free, py::object rrc_uncertainty_pct, py::object pressure_bar,
-                      py::object name_arg, py::object output) {
+                      py::object name_arg, py::object output, py::object measured) {
   const auto size = arg_as<std::string>(size_arg, "size", "a size designation (str)");
   const auto name = arg_as<std::string>(name_arg, "name", "the tyre's name (str)");
   // Checked before the fit, as `tyre fit --output` is: an existing, writable folder, no folders made (session 20:
   // the module made missing folders where the command line refuses).
   const std::string output_path = output.is_none() ? "" : arg_as<std::string>(output, "output", "a file path (str)");
-  if (!output_path.empty()) check_output_file(output_path, "output");
+  const std::string measured_path = measured.is_none() ? "" : arg_as<std::string>(measured, "measured", "a CSV path (str)");
+  if (!output_path.empty()) check_output_file(output_path, "output", {measured_path});
   TyreFitInputs in;
   in.size = parse_tyre_size(size, "size");
   if (!points.is_none()) {
@@ -452,6 +453,10 @@ py::dict api_tyre_fit(py::object size_arg, py::object points, py::object label, 
       in.points.push_back(fit_point(p, in.size, "points[" + std::to_string(i) + "]"));
       ++i;
     }
+  }
+  // The command line's --measured: the same loader, so the same columns and the same errors naming file and line.
+  if (!measured_path.empty()) {
+    for (auto& p : load_measured_rrc_csv(measured_path)) in.points.push_back(p);
   }
   if (!label.is_none()) in.label_class = arg_as<std::string>(label, "label", "a class 'A'..'E'");
   if (!j2452.is_none()) {
@@ -602,11 +607,13 @@ model's domain stops with a warning and returns the valid points.)");
   m.def("tyre_fit", &api_tyre_fit, "size"_a, py::kw_only(), "points"_a = py::none(), "label"_a = py::none(),
         "j2452"_a = py::none(), "drum_radius_m"_a = py::none(), "free"_a = py::none(),
         "rrc_uncertainty_pct"_a = py::none(), "pressure_bar"_a = py::none(), "name"_a = "fitted", "output"_a = py::none(),
+        "measured"_a = py::none(),
         R"(The hysteresis model fitted to what you have for one tyre (`rollsim tyre fit --json`).
 
 size: designation, e.g. '205/55 R16 91V' (a load index is needed for ISO points and labels). points: a list of
 (pressure_kpa [kPa], load_n [N], speed_kmh [km/h], rrc [-]) or of RRCs alone (at ISO 28580 conditions); label: EU
-label class 'A'..'E' (alone: one ISO point at the band's middle); j2452: (alpha, beta, a, b, c) of a J2452 set,
+label class 'A'..'E' (alone: one ISO point at the band's middle); measured: a CSV path of measured points
+(pressure_kpa,load_n,speed_kmh,rrc; the command line's --measured), added to points; j2452: (alpha, beta, a, b, c) of a J2452 set,
 sampled and corrected from a drum of drum_radius_m [m, default 0.85]; free: constants to fit (default: what the
 points determine); rrc_uncertainty_pct [%]; pressure_bar [bar] and name of the tyre file; output: a path to write
 it to (every command takes it). Returns {'fit': dict, 'params': [dict per constant], 'residuals': [dict per

@@ -528,5 +528,26 @@ class Session21Inputs(unittest.TestCase):
         with self.assertRaisesRegex(rollsim.InputError, "vehicle.*expected a shipped name or a file path"):
             rollsim.simulate(vehicle=3.5)
 
+    def test_tyre_fit_takes_a_measured_csv_as_the_command_line_does(self):
+        # tyre_fit had points= only; the command line's --measured FILE.csv had no Python spelling.
+        with tempfile.TemporaryDirectory() as d:
+            csv_path = Path(d) / "lab.csv"
+            csv_path.write_text("pressure_kpa,load_n,speed_kmh,rrc\n210,4000,50,0.0090\n250,4000,80,0.0088\n"
+                                "210,5000,110,0.0102\n210,4000,80,0.0095\n")
+            lines, _, _ = cli("tyre", "fit", "--size", "205/55 R16 91V", "--measured", str(csv_path), "--name", "lab",
+                              "--output", str(Path(d) / "cli.yaml"), "--json")
+            got = rollsim.tyre_fit("205/55 R16 91V", measured=csv_path, name="lab")
+            self.assertEqual(got["fit"], [x for x in lines if x["kind"] == "fit"][0])
+            self.assertEqual(got["params"], [x for x in lines if x["kind"] == "param"])
+            self.assertEqual(len(got["residuals"]), 4)
+            # One more point as points= is fitted with the file's four.
+            both = rollsim.tyre_fit("205/55 R16 91V", measured=str(csv_path), points=[(300, 4000, 80, 0.0080)])
+            self.assertEqual(len(both["residuals"]), 5)
+            with self.assertRaisesRegex(rollsim.InputError, "nothing.csv"):
+                rollsim.tyre_fit("205/55 R16 91V", measured=Path(d) / "nothing.csv")
+            with self.assertRaisesRegex(rollsim.InputError, "output"):
+                rollsim.tyre_fit("205/55 R16 91V", measured=csv_path, output=csv_path)  # would overwrite its input
+            self.assertIn("pressure_kpa", csv_path.read_text())
+
 if __name__ == "__main__":
     unittest.main()
