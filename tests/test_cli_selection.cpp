@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -59,6 +60,70 @@ TEST(CliSelection, CompareBrokenCatalogueFileIsNamedAndTheRestCompared) {
   EXPECT_TRUE(has(r.err, "broken.yaml")) << r.err;
   EXPECT_TRUE(has(r.out, "205-55R16")) << r.out;
   fs::remove_all(dir);
+}
+
+// A CSV line's fields, quoted ones with their doubled quotes undone.
+std::vector<std::string> csv_fields(const std::string& line) {
+  std::vector<std::string> out(1);
+  bool quoted = false;
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    const char ch = line[i];
+    if (quoted && ch == '"' && i + 1 < line.size() && line[i + 1] == '"') out.back() += '"', ++i;
+    else if (ch == '"') quoted = !quoted;
+    else if (ch == ',' && !quoted) out.emplace_back();
+    else out.back() += ch;
+  }
+  return out;
+}
+
+// The CSV says what the JSON says, a column per field (own, wheel load, capacity and diameter change were JSON only
+// until session 21), every line as wide as the header, and an unknown capacity is an empty cell.
+TEST(CliSelection, CompareCsvCarriesTheJsonsFieldsOnEveryLine) {
+  const std::string args = "compare --vehicle ev --tyre low-rrc --tyre 175-65R15 --tyre tyres/catalogue/205-55R16.yaml "
+                           "--cycle nedc --replay --threads 1";
+  const CmdResult csv = run(args + " --csv"), json = run(args + " --json");
+  ASSERT_EQ(csv.exit_code, 0) << csv.err;
+  ASSERT_EQ(json.exit_code, 0) << json.err;
+  const auto rows = lines(csv.out), objects = lines(json.out);
+  ASSERT_EQ(rows.size(), objects.size() + 1);
+  const std::vector<std::string> head = csv_fields(rows[0]);
+  auto column = [&](const std::string& name) {
+    const auto it = std::find(head.begin(), head.end(), name);
+    EXPECT_NE(it, head.end()) << name;
+    return static_cast<std::size_t>(it - head.begin());
+  };
+  for (const std::string name : {"own", "fits", "tyre", "wheel_load_n", "capacity_n", "diameter_change_pct", "value", "rrc_80kmh"}) {
+    ASSERT_NE(std::find(head.begin(), head.end(), name), head.end()) << name << " not in " << rows[0];
+  }
+  for (std::size_t i = 1; i < rows.size(); ++i) {
+    const std::vector<std::string> f = csv_fields(rows[i]);
+    ASSERT_EQ(f.size(), head.size()) << rows[i];
+    const std::string& o = objects[i - 1];
+    EXPECT_EQ(f[column("own")], has(o, "\"own\": true") ? "yes" : "no") << rows[i];
+    EXPECT_EQ(f[column("fits")], has(o, "\"fits\": true") ? "yes" : "no") << rows[i];
+    for (const std::string key : {"wheel_load_n", "capacity_n", "diameter_change_pct", "kwh_per_10km", "rrc_80kmh"}) {
+      const std::string cell = f[column(key == "kwh_per_10km" ? "value" : key)];
+      ASSERT_FALSE(cell.empty()) << key << ": " << rows[i];
+      const double want = rollsim::test::json_number(o, key);
+      EXPECT_NEAR(std::stod(cell), want, 1e-3 * std::max(1.0, std::abs(want))) << key << ": " << rows[i];
+    }
+  }
+  const CmdResult truck = run("compare --vehicle ev --tyre tyres/catalogue/205-55R16.yaml --csv --replay --threads 1 "
+                              "--cycle nedc --tyre '" + (temp_dir() / "lt.yaml").string() + "'",
+                              "printf 'name: lt\\nsize: \"LT215/85 R16 115/112Q\"\\npressure_bar: 4.5\\n' > '" +
+                                  (temp_dir() / "lt.yaml").string() + "' &&");
+  ASSERT_EQ(truck.exit_code, 0) << truck.err;
+  bool seen = false;
+  for (const auto& row : lines(truck.out)) {
+    const std::vector<std::string> f = csv_fields(row);
+    if (f[column("tyre")] != "lt") continue;
+    seen = true;
+    EXPECT_EQ(f[column("capacity_n")], "") << row;  // a light truck's capacity is not known here (it read 0.0)
+  }
+  EXPECT_TRUE(seen) << truck.out;
+  const CmdResult truck_json = run("compare --vehicle ev --json --replay --threads 1 --cycle nedc --tyre '" +
+                                   (temp_dir() / "lt.yaml").string() + "'");
+  EXPECT_TRUE(has(truck_json.out, "\"capacity_n\": null")) << truck_json.out;
 }
 
 TEST(CliSelection, SweepRrcFallsWithPressureInTheCsv) {

@@ -70,10 +70,15 @@ void print_json(const selection::Comparison& c) {
   for (const auto& j : selection::comparison_json(c)) std::cout << j.str() << "\n";
 }
 
+// What is not known is an empty cell (a light truck's capacity, 0 in CandidateFit), as a range is where the car has none.
+std::string known_or_empty(double x, int decimals, bool known) { return known && std::isfinite(x) ? fixed(x, decimals) : ""; }
+
+// The JSON's fields, those added after the first release at the end so that a script reading columns by position
+// keeps working.
 void print_csv(const selection::Comparison& c, bool header) {
   if (header) {
     std::cout << "vehicle,cycle,rank,tyre,size,pressure_bar,rrc_80kmh,rr_power_80kmh_w,value,unit,diff_pct,range_km,"
-                 "range_change_km,fits,reason,followed_trace,max_deficit_kmh\n";
+                 "range_change_km,fits,reason,followed_trace,max_deficit_kmh,own,wheel_load_n,capacity_n,diameter_change_pct\n";
   }
   auto q = [](const std::string& s) {
     std::string o = "\"";
@@ -81,14 +86,17 @@ void print_csv(const selection::Comparison& c, bool header) {
     return o + "\"";
   };
   auto emit = [&](const selection::CandidateResult& r, int rank) {
-    std::cout << q(c.vehicle) << "," << c.cycle << "," << (rank > 0 ? std::to_string(rank) : "") << "," << q(r.tyre.name)
+    std::cout << q(c.vehicle) << "," << q(c.cycle) << "," << (rank > 0 ? std::to_string(rank) : "") << "," << q(r.tyre.name)
               << "," << q(selection::tyre_size_text(r.tyre)) << "," << fixed(units::pa_to_bar(r.tyre.state.pressure_pa), 2)
               << "," << fixed(r.rrc_80, 6) << "," << fixed(r.rr_power_80_w, 2) << ","
               << fixed(r.value, 5) << "," << c.unit << "," << fixed(r.diff_pct, 3) << ","
               << (c.shows_range && std::isfinite(r.range_km) ? fixed(r.range_km, 2) : "") << ","
               << (c.shows_range && std::isfinite(r.range_change_km) ? fixed(r.range_change_km, 2) : "") << "," << (r.fit.fits ? "yes" : "no") << ","
               << q(r.fit.reason) << "," << (r.trace.followed ? "yes" : "no") << ","
-              << fixed(units::mps_to_kmh(r.trace.max_deficit_mps), 2) << "\n";
+              << fixed(units::mps_to_kmh(r.trace.max_deficit_mps), 2) << "," << (r.is_own ? "yes" : "no") << ","
+              << known_or_empty(r.fit.wheel_load_n, 1, true) << ","
+              << known_or_empty(r.fit.capacity_n, 1, r.fit.capacity_n > 0.0) << ","
+              << known_or_empty(r.fit.diameter_change_pct, 3, true) << "\n";
   };
   for (std::size_t i = 0; i < c.ranked.size(); ++i) emit(c.ranked[i], static_cast<int>(i + 1));
   for (const auto& r : c.unfit) emit(r, 0);

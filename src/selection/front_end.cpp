@@ -63,8 +63,10 @@ std::vector<JsonObject> comparison_json(const Comparison& c) {
     if (rank > 0) j.add("rank", rank); else j.add_null("rank");
     j.add("pressure_bar", units::pa_to_bar(r.tyre.state.pressure_pa))
         .add("wheel_load_n", r.fit.wheel_load_n)
-        .add("capacity_n", r.fit.capacity_n)
-        .add("diameter_change_pct", r.fit.diameter_change_pct)
+        .add("diameter_change_pct", r.fit.diameter_change_pct);
+    // Unknown (a light truck's, whose load range the size does not give) is null, not a capacity of 0 N.
+    if (r.fit.capacity_n > 0.0) j.add("capacity_n", r.fit.capacity_n); else j.add_null("capacity_n");
+    j
         .add("rrc_80kmh", r.rrc_80)
         .add("rr_power_80kmh_w", r.rr_power_80_w)
         .add(c.unit, r.value)
