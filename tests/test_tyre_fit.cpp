@@ -712,6 +712,29 @@ TEST(CliTyreFit, HeldOutEvaluationJudgesTheOtherFileAndNeedsTheFirst) {
   EXPECT_TRUE(has(bad.err, "maybe") && has(bad.err, "bad.csv")) << bad.err;
 }
 
+// A set whose coefficients are each in range but multiply to a force no tyre has: a = 1e308 overflowed to inf, and
+// the evaluation's NaN shapes indexed out of bounds (double free, exit 134; session 21's outside testing). Now one
+// error naming the file, the line and the set, as for --j2452 and for a held-out file.
+TEST(CliTyreFit, ASetsSurfaceOutsideAnyTyresIsNamedNotACrash) {
+  const auto dir = temp_dir();
+  for (const std::string a : {"1e308", "9.0"}) {
+    std::ofstream(dir / "huge.csv") << "size,rr_class,alpha,beta,a,b,c,wh_radius_m\n"
+                                    << "P205/60R15,LO,-0.48,1.0,0.068,2.3E-04,1.2E-06,0.304\n"
+                                    << "P205/60R15,HI,-0.48,1.0," << a << ",2.3E-04,1.2E-06,0.304\n";
+    for (const std::string option : {"--evaluate-j2452 '" + (dir / "huge.csv").string() + "'",
+                                     "--evaluate-j2452 '" + kJ2452Csv + "' --held-out-j2452 '" + (dir / "huge.csv").string() + "'"}) {
+      const CmdResult r = fit(option);
+      EXPECT_EQ(r.exit_code, 2) << a << ": " << r.err;
+      EXPECT_TRUE(has(r.err, "huge.csv: line 3, column 'a': the set P205/60R15 HI gives an RRC of")) << r.err;
+      EXPECT_EQ(lines(r.err).size(), 1u) << r.err;
+    }
+  }
+  const CmdResult text = fit("--size '205/55 R16 91V' --j2452 -0.4,1,1e308,0,0 --output '" + (dir / "huge_set.yaml").string() + "'");
+  EXPECT_EQ(text.exit_code, 2);
+  EXPECT_TRUE(has(text.err, "--j2452 -0.4,1,1e308,0,0: the set '-0.4,1,1e308,0,0' gives an RRC of inf")) << text.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "huge_set.yaml"));
+}
+
 // --- tyre files choose their model ---
 
 TEST(TyreFileModel, ThesisIsTheDefaultAndHysteresisNeedsItsLevel) {

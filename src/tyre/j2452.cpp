@@ -38,6 +38,27 @@ std::optional<FieldError> coefficient_error(const J2452Set& s) {
   return std::nullopt;
 }
 
+// Coefficients each in range can still multiply to a force no tyre has (a = 1e308 overflowed to inf and, through
+// NaN shapes, indexed out of bounds in the evaluation: session 21). The law is monotonic in P, Z and V over the grid
+// (alpha < 0.5, beta > 0.3, b and c >= 0 make its RRC vary monotonically in each), so its eight corners bound it.
+std::optional<std::string> surface_error(const J2452Set& s) {
+  const OperatingGrid g = j2452_grid();
+  for (const double p : {g.pressures_pa.front(), g.pressures_pa.back()}) {
+    for (const double z : {g.loads_n.front(), g.loads_n.back()}) {
+      for (const double v : {g.speeds_mps.front(), g.speeds_mps.back()}) {
+        const double v_kmh = units::mps_to_kmh(v);
+        const double rrc = std::pow(p / 1e3, s.alpha) * std::pow(z, s.beta) * (s.a + v_kmh * (s.b + v_kmh * s.c)) / z;
+        if (!(rrc >= 0.001 && rrc <= 0.06)) {
+          return "gives an RRC of " + format_value(rrc) + " on the drum at " + format_value(p / 1e3) + " kPa, " +
+                 format_value(z) + " N, " + format_value(v_kmh) + " km/h: it must give 0.001-0.06 (1-60 kg/t; car " +
+                 "tyres measure 5-15 kg/t) over 180-300 kPa, 3-6 kN, 15-115 km/h";
+        }
+      }
+    }
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 double checked_drum_radius_m(double radius_m, const std::string& where) {
@@ -63,6 +84,7 @@ J2452Set parse_j2452_text(const std::string& text, const std::string& where) {
   if (const auto e = coefficient_error(s)) {
     throw InputError(where, std::string(kNames[e->field]) + " " + cells[e->field] + " is not allowed: " + e->allowed);
   }
+  if (const auto e = surface_error(s)) throw InputError(where, "the set '" + text + "' " + *e);
   return s;
 }
 
@@ -89,6 +111,7 @@ std::vector<J2452Set> load_j2452_csv(const std::string& path) {
       const std::size_t column[] = {al, be, a, b, c};
       throw InputError(t.where(i, column[e->field]), "'" + t.rows[i][column[e->field]] + "' is not allowed: " + e->allowed);
     }
+    if (const auto e = surface_error(s)) throw InputError(t.where(i, a), "the set " + s.name + " " + *e);
     if (!(s.rolling_radius_m > 0.1 && s.rolling_radius_m < 1.0)) {
       throw InputError(t.where(i, r), format_value(s.rolling_radius_m) + " m is not allowed: must be in (0.1, 1) m");
     }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <stdexcept>
 
 #include "rollsim/common/json.hpp"
 #include "rollsim/common/statistics.hpp"
@@ -192,6 +193,7 @@ EnclosingBall smallest_enclosing_ball(const Eigen::MatrixXd& shapes) {
     for (Eigen::Index i = 0; i < n; ++i) {
       if (w[i] > 0.0 && (k < 0 || grad[i] < grad[k])) k = i;
     }
+    if (k < 0 || !std::isfinite(grad[j])) throw std::logic_error("smallest_enclosing_ball: shapes not finite");
     if (grad[j] - at_w < 1e-15) break;  // the duality gap: w is optimal to round-off
     Eigen::VectorXd d = -w;
     double max_step = 1.0;
