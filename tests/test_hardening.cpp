@@ -300,5 +300,32 @@ TEST_F(Hardening, YamlBooleansAreReadInEverySpellingYamlHas) {
   EXPECT_TRUE(has(bad.err, "'tRuE' is not allowed")) << bad.err;
 }
 
+// gnuplot's scratch folder was $TMPDIR/rollsim_plot_<pid>, used as found: another local user who made it first, with a
+// link named data.dat in it, had the plot's data written through the link into any file of the user running rollsim
+// (and could swap plot.gp before gnuplot ran it). Now mkdtemp's own folder: a planted one is left alone.
+TEST_F(Hardening, APlantedScratchFolderIsNotUsed) {
+  const fs::path tmp = dir_ / "tmp", victim = dir_ / "victim.txt";
+  fs::create_directories(tmp);
+  std::ofstream(victim) << "ORIGINAL\n";
+  const char* other = std::getenv("ROLLSIM_TEST_BINARY");
+  const std::string binary = other && *other ? other : ROLLSIM_BINARY;
+  // The paths have no blanks or quotes (the test's folder), so they go unquoted inside sh -c '...'. The shell's $$ is
+  // the pid rollsim runs as after exec, as a planting user would guess it.
+  const std::string args = "sweep --tyre 175-70R14 --param pressure --from 1.5 --to 3.5 --steps 3 --output " +
+                           (dir_ / "o.csv").string() + " --plot " + (dir_ / "o.svg").string();
+  const std::string cmd = "cd '" + std::string(ROLLSIM_SOURCE_DIR) + "' && TMPDIR='" + tmp.string() +
+                          "' sh -c 'd=$TMPDIR/rollsim_plot_$$; mkdir $d && ln -s " + victim.string() +
+                          " $d/data.dat && exec " + binary + " " + args + " >/dev/null 2>&1'";
+  EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  EXPECT_EQ(slurp(victim), "ORIGINAL\n");
+  EXPECT_TRUE(fs::exists(dir_ / "o.svg"));
+  std::size_t left = 0;
+  for (const auto& e : fs::directory_iterator(tmp)) {
+    ++left;  // only the planted folder stays: rollsim removed its own
+    EXPECT_TRUE(fs::is_symlink(e.path() / "data.dat")) << e.path();
+  }
+  EXPECT_EQ(left, 1u);
+}
+
 }  // namespace
 }  // namespace rollsim::test

@@ -81,8 +81,8 @@ std::string render_plot(const selection::SweepResult& r, const std::string& tyre
                                         "): there is no base to divide by; start the range elsewhere");
     }
   }
-  const fs::path work = fs::temp_directory_path() / ("rollsim_plot_" + std::to_string(getpid()));
-  fs::create_directories(work);
+  const report::ScratchDir scratch("rollsim_plot_");
+  const fs::path& work = scratch.path();
   std::ofstream data(work / "data.dat");
   for (auto& [key, pts] : series) {
     const double ref = pts.front().second;
@@ -129,8 +129,6 @@ std::string render_plot(const selection::SweepResult& r, const std::string& tyre
   std::ostringstream bytes;
   bytes << in.rdbuf();
   in.close();
-  std::error_code ec;
-  fs::remove_all(work, ec);
   if (!err.empty()) throw InputError("--plot " + file, "gnuplot failed: " + err);
   return bytes.str();
 }

@@ -109,8 +109,8 @@ void plot(const validate::Validation& v, const std::string& file) {
   const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
   std::error_code ec;
   if (!fs::is_directory(dir, ec) || access(dir.c_str(), W_OK) != 0) throw InputError("--plot " + file, "cannot write here (folder missing or not writable)");
-  const fs::path work = fs::temp_directory_path() / ("rollsim_validate_" + std::to_string(getpid()));
-  fs::create_directories(work);
+  const report::ScratchDir scratch("rollsim_validate_");
+  const fs::path& work = scratch.path();
   // Each series' points, in the legend's (alphabetical) order; a file is named by its place in that order, so the
   // title given to a file is its own (until session 20 the files were numbered by first appearance in the list and
   // the titles alphabetically: the petrol cars were drawn as "E85").
@@ -143,7 +143,6 @@ void plot(const validate::Validation& v, const std::string& file) {
   const std::string err = report::run_gnuplot_script(gnuplot, (work / "plot.gp").string());
   if (err.empty()) fs::rename(tmp_out, target, ec);
   fs::remove(tmp_out);
-  fs::remove_all(work);
   if (!err.empty()) throw InputError("--plot " + file, "gnuplot failed: " + err);
   if (ec) throw InputError("--plot " + file, "cannot replace the file: " + ec.message());
 }

@@ -172,20 +172,11 @@ std::vector<OutputFile> render_diagnosis_report(const std::string& dir, const Di
   const std::string where = "--report '" + dir + "'";
   check_report_dir(dir);
   if (d.series.empty()) throw InputError(where, "the diagnosis has no windows to draw");
-  const fs::path work = fs::temp_directory_path() / ("rollsim_report_" + std::to_string(getpid()) + "_" +
-                                                     std::to_string(reinterpret_cast<std::uintptr_t>(&d)));
-  fs::create_directories(work);
+  const report::ScratchDir scratch("rollsim_report_");
+  const fs::path& work = scratch.path();
   std::vector<std::vector<Figure>> sections{regime_figures(d, work), residual_figures(d, work), road_figures(d, work)};
   std::vector<std::vector<std::string>> svgs;
-  try {
-    for (const auto& s : sections) svgs.push_back(draw(s, work, where));
-  } catch (...) {
-    std::error_code ec;
-    fs::remove_all(work, ec);
-    throw;
-  }
-  std::error_code ec;
-  fs::remove_all(work, ec);
+  for (const auto& s : sections) svgs.push_back(draw(s, work, where));
 
   std::vector<OutputFile> files;
   diag::ReportFigures page;
