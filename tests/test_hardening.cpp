@@ -327,5 +327,20 @@ TEST_F(Hardening, APlantedScratchFolderIsNotUsed) {
   EXPECT_EQ(left, 1u);
 }
 
+// A full disk under stdout: the table or CSV was cut off mid-row and the exit status was 0 (session 21).
+TEST_F(Hardening, AFailedWriteToStdoutIsAnErrorNotExitZero) {
+  const char* other = std::getenv("ROLLSIM_TEST_BINARY");
+  const std::string binary = other && *other ? other : ROLLSIM_BINARY;
+  const fs::path err = dir_ / "err.txt";
+  for (const std::string args : {"sweep --tyre nominal --param pressure --from 2 --to 3", "tyre nominal --json",
+                                 "simulate --vehicle ev --replay", "regress tests/energy_baseline.yaml"}) {
+    const std::string cmd = "cd '" + std::string(ROLLSIM_SOURCE_DIR) + "' && '" + binary + "' " + args + " >/dev/full 2>'" +
+                            err.string() + "'";
+    const int status = std::system(cmd.c_str());
+    EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 2) << args;
+    EXPECT_TRUE(has(slurp(err), "error: writing to standard output failed")) << args << ": " << slurp(err);
+  }
+}
+
 }  // namespace
 }  // namespace rollsim::test

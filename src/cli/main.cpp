@@ -1,7 +1,9 @@
 // rollsim command-line entry point: parses the subcommand and hands over to the library.
 #include <CLI/CLI.hpp>
 
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <iostream>
 #include <optional>
 #include <set>
@@ -37,6 +39,19 @@ void refuse_option_names_as_values(CLI::App& app) {
         "", "not an option name"));
   }
   for (CLI::App* sub : app.get_subcommands({})) refuse_option_names_as_values(*sub);
+}
+
+// Most commands' output is stdout: a write that failed there (a full disk, a closed stream) left a table or CSV cut
+// off mid-row with exit 0 (session 21's outside testing: `sweep > /dev/full`). Flushed and checked before exiting.
+int checked_stdout(const rollsim::ProcessGroup& group, int code) {
+  if (!group.is_root()) return code;  // its stdout is switched off
+  std::cout.flush();
+  const bool failed = std::cout.fail() | (std::fflush(stdout) != 0) | (std::ferror(stdout) != 0);
+  if (!failed) return code;
+  const int err = errno;
+  std::cerr << "error: writing to standard output failed" << (err ? std::string(": ") + std::strerror(err) : "")
+            << "; what was written there is incomplete\n";
+  return code == 0 ? 2 : code;
 }
 
 }  // namespace
@@ -75,7 +90,8 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::RuntimeError& e) {
-    return e.get_exit_code();  // a command's own verdict (regress: 1 when a figure drifted), not a parse error
+    // A command's own verdict (regress: 1 when a figure drifted), not a parse error.
+    return checked_stdout(group, e.get_exit_code());
   } catch (const CLI::ParseError& e) {
     // --help and --version answer with exit 0; every other parse error is bad input, exit 2 like the rest (CLI11's
     // own codes, 105-109, would tell a script nothing more).
@@ -93,5 +109,5 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {
     return report(group, e, group.size() == 1, 1);
   }
-  return 0;
+  return checked_stdout(group, 0);
 }
