@@ -70,6 +70,27 @@ TEST(Fleet, AMissingRecordingNamesTheManifestLineAndColumn) {
   EXPECT_TRUE(r.out.empty()) << r.out;
 }
 
+// --json was checked against the manifest alone: a recording or vehicle file it names was overwritten with the
+// fleet's JSON, exit 0 (session 21's outside testing). Refused before any diagnosis, as a single diagnosis refuses.
+TEST(Fleet, JsonOntoAFileTheManifestNamesIsRefused) {
+  const auto dir = test::temp_dir() / "fleet_clobber";
+  std::filesystem::create_directories(dir);
+  std::filesystem::copy_file(kRecordings + "anl_d3_2018_toyota_camry/61811012_test_data.csv", dir / "a.csv",
+                             std::filesystem::copy_options::overwrite_existing);
+  std::filesystem::copy_file(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/camry_2018.yaml", dir / "car.yaml",
+                             std::filesystem::copy_options::overwrite_existing);
+  std::ofstream(dir / "m.csv") << "vehicle,recording,preset\ncar.yaml,a.csv,anl_d3\n";
+  const std::string recording = test::slurp(dir / "a.csv"), car = test::slurp(dir / "car.yaml");
+  for (const std::string target : {"a.csv", "car.yaml"}) {
+    const auto r = test::run_rollsim("diagnose --fleet '" + (dir / "m.csv").string() + "' --json '" + (dir / target).string() + "'");
+    EXPECT_EQ(r.exit_code, 2) << target;
+    EXPECT_NE(r.err.find("the same file as"), std::string::npos) << r.err;
+    EXPECT_TRUE(r.out.empty()) << r.out;
+  }
+  EXPECT_EQ(test::slurp(dir / "a.csv"), recording);
+  EXPECT_EQ(test::slurp(dir / "car.yaml"), car);
+}
+
 TEST(Fleet, ABadColumnMappingNamesTheManifestAndTheGroupsLine) {
   const std::string camry = kRecordings + "anl_d3_2018_toyota_camry/61811012_test_data.csv";
   const std::string path = write_manifest(

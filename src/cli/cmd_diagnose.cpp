@@ -101,8 +101,19 @@ void run_fleet(const DiagnoseCliOptions& o, const ProcessGroup& group) {
   if (!o.window_s.empty()) fo.diagnose.window_s = window_s_of(o.window_s);
   fo.diagnose.infer_road_profile = o.road_profile;
   fo.map_cases = group.mapper();
-  if (!o.json.empty()) check_output_file(o.json, "--json", {o.fleet});
-  const FleetResult r = diagnose_fleet(read_fleet_manifest(o.fleet), fo);
+  // The manifest is read first so that --json is checked against every file it names, not only against itself
+  // (a recording or vehicle file given as --json was overwritten with the fleet's JSON: session 21).
+  const FleetManifest manifest = read_fleet_manifest(o.fleet);
+  if (!o.json.empty()) {
+    std::vector<std::string> inputs{o.fleet};
+    for (const auto& g : manifest.groups) {
+      for (const auto& f : vehicle_input_files(load_vehicle_file(g.vehicle_path))) inputs.push_back(f);
+      if (!g.tyre_path.empty()) inputs.push_back(g.tyre_path);
+      for (const auto& rec : g.recordings) inputs.push_back(rec.path);
+    }
+    check_output_file(o.json, "--json", inputs);
+  }
+  const FleetResult r = diagnose_fleet(manifest, fo);
   std::cout << fleet_text(r);
   if (o.json.empty()) return;
   std::string lines;
