@@ -914,9 +914,13 @@ SimulationResult simulate_replay(const VehicleModel& m, const DriveCycle& c, con
       // A cruise is booked when the next segment differs; the sample at its end must see it (the state of charge
       // lagged a second behind through every cruise and standstill).
       book_cruise();
-      const int g = gear;
+      // A scratch evaluation, as the ramp's end below: the gear schedule is restored too, since the shift's
+      // hysteresis remembers the gear (the sample at 65.1 km/h upshifted ice.yaml's WLTC a segment early, and a
+      // replay written with --trace booked 0.03 % less fuel than one without: session 21).
+      const int scheduled = scheduled_gear, g = gear;
       evaluate_at(t0, v0, a, grade, rl, distance_m);
       r.trace.push_back(trace_point(m, t0, v0, v0, a, grade, s, gear, acc.data()));
+      scheduled_gear = scheduled;
       gear = g;
     }
     if (a == 0.0) {
