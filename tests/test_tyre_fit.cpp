@@ -735,6 +735,20 @@ TEST(CliTyreFit, ASetsSurfaceOutsideAnyTyresIsNamedNotACrash) {
   EXPECT_FALSE(std::filesystem::exists(dir / "huge_set.yaml"));
 }
 
+// tyre fit took --pressure-bar 0.5-6 and wrote files every other command refused (0.6 bar: "must be in [1, 5]").
+// Now the tyre file's own check (session 21).
+TEST(CliTyreFit, TheWrittenPressureIsOneTheTyreFileTakes) {
+  const auto out = temp_dir() / "pressure_written.yaml";
+  const CmdResult low = fit("--size '205/55 R16 91V' --point 0.0072 --pressure-bar 0.6 --output '" + out.string() + "'");
+  EXPECT_EQ(low.exit_code, 2);
+  EXPECT_TRUE(has(low.err, "--pressure-bar: 0.6 bar is not allowed for a passenger tyre")) << low.err;
+  EXPECT_FALSE(std::filesystem::exists(out));
+  const CmdResult ok = fit("--size '205/55 R16 91V' --point 0.0072 --pressure-bar 1.2 --output '" + out.string() + "'");
+  ASSERT_EQ(ok.exit_code, 0) << ok.err;
+  const CmdResult read = rollsim::test::run_rollsim("tyre '" + out.string() + "' --json");
+  EXPECT_EQ(read.exit_code, 0) << read.err;
+}
+
 // --- tyre files choose their model ---
 
 TEST(TyreFileModel, ThesisIsTheDefaultAndHysteresisNeedsItsLevel) {

@@ -7,6 +7,7 @@
 #include "rollsim/common/json.hpp"
 #include "rollsim/common/units.hpp"
 #include "rollsim/common/yaml_reader.hpp"
+#include "rollsim/tyre/tyre_spec.hpp"
 
 namespace rollsim {
 
@@ -61,7 +62,10 @@ double fitted_file_pressure_pa(const TyreSize& size, std::optional<double> press
                             "load-inflation table, not a passenger tyre's 2.1 bar; give the pressure to write in bar");
   }
   if (!pressure_bar) return iso28580_passenger_pressure_pa(size);
-  return units::bar_to_pa(checked_number(*pressure_bar, where, Range::closed(0.5, 6.0)));
+  // The tyre file's own check, so that every file written here is one the other commands read (0.5-6 bar was taken
+  // here and 0.6 bar refused by `rollsim tyre`: session 21).
+  check_pressure_plausible(checked_number(*pressure_bar, where, Range::closed(0.0, 1e3)), size, where);
+  return units::bar_to_pa(*pressure_bar);
 }
 
 void write_tyre_fit_json(std::ostream& out, const TyreFit& fit, const TyreFitPlan& plan) {
