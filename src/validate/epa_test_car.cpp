@@ -125,6 +125,7 @@ std::string to_string(SkipReason r) {
     case SkipReason::unsupported_fuel: return "fuel without properties here";
     case SkipReason::missing_field: return "missing field";
     case SkipReason::absurd_field: return "field outside its physical range";
+    case SkipReason::cannot_follow_cycle: return "the car from the row cannot follow the cycle (the driver keeps within 2 mph)";
     case SkipReason::simulation_failed: return "simulation failed";
   }
   return "";

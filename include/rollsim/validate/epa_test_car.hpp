@@ -28,6 +28,7 @@ enum class SkipReason {
   unsupported_fuel,       ///< E85 and other fuels without properties here
   missing_field,          ///< a field the car needs is empty or not a number
   absurd_field,           ///< a field outside its physical range
+  cannot_follow_cycle,    ///< the car built from the row cannot deliver what the trace demands (its power is absurd)
   simulation_failed,      ///< the model could not be evaluated (its message is the detail)
 };
 
