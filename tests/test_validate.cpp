@@ -846,6 +846,61 @@ TEST(CliValidate, ACarTooWeakForItsCycleIsSkippedNotPredicted) {
   }
 }
 
+// Fields the rules read, checked as the car's fields are (session 21's outside testing): an unknown drive was read
+// as two-wheel drive, an FE_UNIT other than MPG as mpg, an unknown ADFE flag as "No", and a list without the FE Bag 4
+// or exhaust columns switched the four-bag hybrid rule and the exhaust-carbon check off in silence.
+TEST(CliValidate, TheFieldsTheRulesReadAreCheckedNotAssumed) {
+  auto fields = [](const std::string& line) {
+    std::vector<std::string> out(1);
+    bool quoted = false;
+    for (const char ch : line) {
+      if (ch == '"') quoted = !quoted;
+      if (ch == ',' && !quoted) out.emplace_back();
+      else out.back() += ch;
+    }
+    return out;
+  };
+  auto join = [](const std::vector<std::string>& f) {
+    std::string out;
+    for (std::size_t i = 0; i < f.size(); ++i) out += (i ? "," : "") + f[i];
+    return out;
+  };
+  std::ifstream in(kList);
+  std::string header, line;
+  std::getline(in, header);
+  std::getline(in, line);  // line 2: an Aston Martin DBS FTP, simulated
+  const std::vector<std::string> head = fields(header), row = fields(line);
+  auto at = [&](const std::string& name) { return static_cast<std::size_t>(std::find(head.begin(), head.end(), name) - head.begin()); };
+  const auto file = test::temp_dir() / "fields.csv";
+  auto run_with = [&](const std::string& column, const std::string& value) {
+    std::vector<std::string> changed = row;
+    changed.at(at(column)) = value;
+    std::ofstream(file) << header << "\n" << join(changed) << "\n";
+    return test::run_rollsim("validate --json --threads 1 --epa-test-car-list " + file.string());
+  };
+  const auto plain = run_with("FE_UNIT", "MPG");
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  EXPECT_NE(plain.out.find("\"error_pct\": "), std::string::npos) << plain.out;
+  for (const auto& [column, value, said] :
+       {std::tuple<std::string, std::string, std::string>{"Drive System Description", "Banana", "Drive System Description 'Banana'"},
+        {"FE_UNIT", "gpm", "FE_UNIT 'gpm'"},
+        {"Analytically Derived FE?", "maybe", "Analytically Derived FE? 'maybe'"}}) {
+    const auto r = run_with(column, value);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(r.out.find("\"error_pct\": "), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find(said), std::string::npos) << r.out;
+  }
+  for (const std::string column : {"FE Bag 4", "CO2 (g/mi)", "FE_UNIT"}) {
+    std::vector<std::string> h = head, f = row;
+    h.erase(h.begin() + static_cast<std::ptrdiff_t>(at(column)));
+    f.erase(f.begin() + static_cast<std::ptrdiff_t>(at(column)));
+    std::ofstream(file) << join(h) << "\n" << join(f) << "\n";
+    const auto r = test::run_rollsim("validate --threads 1 --epa-test-car-list " + file.string());
+    EXPECT_EQ(r.exit_code, 2) << column;
+    EXPECT_NE(r.err.find("no column '" + column + "'"), std::string::npos) << r.err;
+  }
+}
+
 // Each series of the --plot figure holds its own powertrain's points: gnuplot's SVG puts a series' title and its
 // points in one group. Until session 20 the data files were numbered by first appearance in the list and titled in
 // alphabetical order, so the list's petrol cars were drawn under "E85 (mpg)" and its electric ones under "diesel".

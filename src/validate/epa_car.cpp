@@ -2,10 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <numbers>
+#include <sstream>
 #include <vector>
 
 #include "rollsim/common/error.hpp"
+#include "rollsim/common/text.hpp"
 #include "rollsim/common/units.hpp"
 #include "rollsim/effects/catalogue.hpp"
 #include "rollsim/vehicle/vehicle.hpp"
@@ -71,7 +74,10 @@ SkipReason missing(std::string& detail, const std::string& field) {
   return SkipReason::missing_field;
 }
 SkipReason absurd(std::string& detail, const std::string& field, double value, const std::string& allowed) {
-  detail = field + " = " + format_value(value) + " (allowed " + allowed + ")";
+  // Six significant digits: a unit's conversion left "999.9000000000001" in the message.
+  std::ostringstream v;
+  v << std::setprecision(6) << value;
+  detail = field + " = " + v.str() + " (allowed " + allowed + ")";
   return SkipReason::absurd_field;
 }
 
@@ -250,20 +256,20 @@ SkipReason check_configuration(const EpaTestRow& r, std::string& detail) {
   if (!r.road_b_n_s_per_m) return missing(detail, "Target Coef B (lbf/mph)");
   if (!r.road_c_n_s2_per_m2) return missing(detail, "Target Coef C (lbf/mph**2)");
   if (*r.road_c_n_s2_per_m2 <= 0.0 || *r.road_c_n_s2_per_m2 > 4.0)
-    return absurd(detail, "target C [N s^2/m^2]", *r.road_c_n_s2_per_m2, "0-4");
+    return absurd(detail, "target C [N s^2/m^2]", *r.road_c_n_s2_per_m2, "more than 0, up to 4");
   for (double v_mps : {2.0, 10.0, 20.0, kRoadLoadPowerSpeed_mps, 30.0, 40.0}) {
     const double f_n = target_road_load_n(r, v_mps);
     if (f_n <= 0.0 || f_n > 5000.0) return absurd(detail, "target road load at " + format_value(units::mps_to_kmh(v_mps)) + " km/h [N]", f_n, "0-5000 N");
   }
   if (!r.rated_power_w) return missing(detail, "Rated Horsepower");
-  if (*r.rated_power_w < 30e3 || *r.rated_power_w > 1.5e6) return absurd(detail, "rated power [W]", *r.rated_power_w, "30-1500 kW");
+  if (*r.rated_power_w < 30e3 || *r.rated_power_w > 1.5e6) return absurd(detail, "rated power [kW]", *r.rated_power_w / 1e3, "30-1500 kW");
   if (!r.engine_radps_per_mps) return missing(detail, "N/V Ratio");
   const double nv = nv_rpm_per_mph(r);
-  if (nv < 12.0 || nv > 250.0) return absurd(detail, "N/V ratio [rpm/mph]", nv, "12-250");
-  if (!liquid(r.fuel)) return SkipReason::none;
   // An engine's top gear: 80 rpm/mph is 4800 rpm at 60 mph (the list's engines reach 51); an electric machine's
   // single reduction runs faster (up to 191 in the list).
-  if (nv > 80.0) return absurd(detail, "N/V ratio of an engine's top gear [rpm/mph]", nv, "12-80");
+  if (liquid(r.fuel) && (nv < 12.0 || nv > 80.0)) return absurd(detail, "N/V ratio of an engine's top gear [rpm/mph]", nv, "12-80");
+  if (nv < 12.0 || nv > 250.0) return absurd(detail, "N/V ratio [rpm/mph]", nv, "12-250");
+  if (!liquid(r.fuel)) return SkipReason::none;
   if (!r.displacement_m3) return missing(detail, "Test Veh Displacement (L)");
   // In litres, as the list gives it, so that its 0.6 and 9 are inside (9e-3 m^3 x 1e3 is 9.000000000000002).
   const double litres = std::round(*r.displacement_m3 * 1e3 * 1e9) / 1e9;
@@ -293,6 +299,16 @@ FuelParams test_fuel(EpaFuel fuel) {
 }
 
 SkipReason check_car_fields(const EpaTestRow& row, std::string& detail) {
+  // An unknown drive was read as two-wheel drive in silence, and an unknown ADFE flag as "No" (session 21).
+  if (!row.drive_known) {
+    detail = "Drive System Description '" + row.drive_text + "' is not one the list uses (2-Wheel Drive, Front; 2-Wheel "
+             "Drive, Rear; All Wheel Drive; 4-Wheel Drive; Part-time 4-Wheel Drive)";
+    return row.drive_text.empty() ? SkipReason::missing_field : SkipReason::absurd_field;
+  }
+  if (lower_ascii(row.adfe_flag) != "yes" && lower_ascii(row.adfe_flag) != "no") {
+    detail = "Analytically Derived FE? '" + row.adfe_flag + "' (allowed Yes or No)";
+    return row.adfe_flag.empty() ? SkipReason::missing_field : SkipReason::absurd_field;
+  }
   if (const char* field = missing_derived_field(row)) return missing(detail, field);
   const SkipReason why = check_configuration(result_configuration(row), detail);
   if (why != SkipReason::none && row.derived) detail = "the analytically derived configuration (ADFE columns): " + detail;

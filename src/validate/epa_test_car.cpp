@@ -149,9 +149,10 @@ std::vector<EpaTestRow> read_epa_test_car_list(const std::string& path) {
                     c_adfe = col("Analytically Derived FE?"), c_adfe_test = col("ADFE Test Number"),
                     c_adfe_power = col(kAdfePower), c_adfe_etw = col(kAdfeWeight), c_adfe_nv = col(kAdfeNv);
   const std::size_t c_bag[3] = {col("FE Bag 1"), col("FE Bag 2"), col("FE Bag 3")};
-  // Optional: a list without them is read as before.
-  const auto c_bag4 = t.column("FE Bag 4"), c_hc = t.column("THC (g/mi)"), c_co = t.column("CO (g/mi)"),
-             c_co2 = t.column("CO2 (g/mi)");
+  // Required too, though optional until session 21: without them the four-bag hybrid rule and the exhaust-carbon
+  // check were switched off in silence, and FE_UNIT was not read at all.
+  const std::size_t c_bag4 = col("FE Bag 4"), c_hc = col("THC (g/mi)"), c_co = col("CO (g/mi)"), c_co2 = col("CO2 (g/mi)"),
+                    c_unit = col("FE_UNIT");
   if (t.rows.empty()) throw InputError(path, "no test rows: the file has the list's columns but no data line");
   std::vector<EpaTestRow> rows;
   rows.reserve(t.rows.size());
@@ -176,6 +177,9 @@ std::vector<EpaTestRow> read_epa_test_car_list(const std::string& path) {
     r.drive_text = trim(cells[c_drive]);
     const std::string d = lower_ascii(r.drive_text);
     r.all_wheel_drive = has(d, "all wheel") || has(d, "4-wheel");
+    r.drive_known = d == "2-wheel drive, front" || d == "2-wheel drive, rear" || d == "all wheel drive" ||
+                    d == "4-wheel drive" || d == "part-time 4-wheel drive";
+    r.fe_unit = trim(cells[c_unit]);
     if (const auto v = number(c_etw)) r.test_mass_kg = *v * kKgPerLb;
     if (const auto v = number(c_disp)) r.displacement_m3 = *v * units::kM3PerLitre;
     if (const auto v = number(c_hp)) r.rated_power_w = *v * units::kWPerHp;
@@ -187,12 +191,12 @@ std::vector<EpaTestRow> read_epa_test_car_list(const std::string& path) {
     if (const auto v = number(c_c)) r.road_c_n_s2_per_m2 = *v * kNPerLbf / (kMpsPerMph * kMpsPerMph);
     r.measured = number(c_fe);
     for (int b = 0; b < 3; ++b) r.bag_mpg[b] = number(c_bag[b]);
-    auto optional_number = [&](const std::optional<std::size_t>& c) { return c ? number(*c) : std::nullopt; };
-    r.bag4_mpg = optional_number(c_bag4);
-    r.hc_g_per_mi = optional_number(c_hc);
-    r.co_g_per_mi = optional_number(c_co);
-    r.co2_g_per_mi = optional_number(c_co2);
-    if (lower_ascii(trim(cells[c_adfe])) == "yes") {
+    r.bag4_mpg = number(c_bag4);
+    r.hc_g_per_mi = number(c_hc);
+    r.co_g_per_mi = number(c_co);
+    r.co2_g_per_mi = number(c_co2);
+    r.adfe_flag = trim(cells[c_adfe]);
+    if (lower_ascii(r.adfe_flag) == "yes") {
       EpaTestRow::DerivedConfiguration d;
       d.base_test = trim(cells[c_adfe_test]);
       if (const auto v = number(c_adfe_etw)) d.test_mass_kg = *v * kKgPerLb;

@@ -161,6 +161,10 @@ void classify(const EpaTestRow& r, const std::map<std::string, VehicleFacts>& fa
   } else if (!charge_depleting(r.cycle)) {
     return skip(SkipReason::other_procedure, "electric car on '" + r.procedure + "' (not a charge-depleting test)");
   }
+  // The list's values are in its FE_UNIT; it gives MPG on every row (MPGe for an electric car), and another unit
+  // was read as mpg in silence until session 21.
+  if (lower_ascii(r.fe_unit) != "mpg")
+    return skip(SkipReason::absurd_field, "FE_UNIT '" + r.fe_unit + "' (the list's results are in MPG, MPGe for electric cars)");
   if (!r.measured) return skip(SkipReason::no_measured_result);
   o.measured = *r.measured;
   if (r.fuel == EpaFuel::electricity && reads_as_kwh_per_100mi(o.measured)) {

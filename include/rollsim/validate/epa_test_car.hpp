@@ -48,6 +48,9 @@ struct EpaTestRow {
   std::string transmission_text;
   std::string drive_text;
   bool all_wheel_drive = false;
+  bool drive_known = false;   ///< drive_text is one the list uses (2- or 4-wheel, all-wheel, part-time 4-wheel)
+  std::string fe_unit;        ///< FE_UNIT as written: the list gives "MPG" on every row (MPGe for electric cars)
+  std::string adfe_flag;      ///< "Analytically Derived FE?" as written: Yes or No
   std::optional<double> test_mass_kg;     ///< equivalent test weight
   std::optional<double> displacement_m3;
   std::optional<double> rated_power_w;
@@ -57,9 +60,9 @@ struct EpaTestRow {
   std::optional<double> measured;         ///< RND_ADJ_FE as published (mpg or mpge)
   std::optional<double> bag_mpg[3];       ///< FE Bag 1..3 (FTP rows)
   /// FE Bag 4: given only where the FTP was run with four bags (the hot start as a whole UDDS), the hybrids'
-  /// procedure of SAE J1711 (40 CFR 600.115-11(c)). Empty where the column is absent.
+  /// procedure of SAE J1711 (40 CFR 600.115-11(c)).
   std::optional<double> bag4_mpg;
-  /// THC, CO and CO2 [g/mi] as measured over the row's test; empty where the columns are absent.
+  /// THC, CO and CO2 [g/mi] as measured over the row's test; empty where the row gives none.
   std::optional<double> hc_g_per_mi, co_g_per_mi, co2_g_per_mi;
   /// "Analytically Derived FE?" Yes: the result was not measured on the vehicle the row describes. EPA derived it
   /// from that vehicle's test (`base_test`) for another configuration, and the ADFE columns hold that
