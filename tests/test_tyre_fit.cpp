@@ -19,6 +19,7 @@
 #include "rollsim/tyre/tyre_fit_plan.hpp"
 #include "rollsim/tyre/tyre_model.hpp"
 #include "rollsim/tyre/tyre_spec.hpp"
+#include "rollsim/common/statistics.hpp"
 #include "test_support.hpp"
 
 using namespace rollsim;
@@ -47,11 +48,6 @@ TyreFit fit_two_points(const RrcPoint& a, const RrcPoint& b) {
   FitRequest r;
   r.points = {a, b};
   return fit_hysteresis(hysteresis_tyre(), r);
-}
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
 }
 
 // The evaluation is deterministic and takes ~0.2 s; computed once for the tests that read it.
@@ -747,6 +743,43 @@ TEST(CliTyreFit, TheWrittenPressureIsOneTheTyreFileTakes) {
   ASSERT_EQ(ok.exit_code, 0) << ok.err;
   const CmdResult read = rollsim::test::run_rollsim("tyre '" + out.string() + "' --json");
   EXPECT_EQ(read.exit_code, 0) << read.err;
+}
+
+// Student's t at the residuals' degrees of freedom (published two-sided 95 % quantiles), towards the normal's 1.96.
+TEST(TyreFit, IntervalsFromFewResidualsUseStudentsT) {
+  for (const auto& [dof, t] : {std::pair{1, 12.7062}, {2, 4.3027}, {3, 3.1824}, {4, 2.7764}, {5, 2.5706}, {10, 2.2281},
+                               {30, 2.0423}, {144, 1.9766}}) {
+    EXPECT_NEAR(student_t_95(dof), t, 1e-4) << dof;
+  }
+  EXPECT_NEAR(student_t_95(100000), 1.95997, 1e-4);
+  // A fit with one degree of freedom says so, and its interval is 12.71 standard errors each side, not 1.96.
+  const auto out = temp_dir() / "few_dof.yaml";
+  const CmdResult r = fit("--size '205/55 R16 91V' --point 210,4500,80,0.0085 --point 210,4500,50,0.0081 "
+                          "--point 210,4500,110,0.0093 --point 210,4500,30,0.0078 --output '" + out.string() + "' --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(has(r.out, "\"degrees_of_freedom\": 1,")) << r.out;
+  for (const auto& l : lines(r.out)) {
+    if (!has(l, "\"key\": \"rrc_ref\"")) continue;
+    const double value = rollsim::test::json_number(l, "value"), low = rollsim::test::json_number(l, "low95"),
+                 high = rollsim::test::json_number(l, "high95"), se = rollsim::test::json_number(l, "std_error");
+    // rrc_ref's interval is symmetric in its logarithm: log(high / low) / 2 = t x se / value.
+    EXPECT_NEAR(std::log(high / low) / 2.0, student_t_95(1) * se / value, 1e-6 * student_t_95(1)) << l;
+  }
+}
+
+// The label check: A and E are open-ended classes (5.0 kg/t is an A, 13.0 an E), and a value computed onto an edge is
+// on it (6.549999999999998 against 6.550000000000001 read OUTSIDE); session 21's outside testing.
+TEST(CliTyreFit, TheLabelCheckKeepsOpenEndsOpenAndEdgesOnTheEdge) {
+  const auto out = temp_dir() / "label_check.yaml";
+  for (const auto& [point, label] : {std::pair<std::string, std::string>{"0.0050", "A"}, {"0.0130", "E"}, {"0.00655", "B"},
+                                     {"0.00655", "A"}, {"0.00775", "C"}}) {
+    const CmdResult r = fit("--size '205/55 R16 91V' --point " + point + " --label " + label + " --output '" + out.string() + "'");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_TRUE(has(r.out, "inside the band")) << point << " " << label << ": " << r.out;
+  }
+  const CmdResult outside = fit("--size '205/55 R16 91V' --point 0.0050 --label B --output '" + out.string() + "' --json");
+  EXPECT_TRUE(has(outside.out, "\"inside_label_band\": false")) << outside.out;
+  EXPECT_TRUE(has(outside.out, "\"label_rrc_min_kg_per_t\": 6.55,")) << outside.out;
 }
 
 // --- tyre files choose their model ---

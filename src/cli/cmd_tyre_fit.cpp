@@ -84,8 +84,11 @@ void print_fit(const TyreFit& fit, const std::optional<LabelBand>& band, const s
   for (auto p : fit.held) {
     t.add_row({hysteresis_param_key(p), g(hysteresis_param_value(fit.tyre.hysteresis, p)), "-", "-", "shared (J2452 sets)"});
   }
-  std::cout << "Hysteresis model fitted to " << fit.residuals.size() << " point(s), " << fit.params.size()
-            << " constant(s) free; intervals from the Jacobian with " << pct(fit.sigma_relative) << " % relative scatter ("
+  // A constant held at its bound is not free: the degrees of freedom do not count it (session 21).
+  const auto held_at_bound = std::count_if(fit.params.begin(), fit.params.end(), [](const auto& e) { return e.at_bound; });
+  std::cout << "Hysteresis model fitted to " << fit.residuals.size() << " point(s), "
+            << fit.params.size() - static_cast<std::size_t>(held_at_bound) << " constant(s) free"
+            << (held_at_bound ? " and " + std::to_string(held_at_bound) + " held at 0" : std::string()) << "; intervals from the Jacobian with " << pct(fit.sigma_relative) << " % relative scatter ("
             << sigma_source(fit) << ")\n"
             << t.render();
   std::cout << "residuals: RMS " << pct(fit.rms_relative_error) << " %";
@@ -104,12 +107,14 @@ void print_fit(const TyreFit& fit, const std::optional<LabelBand>& band, const s
                  fixed(x.model_rrc * 1e3, 3), pct(x.relative_error)});
     }
     std::cout << r.render();
+  } else {
+    std::cout << "(each point's residual: --json, one residual line per point)\n";
   }
   if (band && iso) {
     TyreState at = fit.tyre;
     at.pressure_pa = iso->pressure_pa;
     const double rrc = evaluate_rolling_resistance(at, iso->load_n, iso->speed_mps).rrc;
-    const bool inside = rrc >= band->rrc_min && rrc <= band->rrc_max;
+    const bool inside = band->contains(rrc);
     std::cout << "EU label class " << band->label_class << " (C1, Regulation (EU) 2020/740): RRC "
               << fixed(band->rrc_min * 1e3, 2) << (band->open_below ? " (open below)" : "") << " - "
               << fixed(band->rrc_max * 1e3, 2) << (band->open_above ? " (open above)" : "")

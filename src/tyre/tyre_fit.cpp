@@ -12,6 +12,7 @@
 
 #include "rollsim/common/csv.hpp"
 #include "rollsim/common/error.hpp"
+#include "rollsim/common/statistics.hpp"
 #include "rollsim/common/units.hpp"
 #include "rollsim/tyre/hysteresis_model.hpp"
 #include "rollsim/tyre/least_squares.hpp"
@@ -143,13 +144,17 @@ TyreFit fit_once(const TyreState& start, const FitRequest& r, const std::vector<
     if (!(ls.jacobian.col(k).norm() > 1e-12 * widest)) flat.push_back(free[k]);
   const Eigen::MatrixXd cov =
       fit.sigma_relative * fit.sigma_relative * jtj.completeOrthogonalDecomposition().pseudoInverse();
+  // A scatter estimated from few residuals is itself uncertain: Student's t with their degrees of freedom, not the
+  // normal's 1.96 (at 2 dof the 1.96 interval held the truth 81 % of the time, at 1 dof 71 %: session 21's outside
+  // testing); an assumed scatter is taken as known.
+  fit.interval_quantile = fit.sigma_from_residuals ? student_t_95(fit.degrees_of_freedom) : 1.96;
   for (int k = 0; k < n; ++k) {
     ParamEstimate e;
     e.param = free[k];
     e.value = from_internal(free[k], ls.x[k]);
     const double sd_internal = std::sqrt(std::max(0.0, cov(k, k)));
-    e.low95 = from_internal(free[k], ls.x[k] - 1.96 * sd_internal);
-    e.high95 = from_internal(free[k], ls.x[k] + 1.96 * sd_internal);
+    e.low95 = from_internal(free[k], ls.x[k] - fit.interval_quantile * sd_internal);
+    e.high95 = from_internal(free[k], ls.x[k] + fit.interval_quantile * sd_internal);
     e.std_error = free[k] == HysteresisParam::RrcRef ? e.value * sd_internal
                                                      : std::abs(from_internal(free[k], sd_internal));
     fit.params.push_back(e);
@@ -423,7 +428,10 @@ std::string yaml_quoted(const std::string& s) {
 }  // namespace
 
 std::string sigma_source(const TyreFit& fit) {
-  if (fit.sigma_from_residuals) return "from the residuals";
+  if (fit.sigma_from_residuals) {
+    return "from the residuals, " + std::to_string(fit.degrees_of_freedom) + " degree(s) of freedom: Student's t " +
+           fixed(fit.interval_quantile, 2) + " standard errors each side";
+  }
   return fit.degrees_of_freedom > 0 ? "assumed: the residuals are all 0" : "assumed: no degrees of freedom left";
 }
 

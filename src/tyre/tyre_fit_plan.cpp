@@ -68,6 +68,11 @@ double fitted_file_pressure_pa(const TyreSize& size, std::optional<double> press
   return units::bar_to_pa(*pressure_bar);
 }
 
+namespace {
+// An edge of a label band in kg/t as declared (6.55, not the 6.550000000000001 the product gives).
+double kg_per_t(double rrc) { return std::round(rrc * 1e9) / 1e6; }
+}  // namespace
+
 void write_tyre_fit_json(std::ostream& out, const TyreFit& fit, const TyreFitPlan& plan) {
   JsonObject head;
   head.add("kind", "fit")
@@ -75,30 +80,26 @@ void write_tyre_fit_json(std::ostream& out, const TyreFit& fit, const TyreFitPla
       .add("degrees_of_freedom", fit.degrees_of_freedom)
       .add("rms_error_pct", 100.0 * fit.rms_relative_error)
       .add("sigma_pct", 100.0 * fit.sigma_relative)
+      .add("interval_quantile", fit.interval_quantile)
       .add("sigma_from_residuals", fit.sigma_from_residuals);
   if (plan.band && plan.iso) {
     TyreState at = fit.tyre;
     at.pressure_pa = plan.iso->pressure_pa;
     const double rrc = evaluate_rolling_resistance(at, plan.iso->load_n, plan.iso->speed_mps).rrc;
     head.add("label_class", std::string(1, plan.band->label_class))
-        .add("label_rrc_min_kg_per_t", 1e3 * plan.band->rrc_min)
-        .add("label_rrc_max_kg_per_t", 1e3 * plan.band->rrc_max)
+        .add("label_rrc_min_kg_per_t", kg_per_t(plan.band->rrc_min))
+        .add("label_rrc_max_kg_per_t", kg_per_t(plan.band->rrc_max))
         .add("iso_rrc_kg_per_t", 1e3 * rrc)
-        .add("inside_label_band", rrc >= plan.band->rrc_min && rrc <= plan.band->rrc_max);
+        .add("inside_label_band", plan.band->contains(rrc));
   }
   out << head.str() << '\n';
   for (const auto& p : fit.params) {
-    out << JsonObject()
-               .add("kind", "param")
-               .add("key", hysteresis_param_key(p.param))
-               .add("free", true)
-               .add("value", p.value)
-               .add("std_error", p.std_error)
-               .add("low95", p.low95)
-               .add("high95", p.high95)
-               .add("at_bound", p.at_bound)
-               .str()
-        << '\n';
+    // Held at its bound, a constant has no interval (it was 0 to 0, "95 %", with "free": true; session 21).
+    JsonObject j;
+    j.add("kind", "param").add("key", hysteresis_param_key(p.param)).add("free", !p.at_bound).add("value", p.value);
+    if (p.at_bound) j.add_null("std_error").add_null("low95").add_null("high95");
+    else j.add("std_error", p.std_error).add("low95", p.low95).add("high95", p.high95);
+    out << j.add("at_bound", p.at_bound).str() << '\n';
   }
   for (const auto p : fit.held) {
     out << JsonObject()

@@ -68,6 +68,9 @@ struct TyreFit {
   int degrees_of_freedom = 0;                 ///< points - free parameters
   double sigma_relative = 0.0;                ///< relative measurement scatter used for the intervals
   bool sigma_from_residuals = false;          ///< false: the assumed uncertainty (see sigma_source)
+  /// Standard errors each side in a 95 % interval: Student's t at degrees_of_freedom where the scatter came from the
+  /// residuals, 1.96 where it was assumed.
+  double interval_quantile = 1.96;
   /// What the points made of the tyre that no measured tyre does (the front ends print them as warnings).
   std::vector<std::string> warnings;
 };
@@ -94,6 +97,12 @@ struct LabelBand {
   bool open_below = false;  ///< class A has no lower edge in the regulation; rrc_min is our assumption
   bool open_above = false;  ///< class E has no upper edge; rrc_max is our assumption
   double rrc_mid() const { return 0.5 * (rrc_min + rrc_max); }
+  /// Whether an RRC is of this class: an open end has no edge (A holds 5.0 kg/t, E 13.0; our closing edges are for
+  /// the label-alone uncertainty only), and an edge holds a value computed onto it (6.549999999999998 is 6.55).
+  bool contains(double rrc) const {
+    constexpr double kEdge = 1e-12;  // RRC; far below the 0.1 kg/t of a declared value
+    return (open_below || rrc >= rrc_min - kEdge) && (open_above || rrc <= rrc_max + kEdge);
+  }
 };
 
 /// The C1 (passenger car tyre) band of a class A-E of Regulation (EU) 2020/740; throws InputError(where, ...) for
