@@ -2,6 +2,7 @@
 // outputs left behind on failure. Each test failed before its fix.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -340,6 +341,31 @@ TEST_F(Hardening, AFailedWriteToStdoutIsAnErrorNotExitZero) {
     EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 2) << args;
     EXPECT_TRUE(has(slurp(err), "error: writing to standard output failed")) << args << ": " << slurp(err);
   }
+}
+
+// A YAML file's second document was ignored in silence (the tyre ran at the first's pressure), a NUL byte was an
+// "unknown escape character", and CR-only line ends read as one line, "expected a YAML mapping" (session 21).
+TEST_F(Hardening, AYamlFileIsOneDocumentOfText) {
+  const std::string tyre = shipped("tyres/nominal.yaml");
+  const CmdResult plain = run_rollsim("tyre tyres/nominal.yaml --json");
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  const std::string two = write("two.yaml", tyre + "---\npressure_bar: 3.0\n");
+  CmdResult r = run_rollsim("tyre '" + two + "' --json");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, two + ": line " + std::to_string(1 + std::count(tyre.begin(), tyre.end(), '\n') + 1) +
+                             ": a second YAML document")) << r.err;
+  EXPECT_TRUE(r.out.empty()) << r.out;
+  const double rrc = json_number(plain.out, "rrc");
+  r = run_rollsim("tyre '" + write("lead.yaml", "---\n" + tyre) + "' --json");  // a leading '---' is one document
+  EXPECT_EQ(json_number(r.out, "rrc"), rrc) << r.err;
+  std::string cr = tyre;
+  std::replace(cr.begin(), cr.end(), '\n', '\r');
+  r = run_rollsim("tyre '" + write("cr.yaml", cr) + "' --json");
+  EXPECT_EQ(json_number(r.out, "rrc"), rrc) << r.err;
+  const std::string nul = write("nul.yaml", std::string("name: a\nsize: \"175/70 R14 84T\"\0\n", 32));
+  r = run_rollsim("tyre '" + nul + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, nul + ": line 2: holds a NUL byte")) << r.err;
 }
 
 }  // namespace

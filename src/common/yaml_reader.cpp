@@ -89,10 +89,25 @@ std::string Range::describe_for(double v) const {
 
 YamlMap YamlMap::load_file(const std::string& path) { return load_text(read_input_file(path, kMaxYamlFileBytes), path); }
 
-YamlMap YamlMap::load_text(const std::string& text, const std::string& path) {
+YamlMap YamlMap::load_text(const std::string& given, const std::string& path) {
+  // A NUL byte was reported as an "unknown escape character" on some line (session 21); yaml-cpp stops reading there.
+  if (const auto nul = given.find('\0'); nul != std::string::npos) {
+    const auto line = 1 + std::count(given.begin(), given.begin() + static_cast<std::ptrdiff_t>(nul), '\n');
+    throw InputError(path + ": line " + std::to_string(line), "holds a NUL byte: rollsim reads UTF-8 text (is the file UTF-16, or binary?)");
+  }
+  // Old Mac line ends (CR alone), which the CSV readers take, read as one line: "expected a YAML mapping".
+  std::string text = given;
+  if (text.find('\n') == std::string::npos) std::replace(text.begin(), text.end(), '\r', '\n');
   YAML::Node root;
   try {
-    root = YAML::Load(text);
+    // Every document is read, so that a second one (after '---') is refused, not ignored in silence (session 21:
+    // a tyre file's appended "---\npressure_bar: 3.0" ran at the first document's pressure).
+    const std::vector<YAML::Node> documents = YAML::LoadAll(text);
+    if (documents.size() > 1) {
+      throw InputError(path + ": line " + std::to_string(documents[1].Mark().line + 1),
+                       "a second YAML document (after '---'): a rollsim file is one document; merge its keys into the first");
+    }
+    if (!documents.empty()) root = documents.front();
   } catch (const YAML::Exception& e) {
     const int line = e.mark.line + 1;
     const int tab = tab_indented_line(text, line);
