@@ -8,6 +8,7 @@
 #include <sstream>
 #include <string>
 
+#include "rollsim/common/text.hpp"
 #include "test_support.hpp"
 
 namespace rollsim::test {
@@ -366,6 +367,39 @@ TEST_F(Hardening, AYamlFileIsOneDocumentOfText) {
   r = run_rollsim("tyre '" + nul + "'");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_TRUE(has(r.err, nul + ": line 2: holds a NUL byte")) << r.err;
+}
+
+// Well-formed UTF-8 passes unchanged; each byte of a malformed sequence becomes U+FFFD (RFC 3629's table).
+TEST_F(Hardening, NamesAreWrittenAsValidUtf8) {
+  const std::string fffd = "\xEF\xBF\xBD";
+  EXPECT_EQ(valid_utf8("plain ASCII"), "plain ASCII");
+  EXPECT_EQ(valid_utf8("M\xC3\xBCnchen \xE2\x82\xAC \xF0\x9F\x9A\x97"), "M\xC3\xBCnchen \xE2\x82\xAC \xF0\x9F\x9A\x97");
+  EXPECT_EQ(valid_utf8("bad\xFF\xFEname"), "bad" + fffd + fffd + "name");      // Latin-1 / UTF-16 bytes
+  EXPECT_EQ(valid_utf8("\xC0\xAF"), fffd + fffd);                                // overlong '/'
+  EXPECT_EQ(valid_utf8("\xED\xA0\x80"), fffd + fffd + fffd);                    // a surrogate
+  EXPECT_EQ(valid_utf8("\xF4\x90\x80\x80"), fffd + fffd + fffd + fffd);        // beyond U+10FFFF
+  EXPECT_EQ(valid_utf8("end\xE2\x82"), "end" + fffd + fffd);                     // truncated
+  // Through the CLI: a Latin-1 tyre name gave JSON no strict parser reads; a name opening with a quote stopped
+  // gnuplot ("'93 Winter"), and one holding "]]>" made the SVG ill-formed.
+  const std::string base = shipped("tyres/nominal.yaml");
+  std::string text;
+  {
+    std::istringstream in(base);
+    for (std::string line; std::getline(in, line);)
+      if (line.rfind("name:", 0) != 0) text += line + "\n";
+  }
+  const CmdResult latin = run_rollsim("tyre '" + write("latin.yaml", text + "name: bad\xFF\xFEname\n") + "' --json");
+  ASSERT_EQ(latin.exit_code, 0) << latin.err;
+  EXPECT_EQ(valid_utf8(latin.out), latin.out);
+  EXPECT_TRUE(has(latin.out, "\"tyre\": \"bad" + fffd + fffd + "name\"")) << latin.out;
+  const std::string svg = (dir_ / "quoted.svg").string();
+  const CmdResult quoted = run_rollsim("sweep --tyre '" + write("quoted.yaml", text + "name: \"'93 Winter ]]><x/>\"\n") +
+                                       "' --param pressure --from 1.5 --to 3.5 --steps 3 --output '" +
+                                       (dir_ / "quoted.csv").string() + "' --plot '" + svg + "'");
+  ASSERT_EQ(quoted.exit_code, 0) << quoted.err;
+  const std::string figure = slurp(svg);
+  EXPECT_TRUE(has(figure, "93 Winter ]] >")) << figure.substr(0, 2000);
+  EXPECT_FALSE(has(figure, "Winter ]]>")) << "XML text may not hold ]]>";
 }
 
 }  // namespace

@@ -1,6 +1,6 @@
 // `rollsim compare`: tyre selection for a car: fit checks and a ranking by cycle energy or fuel per cycle.
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "rollsim/common/text.hpp"
 #include "rollsim/common/units.hpp"
 #include "rollsim/report/simulation_report.hpp"
 #include "rollsim/report/table.hpp"
@@ -82,7 +83,7 @@ void print_csv(const selection::Comparison& c, bool header) {
   }
   auto q = [](const std::string& s) {
     std::string o = "\"";
-    for (char ch : s) o += ch == '"' ? std::string("\"\"") : std::string(1, ch);
+    for (char ch : valid_utf8(s)) o += ch == '"' ? std::string("\"\"") : std::string(1, ch);
     return o + "\"";
   };
   auto emit = [&](const selection::CandidateResult& r, int rank) {

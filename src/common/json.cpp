@@ -4,12 +4,13 @@
 #include <cstdio>
 
 #include "rollsim/common/format.hpp"
+#include "rollsim/common/text.hpp"
 
 namespace rollsim {
 
 std::string json_string(const std::string& text) {
   std::string out = "\"";
-  for (const char ch : text) {
+  for (const char ch : valid_utf8(text)) {  // JSON is UTF-8: a Latin-1 name made the whole line unreadable
     switch (ch) {
       case '"': out += "\\\""; break;
       case '\\': out += "\\\\"; break;

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "rollsim/common/format.hpp"
+#include "rollsim/common/text.hpp"
 #include "rollsim/diagnose/report.hpp"
 
 namespace rollsim::diag {
@@ -208,7 +209,7 @@ std::string heldout_change(const Diagnosis& d) {
 std::string html_escape(const std::string& text) {
   std::string o;
   o.reserve(text.size());
-  for (const char c : text) {
+  for (const char c : valid_utf8(text)) {  // the page declares UTF-8
     switch (c) {
       case '&': o += "&amp;"; break;
       case '<': o += "&lt;"; break;

@@ -10,6 +10,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "rollsim/common/text.hpp"
+
 namespace rollsim::report {
 namespace {
 
@@ -46,9 +48,18 @@ std::string find_gnuplot() {
   return "";
 }
 
-std::string gnuplot_string(const std::string& text) {
-  std::string o = "'";
-  for (const char c : text) {
+std::string gnuplot_string(const std::string& given) {
+  // Valid UTF-8 (the SVG is XML; a stray byte made it ill-formed), and no "]]>", which XML text may not hold and
+  // gnuplot's SVG terminal writes as it is (session 21's outside testing).
+  std::string text = valid_utf8(given);
+  for (std::size_t at = text.find("]]>"); at != std::string::npos; at = text.find("]]>", at)) text.insert(at + 2, " ");
+  // gnuplot reads a string that opens with a doubled quote ('''93 Winter') as an empty string and then a stray
+  // token, so a leading quote is a double-quoted "'" joined on with gnuplot's string operator '.' (a double-quoted
+  // string holding only a quote expands nothing).
+  const bool leading_quote = !text.empty() && text.front() == '\'';
+  std::string o = leading_quote ? "\"'\" . '" : "'";
+  for (std::size_t i = leading_quote ? 1 : 0; i < text.size(); ++i) {
+    const char c = text[i];
     const auto u = static_cast<unsigned char>(c);
     if (c == '\'') o += "''";
     else if (u < 0x20 || u == 0x7f) o += ' ';
