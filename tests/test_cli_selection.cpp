@@ -126,6 +126,15 @@ TEST(CliSelection, CompareCsvCarriesTheJsonsFieldsOnEveryLine) {
   EXPECT_TRUE(has(truck_json.out, "\"capacity_n\": null")) << truck_json.out;
 }
 
+// The swept column is the grid asked for, not its binary rounding (1.9 + 0.2 printed as 2.0999999999999996).
+TEST(CliSelection, SweepGridValuesArePrintedAsAsked) {
+  const CmdResult r = run("sweep --tyre nominal --param pressure --from 1.9 --to 2.3 --steps 3");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto rows = lines(r.out);
+  ASSERT_EQ(rows.size(), 4u) << r.out;
+  EXPECT_EQ(rows[2].substr(0, 4), "2.1,") << rows[2];
+}
+
 TEST(CliSelection, SweepRrcFallsWithPressureInTheCsv) {
   const CmdResult r = run("sweep --tyre 175-70R14 --param pressure --from 1.6 --to 3.2 --steps 5");
   ASSERT_EQ(r.exit_code, 0) << r.err;

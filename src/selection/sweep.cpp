@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <sstream>
 #include <utility>
@@ -71,7 +73,14 @@ double sweep_param_max(SweepParam p) {
 
 std::vector<double> SweepAxis::values() const {
   std::vector<double> v;
-  for (int i = 0; i < steps; ++i) v.push_back(i + 1 == steps ? to : from + (to - from) * i / (steps - 1));
+  for (int i = 0; i < steps; ++i) {
+    const double x = i + 1 == steps ? to : from + (to - from) * i / (steps - 1);
+    // To 12 significant digits, the grid the user asked for: 1.9 + 0.2 x 1 is 2.0999999999999996, which the CSV
+    // printed as the swept value (session 21).
+    char text[32];
+    std::snprintf(text, sizeof text, "%.12g", x);
+    v.push_back(std::strtod(text, nullptr));
+  }
   return v;
 }
 
