@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 
 namespace {
@@ -71,4 +72,27 @@ TEST(CliDiagnose, AmbientRrcAcrossRecordedAmbients) {
   ASSERT_NE(at, std::string::npos) << j;
   EXPECT_NE(j.find("\"rrc_change_per_k\": {\"value\": ", at), std::string::npos) << j;
   EXPECT_NE(rollsim::test::slurp(fitted).find("ambient_rrc:"), std::string::npos);
+}
+
+// The text's detection limits at three decimals read "0.000" for a grade offset of 0.00048, as if any were
+// detectable; they are printed to four significant digits, as the JSON's value (session 21's outside testing).
+TEST(CliDiagnose, DetectionLimitsAreNotRoundedToZero) {
+  const auto dir = rollsim::test::temp_dir();
+  const std::string trace = (dir / "ice_wltc_trace.csv").string();
+  const auto sim = rollsim::test::run_rollsim("simulate --vehicle ice --cycle wltc --trace '" + trace + "'");
+  ASSERT_EQ(sim.exit_code, 0) << sim.err;
+  const auto r = rollsim::test::run_rollsim("diagnose --vehicle ice --recording '" + trace + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto at = r.out.find("smallest size of each effect's catalogue shape");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  std::istringstream limits(r.out.substr(at));
+  std::string line;
+  int seen = 0;
+  std::getline(limits, line);
+  std::getline(limits, line);  // the heading's second line
+  while (std::getline(limits, line) && line.rfind("  ", 0) == 0) {
+    ++seen;
+    EXPECT_EQ(line.find(" 0.000 "), std::string::npos) << line;
+  }
+  EXPECT_GT(seen, 0) << r.out;
 }

@@ -1,6 +1,7 @@
 // Diagnosis output: the JSON and text reports, and the vehicle file with the fitted effects.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 
@@ -193,7 +194,11 @@ std::string diagnosis_text(const Diagnosis& d) {
     os << "not found; smallest size of each effect's catalogue shape this data would have shown (a lower bound:\n"
        << "real effects differ from the shape; the discovery benchmark measures 1-3 times these):\n";
     for (const auto& l : d.detection_limits) {
-      os << "  " << l.effect << ": " << l.parameter << " " << l.smallest_detectable << " " << l.unit
+      // Four significant digits: at the text's three decimals a limit of 0.00048 read "0.000", as if any size were
+      // detectable (session 21).
+      char limit[32];
+      std::snprintf(limit, sizeof limit, "%.4g", l.smallest_detectable);
+      os << "  " << l.effect << ": " << l.parameter << " " << limit << " " << l.unit
          << (l.within_bounds ? "" : " (beyond its physical bounds: not detectable here)") << "\n";
     }
   }
