@@ -96,3 +96,17 @@ TEST(CliDiagnose, DetectionLimitsAreNotRoundedToZero) {
   }
   EXPECT_GT(seen, 0) << r.out;
 }
+
+// simulate's own --trace of an electric car holds battery_current_a beside battery_power_kw, and diagnose refused
+// it ("has battery_current_a but no battery_voltage_v"); the lone current is now left out with a note, and the
+// model's own trace, read back, is nothing missing (session 21's outside testing).
+TEST(CliDiagnose, SimulatesOwnTraceIsARecordingItReads) {
+  const std::string trace = (rollsim::test::temp_dir() / "ev_wltc_trace.csv").string();
+  const auto sim = rollsim::test::run_rollsim("simulate --vehicle ev --cycle wltc --trace '" + trace + "'");
+  ASSERT_EQ(sim.exit_code, 0) << sim.err;
+  const auto r = rollsim::test::run_rollsim("diagnose --vehicle ev --recording '" + trace + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("battery_current_a without its pair: not used"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("channel battery_power"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("verdict: nothing_missing"), std::string::npos) << r.out;
+}

@@ -508,6 +508,14 @@ Recording load_recording(const std::string& path, const ColumnMapping& mapping) 
   rec.latitude_deg = gps_channel("latitude", 90.0);
   rec.longitude_deg = gps_channel("longitude", 180.0);
 
+  if (rec.battery_voltage_v.has_value() != rec.battery_current_a.has_value() && rec.battery_power_w) {
+    // A lone current (or voltage) beside a power channel is not needed: simulate's own --trace holds
+    // battery_current_a with battery_power_kw, and was refused (session 21).
+    const std::string have = rec.battery_voltage_v ? "battery_voltage_v" : "battery_current_a";
+    rec.repairs.push_back(have + " without its pair: not used; battery_power_kw is the battery's channel");
+    rec.battery_voltage_v.reset();
+    rec.battery_current_a.reset();
+  }
   if (rec.battery_voltage_v.has_value() != rec.battery_current_a.has_value()) {
     const std::string have = rec.battery_voltage_v ? "battery_voltage_v" : "battery_current_a";
     const std::string lack = rec.battery_voltage_v ? "battery_current_a" : "battery_voltage_v";
