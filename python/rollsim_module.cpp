@@ -443,6 +443,7 @@ py::dict api_tyre_fit(py::object size_arg, py::object points, py::object label, 
   // Checked before the fit, as `tyre fit --output` is: an existing, writable folder, no folders made (session 20:
   // the module made missing folders where the command line refuses).
   const std::string output_path = output.is_none() ? "" : arg_as<std::string>(output, "output", "a file path (str)");
+  if (!output.is_none() && output_path.empty()) throw InputError("output", "an empty path: give a file path, or leave output out");
   const std::string measured_path = measured.is_none() ? "" : arg_as<std::string>(measured, "measured", "a CSV path (str)");
   if (!output_path.empty()) check_output_file(output_path, "output", {measured_path});
   TyreFitInputs in;

@@ -402,5 +402,18 @@ TEST_F(Hardening, NamesAreWrittenAsValidUtf8) {
   EXPECT_FALSE(has(figure, "Winter ]]>")) << "XML text may not hold ]]>";
 }
 
+// An empty value was taken as the option not given: `--trace ""` wrote nothing with exit 0, `sweep --output ""`
+// printed to stdout, `tyre --size ""` blamed --outer-radius-m (session 21). Every option's empty value is refused.
+TEST_F(Hardening, AnEmptyOptionValueIsRefusedNotIgnored) {
+  for (const std::string args : {"simulate --vehicle ev --replay --trace ''", "sweep --tyre nominal --param pressure --from 2 "
+                                 "--to 3 --output ''", "tyre --size ''", "validate --epa-test-car-list '' ",
+                                 "diagnose --vehicle ev --recording x.csv --json ''"}) {
+    const CmdResult r = run_rollsim(args);
+    EXPECT_EQ(r.exit_code, 2) << args;
+    EXPECT_TRUE(has(r.err, "needs a value here, and an empty one is none")) << args << ": " << r.err;
+    EXPECT_TRUE(r.out.empty()) << args << ": " << r.out;
+  }
+}
+
 }  // namespace
 }  // namespace rollsim::test

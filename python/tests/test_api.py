@@ -549,5 +549,10 @@ class Session21Inputs(unittest.TestCase):
                 rollsim.tyre_fit("205/55 R16 91V", measured=csv_path, output=csv_path)  # would overwrite its input
             self.assertIn("pressure_kpa", csv_path.read_text())
 
+    def test_an_empty_output_path_is_refused(self):
+        # output="" wrote nothing, in silence, as --output "" did on the command line.
+        with self.assertRaisesRegex(rollsim.InputError, "output: an empty path"):
+            rollsim.tyre_fit("205/55 R16 91V", label="B", output="")
+
 if __name__ == "__main__":
     unittest.main()

@@ -25,7 +25,8 @@ int report(const rollsim::ProcessGroup& group, const std::exception& e, bool sam
 }
 
 // CLI11 2.1 takes the next word as an option's value even when it is another option ("--label --output x.yaml"
-// read "--output" as the label and then blamed x.yaml): an option's own command's option names are refused as values.
+// read "--output" as the label and then blamed x.yaml): an option's own command's option names are refused as values,
+// and so is an empty value.
 void refuse_option_names_as_values(CLI::App& app) {
   std::set<std::string> names;
   for (const CLI::Option* opt : app.get_options())
@@ -34,6 +35,8 @@ void refuse_option_names_as_values(CLI::App& app) {
     if (opt->get_type_size_max() == 0) continue;  // a flag takes no value
     opt->check(CLI::Validator(
         [names](std::string& value) {
+          // An empty value was taken as the option not given: `--trace ""` wrote nothing and exited 0 (session 21).
+          if (value.empty()) return std::string("needs a value here, and an empty one is none");
           return names.count(value) ? "needs a value here, and '" + value + "' is an option, not a value" : std::string();
         },
         "", "not an option name"));
