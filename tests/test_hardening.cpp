@@ -415,5 +415,25 @@ TEST_F(Hardening, AnEmptyOptionValueIsRefusedNotIgnored) {
   }
 }
 
+// A folder or a device named inside another file (a vehicle's tyres.all, a fleet manifest's recording) read "not
+// found", where the same given on the command line is "a folder" (session 21).
+TEST_F(Hardening, AFolderNamedInAFileIsCalledAFolder) {
+  fs::create_directories(dir_ / "sub.yaml");
+  fs::create_directories(dir_ / "rec_dir");
+  std::string ev = shipped("vehicles/ev.yaml");
+  const std::string all = "  all: nominal.yaml";
+  ASSERT_TRUE(has(ev, all));
+  ev.replace(ev.find(all), all.size(), "  all: sub.yaml");
+  CmdResult r = run_rollsim("simulate --vehicle '" + write("car.yaml", ev) + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, "key 'tyres.all': tyre file '" + (dir_ / "sub.yaml").string() + "' is a folder")) << r.err;
+  r = run_rollsim("simulate --vehicle '" + write("car2.yaml", ev.replace(ev.find("  all: sub.yaml"), 15, "  all: /dev/null")) + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, "is not a regular file")) << r.err;
+  r = run_rollsim("diagnose --fleet '" + write("m.csv", "vehicle,recording\nev,rec_dir\n") + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, "m.csv: line 2, column 'recording': file '" + (dir_ / "rec_dir").string() + "' is a folder")) << r.err;
+}
+
 }  // namespace
 }  // namespace rollsim::test

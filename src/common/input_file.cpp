@@ -20,6 +20,14 @@ bool is_folder_path(const std::filesystem::path& path) {
   return std::filesystem::is_directory(path, ec);
 }
 
+std::string why_not_a_file(const std::filesystem::path& path) {
+  if (is_regular_file_path(path)) return "";
+  if (is_folder_path(path)) return "is a folder; a file is expected here";
+  std::error_code ec;
+  if (std::filesystem::exists(path, ec)) return "is not a regular file (a device, pipe or socket?)";
+  return "not found";
+}
+
 std::optional<std::string> file_beside(const std::string& name, const std::string& referring_file,
                                        const std::string& extension) {
   if (name.empty()) return std::nullopt;

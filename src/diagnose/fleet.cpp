@@ -33,6 +33,8 @@ std::string resolve(const std::string& cell, const std::string& manifest, const 
   try {
     return resolve_data_file_beside(cell, manifest, shipped, ext, where);
   } catch (const InputError& e) {
+    const auto beside = std::filesystem::path(manifest).parent_path() / cell;
+    if (const std::string why = why_not_a_file(beside); why != "not found") throw InputError(where, "'" + beside.string() + "' " + why);
     throw InputError(where, "'" + cell + "' not found (relative to the manifest's folder, or a shipped name)");
   }
 }
@@ -63,8 +65,7 @@ FleetManifest read_fleet_manifest(const std::string& path) {
     const std::string vehicle_path = resolve(cell(vehicle), path, "vehicles", ".yaml", where(vehicle));
     const std::string tyre_path = cell(tyre).empty() ? "" : resolve(cell(tyre), path, "tyres", ".yaml", where(tyre));
     const std::filesystem::path rec = dir / cell(recording);
-    if (!is_regular_file_path(rec))
-      throw InputError(where(recording), "file '" + rec.string() + "' not found");
+    if (const std::string why = why_not_a_file(rec); !why.empty()) throw InputError(where(recording), "file '" + rec.string() + "' " + why);
     FleetRecording fr{rec.string(), {}, t.row_line[r]};
     try {
       YamlMap vehicle_file = YamlMap::load_file(vehicle_path);

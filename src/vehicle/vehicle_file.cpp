@@ -16,6 +16,8 @@ std::string resolve_tyre_path(const std::string& name, const std::string& vehicl
   // depending on where it is run from.
   if (auto beside = file_beside(name, vehicle_file, ".yaml")) return *beside;
   if (auto shipped = shipped_data_file(name, "tyres", ".yaml")) return *shipped;
+  const auto beside = std::filesystem::path(vehicle_file).parent_path() / name;
+  if (const std::string why = why_not_a_file(beside); why != "not found") throw InputError(where, "tyre file '" + beside.string() + "' " + why);
   throw InputError(where, "tyre file '" + name + "' not found beside the vehicle file or in the shipped tyres/");
 }
 

@@ -24,6 +24,10 @@ std::string read_input_file(const std::string& path, std::uintmax_t max_bytes);
 /// error instead of the caller's named "not found".
 bool is_regular_file_path(const std::filesystem::path& path);
 bool is_folder_path(const std::filesystem::path& path);
+/// Why `path` is not a file to read, in the words of an error ("is a folder; a file is expected here", "is not a
+/// regular file (a device, pipe or socket?)", "not found"); empty when it is a regular file. A folder or /dev/null
+/// named inside another file read "not found" (session 21).
+std::string why_not_a_file(const std::filesystem::path& path);
 
 /// A file named inside another file (a vehicle file's tyres, a fleet manifest, a regression baseline) travels with
 /// it: `name` (or `name` + `extension`) resolved against `referring_file`'s folder, if that is a file (an absolute
