@@ -782,6 +782,16 @@ TEST(CliTyreFit, TheLabelCheckKeepsOpenEndsOpenAndEdgesOnTheEdge) {
   EXPECT_TRUE(has(outside.out, "\"label_rrc_min_kg_per_t\": 6.55,")) << outside.out;
 }
 
+// A measured pressure of 1e308 kPa overflowed to Pa and was named "pressure inf kPa" (session 21).
+TEST(CliTyreFit, AnAbsurdMeasuredPressureIsNamedAsWritten) {
+  const auto csv = temp_dir() / "absurd_pressure.csv";
+  std::ofstream(csv) << "pressure_kpa,load_n,speed_kmh,rrc\n1e308,4000,80,0.0090\n210,4000,50,0.0085\n";
+  const CmdResult r = fit("--size '205/55 R16 91V' --measured '" + csv.string() + "' --output '" +
+                          (temp_dir() / "absurd_pressure.yaml").string() + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, "pressure 1e+308 kPa is outside a tyre's physical range")) << r.err;
+}
+
 // --- tyre files choose their model ---
 
 TEST(TyreFileModel, ThesisIsTheDefaultAndHysteresisNeedsItsLevel) {

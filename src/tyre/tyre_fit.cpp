@@ -220,12 +220,17 @@ void set_hysteresis_param(HysteresisConstants& c, HysteresisParam p, double valu
   }
 }
 
-void check_rrc_point(const TyreState& tyre, const RrcPoint& p) {
-  const double kpa = p.pressure_pa / 1e3;
+namespace {
+void check_point_pressure_kpa(double kpa, const std::string& where) {
   if (!(kpa >= 50.0 && kpa <= 600.0)) {
-    throw InputError(p.where, "pressure " + format_value(kpa) + " kPa is outside a tyre's physical range: must be in "
-                                                                "[50, 600] kPa");
+    throw InputError(where, "pressure " + format_value(kpa) + " kPa is outside a tyre's physical range: must be in "
+                                                              "[50, 600] kPa");
   }
+}
+}  // namespace
+
+void check_rrc_point(const TyreState& tyre, const RrcPoint& p) {
+  check_point_pressure_kpa(p.pressure_pa / 1e3, p.where);
   const double kmh = units::mps_to_kmh(p.speed_mps);
   if (!(kmh > 0.0 && kmh <= 300.0)) {
     throw InputError(p.where, "speed " + format_value(kmh) + " km/h is not allowed: must be in (0, 300] km/h (a "
@@ -359,6 +364,8 @@ LabelBand eu_label_band_c1(const std::string& label_class, const std::string& wh
 }
 
 RrcPoint rrc_point_from_file_units(double pressure_kpa, double load_n, double speed_kmh, double rrc, std::string where) {
+  // Checked in the file's unit: 1e308 kPa overflowed to "pressure inf kPa" in Pa (session 21).
+  if (!std::isfinite(pressure_kpa * 1e3)) check_point_pressure_kpa(pressure_kpa, where);
   return {pressure_kpa * 1e3, load_n, units::kmh_to_mps(speed_kmh), rrc, std::move(where)};
 }
 
