@@ -435,5 +435,25 @@ TEST_F(Hardening, AFolderNamedInAFileIsCalledAFolder) {
   EXPECT_TRUE(has(r.err, "m.csv: line 2, column 'recording': file '" + (dir_ / "rec_dir").string() + "' is a folder")) << r.err;
 }
 
+// A name's or a header's terminal escape sequences reached the terminal (cleared it, set its title): names are labels
+// with their control characters as spaces, and messages show them as \xNN (session 21's outside testing).
+TEST_F(Hardening, NoEscapeSequenceReachesTheTerminal) {
+  std::string text;
+  {
+    std::istringstream in(shipped("tyres/nominal.yaml"));
+    for (std::string line; std::getline(in, line);)
+      if (line.rfind("name:", 0) != 0) text += line + "\n";
+  }
+  const CmdResult table = run_rollsim("tyre '" + write("esc.yaml", text + "name: \"\\e[2Jx\\e]0;title\\a\"\n") + "'");
+  ASSERT_EQ(table.exit_code, 0) << table.err;
+  EXPECT_FALSE(has(table.out, "\x1b")) << table.out;
+  EXPECT_TRUE(has(table.out, "[2Jx")) << table.out;
+  const CmdResult message = run_rollsim("simulate --vehicle ev --cycle '" +
+                                        write("esc.csv", "time_s,\x1b[31mgrade,speed_kmh\n0,0,0\n1,0,1\n") + "'");
+  EXPECT_EQ(message.exit_code, 2);
+  EXPECT_FALSE(has(message.err, "\x1b")) << message.err;
+  EXPECT_TRUE(has(message.err, "unknown column '\\x1B[31mgrade'")) << message.err;
+}
+
 }  // namespace
 }  // namespace rollsim::test

@@ -18,9 +18,26 @@ namespace {
 // Under mpirun every rank runs the same command on the same input; only rank 0 prints. Errors that every rank
 // meets alike (bad input, a failed case: agreed collectively) are printed once, by rank 0; any other error may be
 // one rank's alone, so that rank names itself.
+// A message quotes what the user gave (a key, a column header, a value); a control character in it is shown as
+// \xNN, not sent to the terminal (an escape sequence in a CSV header recoloured or cleared it; session 21).
+std::string printable(const std::string& text) {
+  std::string out;
+  for (const char ch : text) {
+    const auto u = static_cast<unsigned char>(ch);
+    if ((u < 0x20 && ch != '\n' && ch != '\t') || u == 0x7f) {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "\\x%02X", u);
+      out += hex;
+    } else {
+      out += ch;
+    }
+  }
+  return out;
+}
+
 int report(const rollsim::ProcessGroup& group, const std::exception& e, bool same_on_every_rank, int code) {
-  if (group.is_root()) std::cerr << "error: " << e.what() << "\n";
-  else if (!same_on_every_rank) std::fprintf(stderr, "error (rank %d): %s\n", group.rank(), e.what());
+  if (group.is_root()) std::cerr << "error: " << printable(e.what()) << "\n";
+  else if (!same_on_every_rank) std::fprintf(stderr, "error (rank %d): %s\n", group.rank(), printable(e.what()).c_str());
   return code;
 }
 

@@ -10,6 +10,12 @@ std::string lower_ascii(std::string text) {
   return text;
 }
 
+std::string display_name(std::string name) {
+  for (char& ch : name)
+    if (static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f) ch = ' ';
+  return name;
+}
+
 std::string valid_utf8(const std::string& text) {
   std::string out;
   out.reserve(text.size());

@@ -15,6 +15,11 @@ void TextTable::set_left_aligned(std::size_t col) { left_.at(col) = true; }
 
 void TextTable::add_row(std::vector<std::string> cells) {
   if (cells.size() != headers_.size()) throw std::logic_error("TextTable: row size differs from header size");
+  // A cell is one line of printable text: a name's line break broke the table, and its escape sequences cleared
+  // the user's terminal or set its title (session 21's outside testing).
+  for (auto& cell : cells)
+    for (char& ch : cell)
+      if (static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f) ch = ' ';
   rows_.push_back(std::move(cells));
 }
 

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "rollsim/common/error.hpp"
+#include "rollsim/common/text.hpp"
 #include "rollsim/common/format.hpp"
 #include "rollsim/common/units.hpp"
 #include "rollsim/common/yaml_reader.hpp"
@@ -363,7 +364,7 @@ TyreSpec load_tyre(YamlMap y) {
                           "load_index", "model"});
   TyreSpec spec;
   spec.source = path;
-  spec.name = opt_string(y, "name").value_or(std::filesystem::path(path).stem().string());
+  spec.name = display_name(opt_string(y, "name").value_or(std::filesystem::path(path).stem().string()));
   spec.description = opt_string(y, "description").value_or("");
   spec.reference = opt_string(y, "source").value_or("");
 

@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include "rollsim/common/error.hpp"
+#include "rollsim/common/text.hpp"
 #include "rollsim/common/format.hpp"
 #include "rollsim/common/units.hpp"
 #include "rollsim/common/yaml_reader.hpp"
@@ -250,7 +251,7 @@ Vehicle load_vehicle(YamlMap root) {
   const std::string path = root.file();
   Vehicle v;
   v.source = path;
-  v.name = root.string_or("name", std::filesystem::path(path).stem().string());
+  v.name = display_name(root.string_or("name", std::filesystem::path(path).stem().string()));
   root.accept("description");
   root.accept("sources");
   const YamlMap body = root.map("body");

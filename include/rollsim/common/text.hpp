@@ -14,4 +14,8 @@ std::string lower_ascii(std::string text);
 /// bytes (a Latin-1 tyre name, a path) made every JSON output unreadable to a strict parser.
 std::string valid_utf8(const std::string& text);
 
+/// A name as a label: its control characters (line breaks, terminal escape sequences) as spaces. A tyre named with
+/// ESC [2J cleared the terminal of whoever printed its table (session 21).
+std::string display_name(std::string name);
+
 }  // namespace rollsim
