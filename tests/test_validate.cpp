@@ -901,6 +901,44 @@ TEST(CliValidate, TheFieldsTheRulesReadAreCheckedNotAssumed) {
   }
 }
 
+// The hybrid name rule reads whole words ("DBX CHEV" was a HEV and "DBX PRIMEVAL" a PRIME), and an electric "60 MPG"
+// is read as kWh per 100 miles as 59.9 is (it was taken as 60 MPGe and predicted +154 %); session 21.
+TEST(CliValidate, NamesAreReadByWordAndSixtyIsInTheKwhRange) {
+  std::ifstream in(kList);
+  std::vector<std::string> lines_of_list;
+  for (std::string line; std::getline(in, line) && lines_of_list.size() < 107;) lines_of_list.push_back(line);
+  ASSERT_EQ(lines_of_list.size(), 107u);
+  const std::string header = lines_of_list[0], dbx = lines_of_list[3], i4 = lines_of_list[106];
+  ASSERT_NE(dbx.find(",DBX,"), std::string::npos) << dbx;
+  ASSERT_NE(i4.find(",154.8,"), std::string::npos) << i4;
+  const auto file = test::temp_dir() / "names.csv";
+  auto run_rows = [&](const std::vector<std::string>& rows) {
+    std::ofstream out(file);
+    out << header << "\n";
+    for (const auto& r : rows) out << r << "\n";
+    out.close();
+    return test::run_rollsim("validate --json --threads 1 --epa-test-car-list " + file.string());
+  };
+  for (const std::string name : {"DBX CHEV", "DBX PRIMEVAL", "DBX 4XE2"}) {
+    std::string row = dbx;
+    row.replace(row.find(",DBX,"), 5, "," + name + ",");
+    const auto r = run_rows({row});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(r.out.find("hybrid"), std::string::npos) << name << ": " << r.out;
+  }
+  for (const std::string name : {"DBX HEV", "DBX PRIME", "DBX 4XE"}) {
+    std::string row = dbx;
+    row.replace(row.find(",DBX,"), 5, "," + name + ",");
+    EXPECT_NE(run_rows({row}).out.find("named so"), std::string::npos) << name;
+  }
+  std::string sixty = i4;
+  sixty.replace(sixty.find(",154.8,"), 7, ",60,");
+  const auto r = run_rows({sixty});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out.find("\"error_pct\": "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"skipped\": \"measured result outside any car of its kind"), std::string::npos) << r.out;
+}
+
 // Each series of the --plot figure holds its own powertrain's points: gnuplot's SVG puts a series' title and its
 // points in one group. Until session 20 the data files were numbered by first appearance in the list and titled in
 // alphabetical order, so the list's petrol cars were drawn under "E85 (mpg)" and its electric ones under "diesel".

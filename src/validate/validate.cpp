@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <map>
 #include <optional>
+#include <set>
 #include <stdexcept>
 #include <tuple>
 
@@ -67,17 +68,19 @@ std::string vehicle_key(const EpaTestRow& r) { return lower_ascii(r.make) + "|" 
 
 bool name_says_hybrid(const EpaTestRow& r) {
   const std::string m = lower_ascii(r.model);
-  for (const char* word : {"hybrid", "plug-in", "prime", "4xe", "recharge", "tfsie"}) {
-    if (m.find(word) != std::string::npos) return true;
+  for (const char* part : {"hybrid", "plug-in"}) {
+    if (m.find(part) != std::string::npos) return true;
   }
-  // Whole tokens: HEV, FHEV, PHEV, MHEV, Volvo's T8 (its plug-in), and Lexus's numbers ending in h.
+  // Whole tokens, not parts of words (DBX CHEV read as HEV and DBX PRIMEVAL as PRIME until session 21): PRIME, 4XE,
+  // RECHARGE, TFSIe, HEV, FHEV, PHEV, MHEV, Volvo's T8 (its plug-in), and Lexus's numbers ending in h.
+  static const std::set<std::string> kTokens{"prime", "4xe", "recharge", "tfsie", "hev", "fhev", "phev", "mhev", "t8"};
   std::string token;
   for (std::size_t i = 0; i <= m.size(); ++i) {
     if (i < m.size() && std::isalnum(static_cast<unsigned char>(m[i]))) {
       token += m[i];
       continue;
     }
-    if (token == "t8" || (token.size() >= 3 && token.compare(token.size() - 3, 3, "hev") == 0)) return true;
+    if (kTokens.count(token)) return true;
     // Lexus names its hybrids by a number and an h: ES 300h, NX 350h, RX 450h, LC 500h, LS 500h.
     if (token.size() == 4 && token.back() == 'h' && std::all_of(token.begin(), token.end() - 1, [](char c) { return std::isdigit(static_cast<unsigned char>(c)); }))
       return true;
@@ -90,12 +93,14 @@ struct VehicleFacts {
   bool charge_depleting_on_fuel = false;
   bool four_bag_ftp = false;  ///< an FTP of this vehicle was run with four bags, as hybrids are (SAE J1711)
   double ftp_mpg = 0.0, hwfet_mpg = 0.0;
-  bool electric_result_in_mpge = false;  ///< a charge-depleting result at 60 MPG or more: MPGe, as the unit says
+  bool electric_result_in_mpge = false;  ///< a charge-depleting result above 60 MPG: MPGe, as the unit says
 };
 
 // An electric row's "MPG" of 8-60 is read as kWh per 100 miles (SOURCES.md: no electric car reaches 8-60 MPGe).
-constexpr double kKwhPer100MiBelow = 60.0, kKwhPer100MiFrom = 8.0;
-bool reads_as_kwh_per_100mi(double value) { return value >= kKwhPer100MiFrom && value < kKwhPer100MiBelow; }
+constexpr double kKwhPer100MiTo = 60.0, kKwhPer100MiFrom = 8.0;
+// 60 itself too: read as 60 MPGe it was predicted at +154 % in silence (session 21), as kWh per 100 miles it is
+// 56 MPGe, under any electric car's, and skipped.
+bool reads_as_kwh_per_100mi(double value) { return value >= kKwhPer100MiFrom && value <= kKwhPer100MiTo; }
 
 std::map<std::string, VehicleFacts> vehicle_facts(const std::vector<EpaTestRow>& rows) {
   std::map<std::string, VehicleFacts> f;
@@ -103,7 +108,7 @@ std::map<std::string, VehicleFacts> vehicle_facts(const std::vector<EpaTestRow>&
     auto& v = f[vehicle_key(r)];
     if (charge_depleting(r.cycle) && liquid(r.fuel)) v.charge_depleting_on_fuel = true;
     if (r.cycle == EpaCycle::ftp75 && r.bag4_mpg && *r.bag4_mpg > 0.0) v.four_bag_ftp = true;
-    if (charge_depleting(r.cycle) && r.fuel == EpaFuel::electricity && r.measured && *r.measured >= kKwhPer100MiBelow)
+    if (charge_depleting(r.cycle) && r.fuel == EpaFuel::electricity && r.measured && *r.measured > kKwhPer100MiTo)
       v.electric_result_in_mpge = true;
     // Only results in a liquid-fuel car's plausible range inform the hybrid rule: an absurd one is skipped as such.
     if (!r.measured || !plausible_liquid_mpg(*r.measured) || !liquid(r.fuel)) continue;
