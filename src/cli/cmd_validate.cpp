@@ -8,11 +8,12 @@
 #include <iostream>
 #include <limits>
 #include <map>
-#include <sstream>
 #include <memory>
+#include <sstream>
 #include <string>
 
 #include "commands.hpp"
+#include "rollsim/common/atomic_file.hpp"
 #include "rollsim/common/json.hpp"
 #include "rollsim/report/gnuplot.hpp"
 #include "rollsim/report/table.hpp"
@@ -122,10 +123,13 @@ void plot(const validate::Validation& v, const std::string& file) {
     lo = std::min({lo, o.measured, o.predicted});
     hi = std::max({hi, o.measured, o.predicted});
   }
-  const fs::path tmp_out = dir / ("." + target.filename().string() + ".tmp" + std::to_string(getpid()) + ext);
+  // gnuplot draws in the scratch folder, and the figure is then written as every output is (atomically, under the
+  // user's path as given): a path with a line break was turned into another name by gnuplot's quoting, and a stray
+  // temporary file was left beside it (session 21).
+  const fs::path figure = work / "figure.svg";
   std::ofstream gp(work / "plot.gp");
   gp << report::gnuplot_terminal("svg size 800,700 dynamic font 'Sans,12'")
-     << "set output " << report::gnuplot_string(tmp_out.string()) << "\n"
+     << "set output " << report::gnuplot_string(figure.string()) << "\n"
      << "set title 'EPA Test Car List 2022: rollsim from certification data against the dynamometer'\n"
      << "set xlabel 'measured [mpg or mpge]'\nset ylabel 'predicted [mpg or mpge]'\n"
      << "set logscale xy\nset grid\nset key top left\nset size square\n";
@@ -141,10 +145,11 @@ void plot(const validate::Validation& v, const std::string& file) {
   gp << "\n";
   gp.close();
   const std::string err = report::run_gnuplot_script(gnuplot, (work / "plot.gp").string());
-  if (err.empty()) fs::rename(tmp_out, target, ec);
-  fs::remove(tmp_out);
   if (!err.empty()) throw InputError("--plot " + file, "gnuplot failed: " + err);
-  if (ec) throw InputError("--plot " + file, "cannot replace the file: " + ec.message());
+  std::ifstream in(figure, std::ios::binary);
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  write_file_atomically(file, "--plot", [&](std::ostream& out) { out << bytes.str(); });
 }
 
 void run_validate(const ValidateOptionsText& o, const ProcessGroup& group) {
