@@ -275,7 +275,8 @@ SkipReason check_configuration(const EpaTestRow& r, std::string& detail) {
   const double litres = std::round(*r.displacement_m3 * 1e3 * 1e9) / 1e9;
   if (litres < 0.6 || litres > 9.0) return absurd(detail, "displacement [l]", litres, "0.6-9 l");
   if (r.transmission == EpaTransmission::other) {
-    detail = "Tested Transmission Type '" + r.transmission_text + "' (automatic, CVT, manual or automated manual)";
+    detail = "Tested Transmission Type '" + r.transmission_text + "' (allowed: the list's Automatic, Semi-Automatic, "
+             "Continuously Variable, Manual, Automated Manual and their Selectable forms)";
     return SkipReason::absurd_field;
   }
   if (r.transmission != EpaTransmission::cvt) {

@@ -184,7 +184,8 @@ std::vector<EpaTestRow> read_epa_test_car_list(const std::string& path) {
     if (const auto v = number(c_disp)) r.displacement_m3 = *v * units::kM3PerLitre;
     if (const auto v = number(c_hp)) r.rated_power_w = *v * units::kWPerHp;
     // Any whole number is kept, so that a negative count is skipped as outside its range, not as missing.
-    if (const auto v = number(c_gears); v && *v == std::floor(*v) && std::abs(*v) < 100) r.gears = static_cast<int>(*v);
+    // (100 gears read as "missing" until session 21: only whole numbers under 100 were kept.)
+    if (const auto v = number(c_gears); v && *v == std::floor(*v) && std::abs(*v) < 1e6) r.gears = static_cast<int>(*v);
     if (const auto v = number(c_nv)) r.engine_radps_per_mps = *v * units::kRadpsPerRpm / kMpsPerMph;
     if (const auto v = number(c_a)) r.road_a_n = *v * kNPerLbf;
     if (const auto v = number(c_b)) r.road_b_n_s_per_m = *v * kNPerLbf / kMpsPerMph;
