@@ -884,7 +884,9 @@ TEST(CliValidate, TheFieldsTheRulesReadAreCheckedNotAssumed) {
   for (const auto& [column, value, said] :
        {std::tuple<std::string, std::string, std::string>{"Drive System Description", "Banana", "Drive System Description 'Banana'"},
         {"FE_UNIT", "gpm", "FE_UNIT 'gpm'"},
-        {"Analytically Derived FE?", "maybe", "Analytically Derived FE? 'maybe'"}}) {
+        {"Analytically Derived FE?", "maybe", "Analytically Derived FE? 'maybe'"},
+        {"# of Gears", "100", "# of Gears of a stepped transmission = 100 (allowed 2-10)"},
+        {"Tested Transmission Type", "CVT", "the list's Automatic, Semi-Automatic, Continuously Variable"}}) {
     const auto r = run_with(column, value);
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_EQ(r.out.find("\"error_pct\": "), std::string::npos) << r.out;
