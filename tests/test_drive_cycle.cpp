@@ -227,11 +227,33 @@ TEST_F(DriveCycleFiles, ElevationBecomesGradeOverDistance) {
   s += 5.0;
   text += "102,0," + std::to_string(100 + 0.1 * s) + "\n103,0," + std::to_string(100 + 0.1 * s) + "\n";
   const auto c = load_cycle(write("climb.csv", text));
-  for (double t : {0.0, 5.0, 50.0, 95.0, 103.0}) EXPECT_NEAR(c.grade_at(t), 0.10, 1e-9) << t;
+  // 0.1 m per metre along the road is the slope's sine; the cycle's grade is its tangent, rise over run.
+  const double tangent = 0.10 / std::sqrt(1.0 - 0.10 * 0.10);
+  for (double t : {0.0, 5.0, 50.0, 95.0, 103.0}) EXPECT_NEAR(c.grade_at(t), tangent, 1e-9) << t;
   for (double g : c.grade) {
     EXPECT_TRUE(std::isfinite(g));
-    EXPECT_NEAR(g, 0.10, 1e-9);
+    EXPECT_NEAR(g, tangent, 1e-9);
   }
+}
+
+// A route that ends where it began climbs nothing net: the grade's blocks partition the route, so the rise each
+// books (sine times distance) adds up to the elevation's own change, here 0, whatever the noise between. A window
+// grown about each sample, mostly backwards, read the hill a sample late and booked a net climb.
+TEST_F(DriveCycleFiles, AClosedRouteBooksNoNetClimb) {
+  std::string text = "time_s,speed_kmh,elevation_m\n";
+  for (int t = 0; t <= 400; ++t) {
+    const double hill_m = 20.0 * std::sin(3.14159265358979 * t / 200.0) + 0.3 * ((t * 7919) % 11 - 5) / 5.0;
+    text += std::to_string(t) + ",36," + std::to_string(t == 0 || t == 400 ? 0.0 : hill_m) + "\n";
+  }
+  const auto c = load_cycle(write("loop.csv", text));
+  double climb_m = 0.0, max_grade = 0.0;
+  for (std::size_t i = 0; i + 1 < c.time_s.size(); ++i) {
+    const double run_m = 0.5 * (c.speed_mps[i] + c.speed_mps[i + 1]) * (c.time_s[i + 1] - c.time_s[i]);
+    climb_m += run_m * c.grade[i] / std::sqrt(1.0 + c.grade[i] * c.grade[i]);
+    max_grade = std::max(max_grade, std::abs(c.grade[i]));
+  }
+  EXPECT_NEAR(climb_m, 0.0, 1e-9);
+  EXPECT_GT(max_grade, 0.025);  // the hill and the dip are there (+-20 m over 4 km: up to 3.1 %)
 }
 
 TEST_F(DriveCycleFiles, BadInputNamesFileLineColumnAndValue) {

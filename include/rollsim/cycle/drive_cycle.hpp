@@ -61,9 +61,10 @@ struct DriveCycle {
   double grade_at(double t, std::size_t& hint) const;
 };
 
-/// Interior sample times where the piecewise-linear speed changes slope (kinks) or a standstill begins, in
-/// increasing order; the first and last sample times are not included. An integrator uses them as stop times so
-/// that it never steps across a discontinuity of the acceleration.
+/// Interior sample times where the piecewise-linear speed changes slope (kinks), a standstill begins, or what a
+/// segment holds besides its speed changes (grade, engine_off, accessories_on, heading), in increasing order; the first
+/// and last sample times are not included. An integrator uses them as stop times so that it never steps across a
+/// discontinuity of the power.
 std::vector<double> breakpoints_s(const DriveCycle& cycle);
 /// Times, in increasing order, where the piecewise-linear speed crosses `speed_mps` (reaching it at an interior
 /// sample counts; the last sample does not), only while it falls if `falling_only`: where a powertrain's regime
