@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <tuple>
 
 #include "rollsim/common/text.hpp"
 #include "test_support.hpp"
@@ -367,6 +368,26 @@ TEST_F(Hardening, AYamlFileIsOneDocumentOfText) {
   r = run_rollsim("tyre '" + nul + "'");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_TRUE(has(r.err, nul + ": line 2: holds a NUL byte")) << r.err;
+}
+
+// A document that opens with a ',' (or another token no node starts with) sent yaml-cpp's LoadAll round an endless
+// loop of empty documents, memory growing until the process was killed: the tyre fuzzer's ",name: x" (session 22).
+// One named error, at once, whatever the file.
+TEST_F(Hardening, AYamlFileOpeningWithAFlowIndicatorIsRefusedNotLoopedOn) {
+  for (const auto& [name, text, line] : {std::tuple{"comma.yaml", std::string(",name: x\n"), 1},
+                                         std::tuple{"comment.yaml", std::string("# a tyre\n\n  , size: x\n"), 3},
+                                         std::tuple{"bracket.yaml", std::string("]\n"), 1},
+                                         std::tuple{"second.yaml", std::string("name: a\n---\n,\n"), 3}}) {
+    const std::string file = write(name, text);
+    const CmdResult r = run_rollsim("tyre '" + file + "'");
+    EXPECT_EQ(r.exit_code, 2) << name;
+    EXPECT_TRUE(has(r.err, file + ": line " + std::to_string(line))) << r.err;
+    EXPECT_TRUE(r.out.empty()) << r.out;
+  }
+  const std::string vehicle = write("vehicle.yaml", ",\n");
+  const CmdResult r = run_rollsim("simulate --vehicle '" + vehicle + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, vehicle + ": line 1: malformed YAML: no key or value can start with ','")) << r.err;
 }
 
 // Well-formed UTF-8 passes unchanged; each byte of a malformed sequence becomes U+FFFD (RFC 3629's table).
