@@ -436,6 +436,63 @@ TEST(J2452, CommonShapeBoundLiesBetweenHalfTheWidestPairAndTheBestShapeFound) {
   EXPECT_GT(worst_constant, b.worst_log_rms);
 }
 
+TEST(J2452, NearestMixOfKnownShapes) {
+  Eigen::MatrixXd shapes(2, 4);
+  shapes << 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0;
+  Eigen::VectorXd inside(4);
+  inside << 3.5, 3.5, 3.0, 3.0;  // half of each, 3 higher: a mix at another level
+  const NearestMix a = nearest_mix(shapes, inside);
+  EXPECT_NEAR(a.log_rms, 0.0, 1e-7);
+  EXPECT_NEAR(a.rms, 0.0, 1e-7);
+  EXPECT_NEAR(a.weights[0], 0.5, 1e-6);
+  Eigen::VectorXd outside(4);
+  outside << 0.0, 0.0, 1.0, 0.0;
+  // Centred, the mix w a + (1 - w) b misses it by (w, 1 - w, -1, 0): least at w = 1/2, sqrt(1.5 / 4).
+  const NearestMix b = nearest_mix(shapes, outside);
+  EXPECT_NEAR(b.log_rms, std::sqrt(1.5 / 4.0), 1e-7);
+  EXPECT_NEAR(b.weights[0], 0.5, 1e-6);
+  EXPECT_NEAR(b.weights.sum(), 1.0, 1e-12);
+  // On the simplex: the point of it nearest p minimises |w|^2 - 2 p'w; a p outside it lands on its edge.
+  Eigen::VectorXd p(3);
+  p << 1.0, 0.5, -1.0;
+  const Eigen::VectorXd w = minimise_on_simplex(Eigen::MatrixXd::Identity(3, 3), -2.0 * p);
+  EXPECT_NEAR(w[0], 0.75, 1e-7);
+  EXPECT_NEAR(w[1], 0.25, 1e-7);
+  EXPECT_NEAR(w[2], 0.0, 1e-12);
+}
+
+// Every tyre seen is itself a mix of the shapes seen (all weight on it), so the bound can be no worse than the
+// nearest single tyre at its best level; and the measured sets make it large for one tyre: no prediction that
+// stays among the other eight tyres' shapes comes within 5 % of P225/60R16 HI, which is why issue 12's worst-tyre
+// target is out of reach from one point on these data.
+TEST(J2452, SeenShapesBoundIsNoWorseThanTheNearestTyreSeen) {
+  const auto sets = load_j2452_csv(kJ2452Csv);
+  const OperatingGrid grid = j2452_grid();
+  std::vector<std::vector<double>> shapes;
+  for (const auto& s : sets) {
+    const double ref = j2452_flat_rrc(s, 2.1e5, 4000.0, 80 / 3.6, kJ2452DrumRadius_m);
+    std::vector<double> x;
+    for (const auto& pt : sample_j2452(s, grid, kJ2452DrumRadius_m, s.name)) x.push_back(std::log(pt.rrc / ref));
+    shapes.push_back(x);
+  }
+  const auto& tyres = evaluation().tyres;
+  ASSERT_EQ(tyres.size(), sets.size());
+  for (std::size_t i = 0; i < sets.size(); ++i) {
+    double nearest = 1e9;
+    for (std::size_t j = 0; j < sets.size(); ++j) {
+      if (j == i) continue;
+      double mean = 0.0, sq = 0.0;
+      for (std::size_t g = 0; g < shapes[i].size(); ++g) mean += (shapes[j][g] - shapes[i][g]) / shapes[i].size();
+      for (std::size_t g = 0; g < shapes[i].size(); ++g) sq += std::pow(shapes[j][g] - shapes[i][g] - mean, 2);
+      nearest = std::min(nearest, std::sqrt(sq / shapes[i].size()));
+    }
+    EXPECT_LE(tyres[i].seen_shapes.log_rms, nearest + 1e-9) << tyres[i].name;
+    EXPECT_GE(tyres[i].seen_shapes.log_rms, 0.0);
+    EXPECT_NEAR(tyres[i].seen_shapes.weights.sum(), 1.0, 1e-9);
+    if (tyres[i].name == "P225/60R16 HI") EXPECT_GT(tyres[i].seen_shapes.rms, 0.05);
+  }
+}
+
 TEST(J2452, FullFitFollowsEachSurfaceAndItsMeasuredExponents) {
   for (const auto& e : evaluation().tyres) {
     EXPECT_LT(e.full_fit_rms, 0.01) << e.name;

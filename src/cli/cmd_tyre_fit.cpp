@@ -164,6 +164,15 @@ void print_one_point_table(const J2452Evaluation& ev) {
             << pct(b.worst_log_rms) << " % (RMS of the log ratio); the best such shape's relative RMS error per tyre, as the table's:";
   for (std::size_t i = 0; i < b.rms.size(); ++i) std::cout << (i ? ", " : " ") << pct(b.rms[i]);
   std::cout << " %\n";
+  std::cout << "best mix of the shapes seen in hindsight (each tyre's nearest mix of the "
+            << (ev.leave_one_out ? "other tyres'" : "training sets'")
+            << " shapes, level free, chosen with its own grid in hand: no prediction that stays among the shapes seen does "
+               "better), relative RMS error per tyre, as the table's:";
+  for (std::size_t i = 0; i < ev.tyres.size(); ++i) std::cout << (i ? ", " : " ") << pct(ev.tyres[i].seen_shapes.rms);
+  const auto hardest = std::max_element(ev.tyres.begin(), ev.tyres.end(), [](const TyreEvaluation& a, const TyreEvaluation& b) {
+    return a.seen_shapes.log_rms < b.seen_shapes.log_rms;
+  });
+  std::cout << " %; worst " << hardest->name << " >= " << pct(hardest->seen_shapes.log_rms) << " % (RMS of the log ratio)\n";
 }
 
 // What more measured points buy: one row per measurement plan.

@@ -177,55 +177,83 @@ HysteresisConstants fit_shared_constants(const std::vector<J2452Set>& training, 
   return constants(least_squares(residuals, m, x0).x);
 }
 
-EnclosingBall smallest_enclosing_ball(const Eigen::MatrixXd& shapes) {
-  const Eigen::Index n = shapes.rows();
-  const Eigen::MatrixXd gram = shapes * shapes.transpose() / static_cast<double>(shapes.cols());
+Eigen::VectorXd minimise_on_simplex(const Eigen::MatrixXd& q, const Eigen::VectorXd& c) {
+  const Eigen::Index n = q.rows();
   Eigen::VectorXd w = Eigen::VectorXd::Constant(n, 1.0 / n);
-  // The dual f(w) = sum w_i G_ii - w'Gw is concave; every w on the simplex gives a lower bound on the radius^2
-  // (for any centre, the largest squared distance is at least the w-weighted mean one, itself at least f(w)).
   // Frank-Wolfe with away steps (Lacoste-Julien and Jaggi 2015), which converges linearly here where the plain
   // method crawls towards a face of the simplex.
   for (int iter = 0; iter < 100000; ++iter) {
-    const Eigen::VectorXd grad = gram.diagonal() - 2.0 * gram * w;
+    const Eigen::VectorXd grad = 2.0 * q * w + c;
     const double at_w = grad.dot(w);
     Eigen::Index j = 0, k = -1;
-    grad.maxCoeff(&j);
+    grad.minCoeff(&j);
     for (Eigen::Index i = 0; i < n; ++i) {
-      if (w[i] > 0.0 && (k < 0 || grad[i] < grad[k])) k = i;
+      if (w[i] > 0.0 && (k < 0 || grad[i] > grad[k])) k = i;
     }
-    if (k < 0 || !std::isfinite(grad[j])) throw std::logic_error("smallest_enclosing_ball: shapes not finite");
-    if (grad[j] - at_w < 1e-15) break;  // the duality gap: w is optimal to round-off
+    if (k < 0 || !std::isfinite(grad[j])) throw std::logic_error("minimise_on_simplex: not finite");
+    if (at_w - grad[j] < 1e-15) break;  // the duality gap: w is optimal to round-off
     Eigen::VectorXd d = -w;
     double max_step = 1.0;
-    if (grad[j] - at_w >= at_w - grad[k]) {
+    if (at_w - grad[j] >= grad[k] - at_w) {
       d[j] += 1.0;
     } else {
       d = w;
       d[k] -= 1.0;
       max_step = w[k] / (1.0 - w[k]);
     }
-    const double curvature = d.dot(gram * d);
+    const double curvature = d.dot(q * d);
     if (curvature <= 0.0) break;
-    w += std::clamp(grad.dot(d) / (2.0 * curvature), 0.0, max_step) * d;
+    w += std::clamp(-grad.dot(d) / (2.0 * curvature), 0.0, max_step) * d;
   }
+  return w;
+}
+
+EnclosingBall smallest_enclosing_ball(const Eigen::MatrixXd& shapes) {
+  const Eigen::MatrixXd gram = shapes * shapes.transpose() / static_cast<double>(shapes.cols());
+  // The dual, max sum w_i G_ii - w'Gw over the simplex, is concave; every w on it gives a lower bound on the
+  // radius^2 (for any centre, the largest squared distance is at least the w-weighted mean one, itself at least
+  // the dual's value), and its maximiser weights the points that lie on the ball.
+  const Eigen::VectorXd w = minimise_on_simplex(gram, -gram.diagonal());
   EnclosingBall ball;
   ball.centre = shapes.transpose() * w;
   ball.radius = std::sqrt(std::max(0.0, gram.diagonal().dot(w) - w.dot(gram * w)));
   return ball;
 }
 
+NearestMix nearest_mix(const Eigen::MatrixXd& shapes, const Eigen::VectorXd& target) {
+  const double cols = static_cast<double>(shapes.cols());
+  // A free level is a constant added over the grid: centring every row and the target removes it.
+  const Eigen::MatrixXd a = shapes.colwise() - shapes.rowwise().mean();
+  const Eigen::VectorXd y = target.array() - target.mean();
+  const Eigen::VectorXd w = minimise_on_simplex(a * a.transpose() / cols, -2.0 * a * y / cols);
+  NearestMix out;
+  out.weights = w;
+  out.log_rms = std::sqrt((a.transpose() * w - y).squaredNorm() / cols);
+  // The relative error of the mix at its best level: mean((e^(d+c) - 1)^2) is least where e^c = mean(e^d) / mean(e^2d).
+  const Eigen::ArrayXd ed = (shapes.transpose() * w - target).array().exp();
+  const double level = ed.mean() / ed.square().mean();
+  out.rms = std::sqrt((ed * level - 1.0).square().mean());
+  return out;
+}
+
 namespace {
 
-// Each tyre's log-RRC over the grid relative to its own reference point: its shape, as a one-point fit sees it.
-CommonShapeBound common_shape_bound(const std::vector<J2452Set>& sets, double drum_radius_m) {
+// Each tyre's log-RRC over the grid relative to its own reference point (one row per set): its shape, as a
+// one-point fit sees it.
+Eigen::MatrixXd log_shapes(const std::vector<J2452Set>& sets, double drum_radius_m) {
   const OperatingGrid grid = j2452_grid();
-  std::vector<std::vector<RrcPoint>> truth;
-  for (const auto& s : sets) truth.push_back(sample_j2452(s, grid, drum_radius_m, s.name));
-  Eigen::MatrixXd shapes(static_cast<Eigen::Index>(sets.size()), static_cast<Eigen::Index>(truth.front().size()));
+  Eigen::MatrixXd shapes;
   for (std::size_t i = 0; i < sets.size(); ++i) {
+    const auto truth = sample_j2452(sets[i], grid, drum_radius_m, sets[i].name);
+    if (i == 0) shapes.resize(static_cast<Eigen::Index>(sets.size()), static_cast<Eigen::Index>(truth.size()));
     const double ref = j2452_flat_rrc(sets[i], kRefPressure_pa, kRefLoad_n, kRefSpeed_mps, drum_radius_m);
-    for (std::size_t g = 0; g < truth[i].size(); ++g) shapes(i, g) = std::log(truth[i][g].rrc / ref);
+    for (std::size_t g = 0; g < truth.size(); ++g) shapes(i, g) = std::log(truth[g].rrc / ref);
   }
+  return shapes;
+}
+
+CommonShapeBound common_shape_bound(const std::vector<J2452Set>& sets, double drum_radius_m) {
+  const Eigen::MatrixXd shapes = log_shapes(sets, drum_radius_m);
   const EnclosingBall ball = smallest_enclosing_ball(shapes);
   CommonShapeBound out;
   out.worst_log_rms = ball.radius;
@@ -287,13 +315,16 @@ J2452Evaluation evaluate_j2452(const std::vector<J2452Set>& sets, double drum_ra
   out.shared_all = fit_shared_constants(sets, drum_radius_m);
   out.common_shape = common_shape_bound(sets, drum_radius_m);
   out.plans = j2452_measurement_plans();
+  const Eigen::MatrixXd shapes = log_shapes(sets, drum_radius_m);
   for (std::size_t i = 0; i < sets.size(); ++i) {
     std::vector<J2452Set> others;
+    std::vector<Eigen::Index> seen;
     for (std::size_t j = 0; j < sets.size(); ++j) {
-      if (j != i) others.push_back(sets[j]);
+      if (j != i) others.push_back(sets[j]), seen.push_back(static_cast<Eigen::Index>(j));
     }
     out.tyres.push_back(evaluate_tyre(sets[i], fit_shared_constants(others, drum_radius_m), others, out.shared_all,
                                       out.plans, drum_radius_m));
+    out.tyres.back().seen_shapes = nearest_mix(shapes(seen, Eigen::all), shapes.row(static_cast<Eigen::Index>(i)).transpose());
   }
   return out;
 }
@@ -305,8 +336,10 @@ J2452Evaluation evaluate_j2452_held_out(const std::vector<J2452Set>& training, c
   out.shared_all = fit_shared_constants(training, drum_radius_m);
   out.common_shape = common_shape_bound(test, drum_radius_m);
   out.plans = j2452_measurement_plans();
-  for (const auto& set : test) {
-    out.tyres.push_back(evaluate_tyre(set, out.shared_all, training, out.shared_all, out.plans, drum_radius_m));
+  const Eigen::MatrixXd seen = log_shapes(training, drum_radius_m), judged = log_shapes(test, drum_radius_m);
+  for (std::size_t i = 0; i < test.size(); ++i) {
+    out.tyres.push_back(evaluate_tyre(test[i], out.shared_all, training, out.shared_all, out.plans, drum_radius_m));
+    out.tyres.back().seen_shapes = nearest_mix(seen, judged.row(static_cast<Eigen::Index>(i)).transpose());
   }
   return out;
 }
@@ -348,6 +381,8 @@ void write_j2452_evaluation_json(std::ostream& out, const J2452Evaluation& ev) {
                .add("thesis_rms_pct", 100.0 * e.thesis_rms)
                .add("constant_rms_pct", 100.0 * e.constant_rms)
                .add("median_shape_rms_pct", 100.0 * e.median_shape_rms)
+               .add("seen_shapes_bound_log_rms_pct", 100.0 * e.seen_shapes.log_rms)
+               .add("seen_shapes_bound_rms_pct", 100.0 * e.seen_shapes.rms)
                .add("measured", scaling_json(e.measured))
                .add("one_point", scaling_json(e.one_point))
                .add("full_fit", scaling_json(e.full_fit))

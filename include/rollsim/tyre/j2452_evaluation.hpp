@@ -39,6 +39,15 @@ struct MeasurementPlan {
 /// every pair of one extra speed and one extra pressure, both speeds, and both speeds with either pressure.
 std::vector<MeasurementPlan> j2452_measurement_plans();
 
+/// The mix of seen shapes nearest a target shape, level free: the weights (>= 0, summing to 1) of the rows of
+/// `shapes` whose weighted sum, shifted by a constant, is closest to `target` in RMS over the columns.
+struct NearestMix {
+  Eigen::VectorXd weights;
+  double log_rms = 0.0;  ///< RMS of the log ratio at the optimum: no mix at any level comes nearer
+  double rms = 0.0;      ///< RMS relative error of that mix at its best level
+};
+NearestMix nearest_mix(const Eigen::MatrixXd& shapes, const Eigen::VectorXd& target);
+
 struct TyreEvaluation {
   std::string name;
   bool flagged = false;            ///< the set's values were read with a correction (J2452Set::flagged)
@@ -53,6 +62,10 @@ struct TyreEvaluation {
   double median_shape_rms = 0.0;   ///< median J2452 exponents and speed terms of the other tyres, scaled
   std::vector<double> plan_rms;    ///< hysteresis model fitted to each measurement plan's points (J2452Evaluation::plans)
   SurfaceScaling measured, one_point, full_fit, thesis;
+  /// The bound of every predictor confined to the shapes of the tyres it saw (the others, or the training sets):
+  /// their mix nearest this tyre's own log-RRC shape over the grid, chosen in hindsight with its grid in hand. A
+  /// prediction from one point that stays among the shapes seen cannot come nearer this tyre than this.
+  NearestMix seen_shapes;
   HysteresisConstants shared;      ///< the shared constants it was judged with, fitted without this tyre
 };
 
@@ -71,6 +84,9 @@ struct J2452Evaluation {
   std::vector<MeasurementPlan> plans;
   CommonShapeBound common_shape;
 };
+
+/// The minimiser of w'Qw + c'w over the simplex (w >= 0, sum w = 1), Q symmetric positive semi-definite.
+Eigen::VectorXd minimise_on_simplex(const Eigen::MatrixXd& q, const Eigen::VectorXd& c);
 
 /// The smallest enclosing ball of `shapes` (rows), in RMS over the columns: its centre and radius. Frank-Wolfe on
 /// the dual over the simplex of the rows' weights, which needs only their Gram matrix.
