@@ -125,7 +125,7 @@ class WeakBrakes final : public Powertrain {
   int select_gear(double v, int g) const override { return inner_->select_gear(v, g); }
   double max_wheel_force_n(int g, double v, double r) const override { return inner_->max_wheel_force_n(g, v, r); }
   std::vector<double> shift_speeds_mps(int g) const override { return inner_->shift_speeds_mps(g); }
-  std::vector<double> braking_regime_speeds_mps() const override { return inner_->braking_regime_speeds_mps(); }
+  std::vector<double> braking_regime_speeds_mps(double r) const override { return inner_->braking_regime_speeds_mps(r); }
   const BatteryParams* battery() const override { return inner_->battery(); }
   const FuelParams* fuel() const override { return inner_->fuel(); }
   void add_electric_load(double power_w, PowerFlow& flow) const override { inner_->add_electric_load(power_w, flow); }

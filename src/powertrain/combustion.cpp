@@ -30,6 +30,16 @@ std::vector<double> CombustionPowertrain::shift_speeds_mps(int gear) const {
   return s;
 }
 
+// Braking in gear g, the engine is cut off above its cut-off speed and idles declutched below it.
+std::vector<double> CombustionPowertrain::braking_regime_speeds_mps(double wheel_radius_m) const {
+  const auto& g = p_.gearbox;
+  std::vector<double> s;
+  if (p_.engine.fuel_cut_min_speed_radps <= 0.0) return s;  // cut off at any speed
+  for (double r : g.ratios) s.push_back(p_.engine.fuel_cut_min_speed_radps * wheel_radius_m / (r * g.final_drive_ratio));
+  std::sort(s.begin(), s.end());
+  return s;
+}
+
 double CombustionPowertrain::max_wheel_force_n(int gear, double speed_mps, double wheel_radius_m) const {
   const auto& e = p_.engine;
   const auto& g = p_.gearbox;

@@ -45,6 +45,7 @@ ConventionalPowertrain::Operating ConventionalPowertrain::through(double ratio, 
   const auto& e = p_.engine;
   Operating op;
   op.ratio = ratio;
+  op.gear = t.kind == TransmissionKind::cvt ? 0 : gear;
   const double turbine_radps = wheel_speed_radps * ratio;
   const double turbine_nm = wheel_torque_nm / (ratio * t.efficiency) + t.spin_loss_nm;
   const bool converter = t.kind != TransmissionKind::clutch;
@@ -138,6 +139,41 @@ void ConventionalPowertrain::add_electric_load(double power_w, PowerFlow& flow) 
   add_alternator_load(power_w, p_.alternator_efficiency, map_.part_load_marginal_efficiency(), p_.fuel, flow);
 }
 
+bool ConventionalPowertrain::fuel_cut_off(double speed_mps, double wheel_radius_m, Operating& coasting) const {
+  const auto& e = p_.engine;
+  coasting = operate(0.0, speed_mps / wheel_radius_m);
+  return coasting.locked && coasting.engine_speed_radps > e.fuel_cut_min_speed_radps &&
+         speed_mps > e.fuel_cut_min_vehicle_speed_mps;
+}
+
+// Where fuel_cut_off changes its answer. Coasting, the gearbox picks its ratio from the speed alone, so the answer
+// can change only where the vehicle speed passes its threshold or an input speed in some ratio passes one of the
+// engine speeds the choice and the lock-up compare with; of those candidates, the ones where it does change.
+std::vector<double> ConventionalPowertrain::braking_regime_speeds_mps(double wheel_radius_m) const {
+  const auto& e = p_.engine;
+  const auto& t = p_.transmission;
+  std::vector<double> candidates{e.fuel_cut_min_vehicle_speed_mps};
+  for (double engine_radps : {t.min_engine_speed_radps, t.converter.lockup_min_speed_radps, e.fuel_cut_min_speed_radps,
+                              e.idle_speed_radps}) {
+    for (double ratio : t.ratios) candidates.push_back(engine_radps * wheel_radius_m / ratio);
+  }
+  std::sort(candidates.begin(), candidates.end());
+  candidates.erase(std::remove_if(candidates.begin(), candidates.end(), [](double v) { return !(v > 0.0); }), candidates.end());
+  candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+  // The answer is constant between neighbouring candidates: read it once in each gap, and keep the candidates
+  // between two gaps that differ (once per replay of every validate row, so the reading is not doubled).
+  std::vector<double> s;
+  Operating op;
+  bool below = fuel_cut_off(0.5 * candidates.front(), wheel_radius_m, op);
+  for (std::size_t k = 0; k < candidates.size(); ++k) {
+    const double next = k + 1 < candidates.size() ? 0.5 * (candidates[k] + candidates[k + 1]) : 2.0 * candidates[k];
+    const bool above = fuel_cut_off(next, wheel_radius_m, op);
+    if (above != below) s.push_back(candidates[k]);
+    below = above;
+  }
+  return s;
+}
+
 PowerFlow ConventionalPowertrain::deliver(double wheel_force_n, double speed_mps, int gear, double wheel_radius_m) const {
   const auto& e = p_.engine;
   const double v = std::max(speed_mps, 0.0);
@@ -159,6 +195,7 @@ PowerFlow ConventionalPowertrain::deliver(double wheel_force_n, double speed_mps
     engine_radps = op.engine_speed_radps;
     engine_nm = op.engine_torque_nm;
     out.gear_ratio = op.ratio;
+    out.engaged_gear = op.gear;
   } else {
     // Braking, coasting or standing: friction brakes hold the car. Coupled above the cut-off speeds (engine and
     // road) the engine is motored without fuel and the wheels carry the accessories too (all booked as braking);
@@ -166,8 +203,10 @@ PowerFlow ConventionalPowertrain::deliver(double wheel_force_n, double speed_mps
     out.wheel_force_n = wheel_force_n;
     out.friction_brake_power_w = -wheel_force_n * v;
     if (v > 0.0) {
-      const Operating op = operate(0.0, wheel_radps);
-      if (op.locked && op.engine_speed_radps > e.fuel_cut_min_speed_radps && v > e.fuel_cut_min_vehicle_speed_mps) {
+      Operating op;
+      const bool cut_off = fuel_cut_off(v, wheel_radius_m, op);
+      out.engaged_gear = op.gear;
+      if (cut_off) {
         out.aux_power_w = 0.0;
         out.machine_speed_radps = op.engine_speed_radps;
         out.gear_ratio = op.ratio;

@@ -172,7 +172,7 @@ void ElectricPowertrain::add_electric_load(double power_w, PowerFlow& flow) cons
   flow.battery_terminal_power_w += power_w;
 }
 
-std::vector<double> ElectricPowertrain::braking_regime_speeds_mps() const {
+std::vector<double> ElectricPowertrain::braking_regime_speeds_mps(double /*wheel_radius_m*/) const {
   std::vector<double> s;
   if (p_.regen.min_speed_mps > 0.0) s.push_back(p_.regen.min_speed_mps);
   if (p_.regen.fade_speed_mps > p_.regen.min_speed_mps) s.push_back(p_.regen.fade_speed_mps);

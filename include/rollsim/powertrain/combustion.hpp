@@ -45,6 +45,7 @@ class CombustionPowertrain final : public Powertrain {
   PowerFlow deliver(double wheel_force_n, double speed_mps, int gear, double wheel_radius_m) const override;
   int select_gear(double speed_mps, int current_gear) const override;
   std::vector<double> shift_speeds_mps(int gear) const override;
+  std::vector<double> braking_regime_speeds_mps(double wheel_radius_m) const override;
   int num_gears() const override { return static_cast<int>(p_.gearbox.ratios.size()); }
   double max_wheel_force_n(int gear, double speed_mps, double wheel_radius_m) const override;
   const FuelParams* fuel() const override { return &p_.fuel; }

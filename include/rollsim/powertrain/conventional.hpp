@@ -64,6 +64,7 @@ class ConventionalPowertrain final : public Powertrain {
   PowerFlow deliver(double wheel_force_n, double speed_mps, int gear, double wheel_radius_m) const override;
   int select_gear(double, int) const override { return 0; }
   std::vector<double> shift_speeds_mps(int) const override { return {}; }
+  std::vector<double> braking_regime_speeds_mps(double wheel_radius_m) const override;
   double max_wheel_force_n(int gear, double speed_mps, double wheel_radius_m) const override;
   const FuelParams* fuel() const override { return &p_.fuel; }
   const EngineMap* engine_map() const override { return &map_; }
@@ -78,8 +79,11 @@ class ConventionalPowertrain final : public Powertrain {
     double engine_torque_nm = 0.0;   ///< brake torque at the crank for the driveline (accessories excluded)
     double slip_loss_w = 0.0;        ///< converter or clutch slip
     double ratio = 0.0;
+    int gear = 0;                    ///< the stepped gear engaged (1 = first); 0 for a CVT
     bool locked = true;
   };
+  /// Coasting or braking at `speed_mps`: the gearbox's choice at no torque, and whether the engine is cut off there.
+  bool fuel_cut_off(double speed_mps, double wheel_radius_m, Operating& coasting) const;
   Operating operate(double wheel_torque_nm, double wheel_speed_radps) const;
   Operating through(double ratio, int gear, double wheel_torque_nm, double wheel_speed_radps) const;
   double converter_pump_speed_radps(double turbine_speed_radps, double turbine_torque_nm) const;

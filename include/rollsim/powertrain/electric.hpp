@@ -66,7 +66,7 @@ class ElectricPowertrain final : public Powertrain {
   PowerFlow deliver(double wheel_force_n, double speed_mps, int gear, double wheel_radius_m) const override;
   int select_gear(double, int) const override { return 0; }
   std::vector<double> shift_speeds_mps(int) const override { return {}; }
-  std::vector<double> braking_regime_speeds_mps() const override;
+  std::vector<double> braking_regime_speeds_mps(double wheel_radius_m) const override;
   double max_wheel_force_n(int gear, double speed_mps, double wheel_radius_m) const override;
   const BatteryParams* battery() const override { return &p_.battery; }
   /// From the battery terminals (its own I^2 R for the extra current is neglected: under 1 % of the load at

@@ -50,6 +50,7 @@ struct PowerFlow {
   double battery_current_a = 0.0;       ///< signed: + discharging
   double machine_speed_radps = 0.0;     ///< motor or engine speed
   double machine_torque_nm = 0.0;       ///< motor or engine torque
+  int engaged_gear = 0;                 ///< the gear a powertrain that picks its own engaged (1 = first); 0 otherwise
   double gear_ratio = 0.0;              ///< the engaged gear's (or a CVT's) input per output speed; 0 when none is
   bool force_limited = false;           ///< true when the request exceeded what the powertrain can deliver
 };
@@ -80,9 +81,11 @@ class Powertrain {
   /// roots so it never steps over a shift. Empty for single-speed drives.
   virtual std::vector<double> shift_speeds_mps(int gear) const = 0;
 
-  /// Speeds [m/s] at which deliver() changes how it splits a braking force (the regen fade's ends): kinks of the
-  /// energies only, so a simulation splits its steps where a deceleration falls through them. Empty by default.
-  virtual std::vector<double> braking_regime_speeds_mps() const { return {}; }
+  /// Speeds [m/s] at which deliver() changes how it handles a braking force (the regen fade's ends, an overrun fuel
+  /// cut-off's road and engine speeds in the gears a braking car is in): kinks or steps of the energies only, which
+  /// the speed does not feel, so a simulation splits its steps where a deceleration falls through them. Ascending;
+  /// empty by default. `wheel_radius_m` as for deliver().
+  virtual std::vector<double> braking_regime_speeds_mps(double /*wheel_radius_m*/) const { return {}; }
 
   /// The traction battery, or nullptr when the powertrain has none.
   virtual const BatteryParams* battery() const { return nullptr; }
