@@ -193,6 +193,7 @@ std::vector<EpaTestRow> read_epa_test_car_list(const std::string& path) {
     r.measured = number(c_fe);
     for (int b = 0; b < 3; ++b) r.bag_mpg[b] = number(c_bag[b]);
     r.bag4_mpg = number(c_bag4);
+    if (!r.bag4_mpg && !trim(cells[c_bag4]).empty()) r.bag4_unreadable = trim(cells[c_bag4]);
     r.hc_g_per_mi = number(c_hc);
     r.co_g_per_mi = number(c_co);
     r.co2_g_per_mi = number(c_co2);

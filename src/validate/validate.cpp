@@ -92,7 +92,13 @@ bool name_says_hybrid(const EpaTestRow& r) {
 struct VehicleFacts {
   bool charge_depleting_on_fuel = false;
   bool four_bag_ftp = false;  ///< an FTP of this vehicle was run with four bags, as hybrids are (SAE J1711)
-  double ftp_mpg = 0.0, hwfet_mpg = 0.0;
+  std::string bag4_unreadable;  ///< ... or its FTP's FE Bag 4 is text the rule cannot read (read as no bag until session 22)
+  /// Its FTP and HWFET results per liquid fuel: the hybrid rule compares the two on one fuel (a flex-fuel car's
+  /// E85 highway against its petrol city figure read as a hybrid's: session 22's outside testing).
+  struct Economy {
+    double ftp_mpg = 0.0, hwfet_mpg = 0.0;
+  };
+  std::map<EpaFuel, Economy> economy;
   bool electric_result_in_mpge = false;  ///< a charge-depleting result above 60 MPG: MPGe, as the unit says
 };
 
@@ -108,12 +114,13 @@ std::map<std::string, VehicleFacts> vehicle_facts(const std::vector<EpaTestRow>&
     auto& v = f[vehicle_key(r)];
     if (charge_depleting(r.cycle) && liquid(r.fuel)) v.charge_depleting_on_fuel = true;
     if (r.cycle == EpaCycle::ftp75 && r.bag4_mpg && *r.bag4_mpg > 0.0) v.four_bag_ftp = true;
+    if (r.cycle == EpaCycle::ftp75 && !r.bag4_unreadable.empty()) v.bag4_unreadable = r.bag4_unreadable;
     if (charge_depleting(r.cycle) && r.fuel == EpaFuel::electricity && r.measured && *r.measured > kKwhPer100MiTo)
       v.electric_result_in_mpge = true;
     // Only results in a liquid-fuel car's plausible range inform the hybrid rule: an absurd one is skipped as such.
     if (!r.measured || !plausible_liquid_mpg(*r.measured) || !liquid(r.fuel)) continue;
-    if (r.cycle == EpaCycle::ftp75) v.ftp_mpg = *r.measured;
-    if (r.cycle == EpaCycle::hwfet) v.hwfet_mpg = *r.measured;
+    if (r.cycle == EpaCycle::ftp75) v.economy[r.fuel].ftp_mpg = *r.measured;
+    if (r.cycle == EpaCycle::hwfet) v.economy[r.fuel].hwfet_mpg = *r.measured;
   }
   return f;
 }
@@ -125,8 +132,8 @@ constexpr double kHybridHighwayOverCity = 1.10;
 // ---- the measured result against the row's own exhaust: EPA computes fuel economy from the carbon in it ----
 // 40 CFR 600.113: mpg = K / (0.866 HC + 0.429 CO + 0.273 CO2), g/mi; K = 2778 for diesel, and for petrol
 // 5174e4 CWF SG / (0.6 SG NHV + 5471) = 2421-2424 with the certification fuel's carbon fraction, density and heating
-// value (0.864, 0.745, 18,500 BTU/lb). Over this list the two agree to +-0.9 % (10th-90th percentile, petrol) and
-// exactly (diesel); a row off by more than kCarbonBalanceTolerance carries a result that is not its own test's.
+// value (0.864, 0.745, 18,500 BTU/lb). Over this list the two agree to -0.6..+1.1 % (10th-90th percentile, petrol) and
+// to -0.2..+0.2 % (diesel); a row off by more than kCarbonBalanceTolerance carries a result that is not its own test's.
 constexpr double kCarbonBalancePetrol = 2421.0, kCarbonBalanceDiesel = 2778.0, kCarbonBalanceTolerance = 0.05;
 
 std::optional<double> carbon_balance_mpg(const EpaTestRow& r) {
@@ -157,12 +164,17 @@ void classify(const EpaTestRow& r, const std::map<std::string, VehicleFacts>& fa
     if (charge_depleting(r.cycle) || v.charge_depleting_on_fuel)
       return skip(SkipReason::hybrid, "plug-in: charge-depleting tests on a liquid fuel");
     if (name_says_hybrid(r)) return skip(SkipReason::hybrid, "named so: '" + r.model + "'");
+    if (!v.bag4_unreadable.empty())
+      return skip(SkipReason::absurd_field, "its FTP's FE Bag 4 '" + v.bag4_unreadable +
+                                                "' is not a number, so whether it was run with four bags (a hybrid) is unknown");
     if (v.four_bag_ftp)
       return skip(SkipReason::hybrid, "its FTP was run with four bags (FE Bag 4 given), the hybrids' procedure of SAE "
                                       "J1711 (40 CFR 600.115-11(c)); mild (48 V) hybrids are tested so too");
-    if (v.ftp_mpg > 0.0 && v.hwfet_mpg > 0.0 && v.hwfet_mpg < kHybridHighwayOverCity * v.ftp_mpg)
-      return skip(SkipReason::hybrid, "city economy as good as highway: HWFET " + format_value(v.hwfet_mpg) +
-                                          " mpg < 1.1 x FTP " + format_value(v.ftp_mpg) + " mpg");
+    for (const auto& [fuel, e] : v.economy) {
+      if (e.ftp_mpg > 0.0 && e.hwfet_mpg > 0.0 && e.hwfet_mpg < kHybridHighwayOverCity * e.ftp_mpg)
+        return skip(SkipReason::hybrid, "city economy as good as highway: HWFET " + format_value(e.hwfet_mpg) +
+                                            " mpg < 1.1 x FTP " + format_value(e.ftp_mpg) + " mpg, both on " + to_string(fuel));
+    }
   } else if (!charge_depleting(r.cycle)) {
     return skip(SkipReason::other_procedure, "electric car on '" + r.procedure + "' (not a charge-depleting test)");
   }
@@ -451,7 +463,11 @@ Validation validate_epa_list(const std::vector<EpaTestRow>& rows, unsigned threa
     const auto& o = v.rows[i];
     const auto& r = rows[i];
     if (o.skip != SkipReason::none || !o.fitting_half || r.fuel != EpaFuel::petrol || r.cycle != EpaCycle::ftp75) continue;
-    if (!r.bag_mpg[0] || !r.bag_mpg[2] || *r.bag_mpg[0] <= 0.0 || raw[i].cold_extra_per_k_m3 <= 0.0) continue;
+    // Both bags must be results a car can have: a bag 3 of 0, -20.9 or 999 moved the fitted excess in silence while
+    // such a bag 1 was dropped (session 22's outside testing).
+    if (!r.bag_mpg[0] || !r.bag_mpg[2] || !plausible_liquid_mpg(*r.bag_mpg[0]) || !plausible_liquid_mpg(*r.bag_mpg[2]) ||
+        raw[i].cold_extra_per_k_m3 <= 0.0)
+      continue;
     ks.push_back((*r.bag_mpg[2] / *r.bag_mpg[0] - 1.0) * raw[i].bag1_hot_m3 / raw[i].cold_extra_per_k_m3);
   }
   f.cold_start_rows = ks.size();

@@ -62,6 +62,8 @@ struct EpaTestRow {
   /// FE Bag 4: given only where the FTP was run with four bags (the hot start as a whole UDDS), the hybrids'
   /// procedure of SAE J1711 (40 CFR 600.115-11(c)).
   std::optional<double> bag4_mpg;
+  /// FE Bag 4 as written where it is not a number ('n/a'): the four-bag rule cannot read it (empty otherwise).
+  std::string bag4_unreadable;
   /// THC, CO and CO2 [g/mi] as measured over the row's test; empty where the row gives none.
   std::optional<double> hc_g_per_mi, co_g_per_mi, co2_g_per_mi;
   /// "Analytically Derived FE?" Yes: the result was not measured on the vehicle the row describes. EPA derived it
