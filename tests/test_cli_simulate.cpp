@@ -31,6 +31,19 @@ TEST(CliSimulate, JsonHasTheDocumentedKeys) {
   }
 }
 
+// The energy table names what each row holds: a coast-down car's A + B v is its tyres and its driveline together, and
+// an automatic's slip is its torque converter's (both read "rolling resistance (tyres)" and "clutch slip at launch"
+// until session 22's outside testing).
+TEST(CliSimulate, TheEnergyTableNamesWhatTheRoadLoadAndTheSlipAre) {
+  const auto coastdown = run("simulate --vehicle camry_2018_map");
+  ASSERT_EQ(coastdown.exit_code, 0) << coastdown.text;
+  EXPECT_NE(coastdown.text.find("  rolling and driveline (coast-down A + B v)"), std::string::npos) << coastdown.text;
+  EXPECT_NE(coastdown.text.find("  clutch or converter slip"), std::string::npos) << coastdown.text;
+  EXPECT_EQ(coastdown.text.find("(tyres)"), std::string::npos) << coastdown.text;
+  const auto tyres = run("simulate --vehicle ice");
+  EXPECT_NE(tyres.text.find("  rolling resistance (tyres)"), std::string::npos) << tyres.text;
+}
+
 TEST(CliSimulate, SeveralTyresGiveOneTableWithDifferences) {
   const auto out = run("simulate --vehicle ice --tyre nominal --tyre low-rrc --cycle nedc");
   ASSERT_EQ(out.exit_code, 0) << out.text;

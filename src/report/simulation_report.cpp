@@ -102,7 +102,7 @@ std::string summary_text(const SimulationResult& r, bool solver_stats) {
     t.add_row({name, fixed(units::j_to_kwh(j), 4), of_j != 0.0 ? fixed(100.0 * j / of_j, 1) : "-"});
   };
   row("at the wheels: traction", e.traction_j, traction_scale_j);
-  row("  rolling resistance (tyres)", e.rolling_j, traction_scale_j);
+  row("  " + r.rolling_term, e.rolling_j, traction_scale_j);
   row("  aerodynamic drag", e.aero_j, traction_scale_j);
   if (e.grade_j != 0.0) row("  grade (net climb)", e.grade_j, traction_scale_j);
   if (e.other_resistance_j != 0.0) row("  other resistance (effects)", e.other_resistance_j, traction_scale_j);
@@ -124,7 +124,7 @@ std::string summary_text(const SimulationResult& r, bool solver_stats) {
     row("  engine loss (heat, friction)", e.engine_loss_j, source_j);
     row("  traction", e.traction_j, source_j);
     row("  gearbox and final drive", e.gearbox_loss_j, source_j);
-    row("  clutch slip at launch", e.clutch_loss_j, source_j);
+    row("  clutch or converter slip", e.clutch_loss_j, source_j);
     row("  accessories (alternator)", e.aux_j, source_j);
   }
   o << t.render();

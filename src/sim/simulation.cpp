@@ -19,6 +19,7 @@ VehicleModel VehicleModel::assemble(const Vehicle& vehicle) {
   m.wheel_radius_m = driven_wheel_radius_m(vehicle);
   m.road_load = make_road_load(vehicle);
   m.road_load_description = m.road_load->describe();
+  m.rolling_term = m.road_load->rolling_term();
   m.flat_road_load = m.road_load->at_grade(0.0);
   m.powertrain = make_powertrain(vehicle);
   const EffectContext context = effect_context(vehicle);
@@ -31,6 +32,7 @@ VehicleModel VehicleModel::with_tyres_of(const VehicleModel& base, const Vehicle
   m.wheel_radius_m = driven_wheel_radius_m(vehicle);
   m.road_load = make_road_load(vehicle);
   m.road_load_description = m.road_load->describe();
+  m.rolling_term = m.road_load->rolling_term();
   m.flat_road_load = m.road_load->at_grade(0.0);
   return m;
 }
@@ -271,6 +273,7 @@ void finish_result(const VehicleModel& m, const DriveCycle& c, double distance_m
                    double v_end, SimulationResult& r) {
   r.vehicle = m.name;
   r.road_load = m.road_load_description;
+  r.rolling_term = m.rolling_term;
   r.cycle = c.name;
   r.duration_s = c.duration_s();
   r.distance_m = distance_m;

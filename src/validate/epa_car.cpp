@@ -330,6 +330,7 @@ VehicleModel car_from_row(const EpaTestRow& listed, const EpaDefaults& d) {
   m.wheel_radius_m = kWheelRadius_m;
   m.road_load = make_road_load(v);
   m.road_load_description = m.road_load->describe();
+  m.rolling_term = m.road_load->rolling_term();
   m.flat_road_load = m.road_load->at_grade(0.0);
   m.powertrain = row.fuel == EpaFuel::electricity ? electric_of(row) : conventional_of(row, d);
   return m;

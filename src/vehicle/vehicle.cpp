@@ -388,6 +388,7 @@ class TyreRoadLoad final : public RoadLoadModel {
     return front_.name == rear_.name ? "tyre model, 4 x " + front_.name
                                      : "tyre model, front " + front_.name + ", rear " + rear_.name;
   }
+  std::string rolling_term() const override { return "rolling resistance (tyres)"; }
 
  private:
   // A tyre outside its model's domain at this car's load is named with its axle and file.
@@ -415,6 +416,8 @@ class CoastdownRoadLoad final : public RoadLoadModel {
     return r;
   }
   std::string describe() const override { return "coast-down A + B v + C v^2"; }
+  // A coast-down's A + B v is the tyres' rolling resistance and the driveline's drag together.
+  std::string rolling_term() const override { return "rolling and driveline (coast-down A + B v)"; }
 
  private:
   CoastdownParams c_;

@@ -20,6 +20,7 @@ namespace rollsim {
 struct VehicleModel {
   std::string name;
   std::string road_load_description;
+  std::string rolling_term;        ///< road_load->rolling_term(), as the energy table names it
   double mass_kg = 0.0;             ///< test mass (grade and inertia)
   double rotating_mass_kg = 0.0;    ///< equivalent mass of rotating parts (inertia only)
   double wheel_radius_m = 0.0;      ///< effective rolling radius of the driven wheels
@@ -149,6 +150,7 @@ struct FuelFigures {
 struct SimulationResult {
   std::string vehicle;
   std::string road_load;
+  std::string rolling_term = "rolling resistance (tyres)";  ///< what the rolling energy holds (RoadLoadModel)
   std::string cycle;
   std::string mode;  ///< "forward" or "replay"
   double duration_s = 0.0;

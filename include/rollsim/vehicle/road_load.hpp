@@ -31,6 +31,8 @@ class RoadLoadModel {
   virtual RoadLoadCoeffs at_grade(double grade) const = 0;
   /// One line for reports, e.g. "tyre model: 4 x nominal" or "coast-down A/B/C".
   virtual std::string describe() const = 0;
+  /// What its rolling term (the RoadLoadCoeffs' rolling part) holds, for an energy table's row.
+  virtual std::string rolling_term() const = 0;
 };
 
 }  // namespace rollsim
