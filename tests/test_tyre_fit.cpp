@@ -405,12 +405,10 @@ TEST(J2452, SmallestEnclosingBallOfKnownPointSets) {
   EXPECT_NEAR(b.centre[1], 1.0 / std::sqrt(3.0), 1e-5);
 }
 
-TEST(J2452, CommonShapeBoundLiesBetweenHalfTheWidestPairAndTheBestShapeFound) {
-  // The bound is a lower bound for any model giving every tyre one shape: it must lie between half the largest
-  // pairwise distance of two tyres' shapes and the worst error of the best shape found.
-  const auto sets = load_j2452_csv(kJ2452Csv);
-  const auto& b = evaluation().common_shape;
-  ASSERT_EQ(b.rms.size(), sets.size());
+// Each set's log-RRC over the grid relative to its own value at the one point (210 kPa, 4000 N, 80 km/h), computed
+// here from the J2452 law as sampled, not through the evaluation's own code.
+namespace {
+std::vector<std::vector<double>> log_shapes_of(const std::vector<J2452Set>& sets) {
   const OperatingGrid grid = j2452_grid();
   std::vector<std::vector<double>> shapes;
   for (const auto& s : sets) {
@@ -419,6 +417,17 @@ TEST(J2452, CommonShapeBoundLiesBetweenHalfTheWidestPairAndTheBestShapeFound) {
     for (const auto& pt : sample_j2452(s, grid, kJ2452DrumRadius_m, s.name)) x.push_back(std::log(pt.rrc / ref));
     shapes.push_back(x);
   }
+  return shapes;
+}
+}  // namespace
+
+TEST(J2452, CommonShapeBoundLiesBetweenHalfTheWidestPairAndTheBestShapeFound) {
+  // The bound is a lower bound for any model giving every tyre one shape: it must lie between half the largest
+  // pairwise distance of two tyres' shapes and the worst error of the best shape found.
+  const auto sets = load_j2452_csv(kJ2452Csv);
+  const auto& b = evaluation().common_shape;
+  ASSERT_EQ(b.rms.size(), sets.size());
+  const std::vector<std::vector<double>> shapes = log_shapes_of(sets);
   double half_widest = 0.0;
   for (std::size_t i = 0; i < shapes.size(); ++i) {
     for (std::size_t j = 0; j < i; ++j) {
@@ -467,14 +476,7 @@ TEST(J2452, NearestMixOfKnownShapes) {
 // target is out of reach from one point on these data.
 TEST(J2452, SeenShapesBoundIsNoWorseThanTheNearestTyreSeen) {
   const auto sets = load_j2452_csv(kJ2452Csv);
-  const OperatingGrid grid = j2452_grid();
-  std::vector<std::vector<double>> shapes;
-  for (const auto& s : sets) {
-    const double ref = j2452_flat_rrc(s, 2.1e5, 4000.0, 80 / 3.6, kJ2452DrumRadius_m);
-    std::vector<double> x;
-    for (const auto& pt : sample_j2452(s, grid, kJ2452DrumRadius_m, s.name)) x.push_back(std::log(pt.rrc / ref));
-    shapes.push_back(x);
-  }
+  const std::vector<std::vector<double>> shapes = log_shapes_of(sets);
   const auto& tyres = evaluation().tyres;
   ASSERT_EQ(tyres.size(), sets.size());
   for (std::size_t i = 0; i < sets.size(); ++i) {

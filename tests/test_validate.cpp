@@ -803,20 +803,28 @@ TEST(CliValidate, JsonRowsAndANamedErrorForAFileWithoutTheColumns) {
   for (const auto& row : test::lines(hj.out)) EXPECT_NE(row.find("\"maker_factor\": 1,"), std::string::npos) << row;
 }
 
+// A line of the list cut into its fields (a quoted field keeps its commas and quotes), and put back together.
+std::vector<std::string> csv_fields(const std::string& line) {
+  std::vector<std::string> out(1);
+  bool quoted = false;
+  for (const char ch : line) {
+    if (ch == '"') quoted = !quoted;
+    if (ch == ',' && !quoted) out.emplace_back();
+    else out.back() += ch;
+  }
+  return out;
+}
+std::string csv_join(const std::vector<std::string>& f) {
+  std::string out;
+  for (std::size_t i = 0; i < f.size(); ++i) out += (i ? "," : "") + f[i];
+  return out;
+}
+
 // A car the row's power cannot drive round the cycle was predicted in silence (a Colorado ZR2 diesel, line 1021,
 // set to 41 hp: 31.2 mpg on the US06 where its own 181 hp gives 21.2; session 21's outside testing). The dynamometer
 // driver keeps within 2 mph, so the row is skipped, naming the shortfall; the list's own rows all drive their cycles.
 TEST(CliValidate, ACarTooWeakForItsCycleIsSkippedNotPredicted) {
-  auto fields = [](const std::string& line) {
-    std::vector<std::string> out(1);
-    bool quoted = false;
-    for (const char ch : line) {
-      if (ch == '"') quoted = !quoted;
-      if (ch == ',' && !quoted) out.emplace_back();
-      else out.back() += ch;
-    }
-    return out;
-  };
+  const auto fields = csv_fields;
   std::ifstream in(kList);
   std::string header, line;
   std::getline(in, header);
@@ -849,23 +857,6 @@ TEST(CliValidate, ACarTooWeakForItsCycleIsSkippedNotPredicted) {
 // Fields the rules read, checked as the car's fields are (session 21's outside testing): an unknown drive was read
 // as two-wheel drive, an FE_UNIT other than MPG as mpg, an unknown ADFE flag as "No", and a list without the FE Bag 4
 // or exhaust columns switched the four-bag hybrid rule and the exhaust-carbon check off in silence.
-// A line of the list cut into its fields (a quoted field keeps its commas and quotes), and put back together.
-std::vector<std::string> csv_fields(const std::string& line) {
-  std::vector<std::string> out(1);
-  bool quoted = false;
-  for (const char ch : line) {
-    if (ch == '"') quoted = !quoted;
-    if (ch == ',' && !quoted) out.emplace_back();
-    else out.back() += ch;
-  }
-  return out;
-}
-std::string csv_join(const std::vector<std::string>& f) {
-  std::string out;
-  for (std::size_t i = 0; i < f.size(); ++i) out += (i ? "," : "") + f[i];
-  return out;
-}
-
 TEST(CliValidate, TheFieldsTheRulesReadAreCheckedNotAssumed) {
   const auto fields = csv_fields;
   const auto join = csv_join;
