@@ -12,7 +12,7 @@
 #include "rollsim/common/error.hpp"
 #include "rollsim/cycle/drive_cycle.hpp"
 #include "rollsim/diagnose/diagnose.hpp"
-#include "rollsim/diagnose/elevation.hpp"
+#include "rollsim/cycle/elevation.hpp"
 #include "rollsim/diagnose/report.hpp"
 #include "rollsim/recording/recording.hpp"
 #include "rollsim/sim/simulation.hpp"

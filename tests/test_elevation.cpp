@@ -4,7 +4,7 @@
 #include <cmath>
 #include <random>
 
-#include "rollsim/diagnose/elevation.hpp"
+#include "rollsim/cycle/elevation.hpp"
 
 namespace rollsim {
 namespace {
@@ -20,7 +20,9 @@ double hill_gain(double wave_m) {
     t.push_back(0.1 * i);
     v.push_back(20.0);
     h.push_back(100.0 + 20.0 * std::sin(kTwoPi * s / wave_m));
-    truth.push_back(20.0 * kTwoPi / wave_m * std::cos(kTwoPi * s / wave_m));
+    // s is the distance along the road, so dh/ds is the sine of the road's angle; the grade is its tangent.
+    const double sine = 20.0 * kTwoPi / wave_m * std::cos(kTwoPi * s / wave_m);
+    truth.push_back(sine / std::sqrt(1.0 - sine * sine));
   }
   const ElevationGrade g = grade_from_elevation(t, v, h);
   double num = 0.0, den = 0.0;

@@ -9,7 +9,7 @@
 #include "pipeline.hpp"
 #include "rollsim/common/error.hpp"
 #include "rollsim/common/units.hpp"
-#include "rollsim/diagnose/elevation.hpp"
+#include "rollsim/cycle/elevation.hpp"
 
 namespace rollsim {
 namespace {

@@ -1,5 +1,5 @@
 // Road grade from recorded elevation: glitch rejection, then a Savitzky-Golay (cubic) derivative over distance.
-#include "rollsim/diagnose/elevation.hpp"
+#include "rollsim/cycle/elevation.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -94,7 +94,10 @@ ElevationGrade grade_from_elevation(const std::vector<double>& time_s, const std
     const std::vector<double> w = a == c - half && b == c + half ? interior : cubic_slope_weights(a - c, b - c);
     double slope = 0.0;
     for (std::ptrdiff_t j = a; j <= b; ++j) slope += w[static_cast<std::size_t>(j - a)] * prof[static_cast<std::size_t>(j)];
-    g[static_cast<std::size_t>(c)] = std::clamp(slope / opt.grid_m, -opt.max_grade, opt.max_grade);
+    // The distance is travelled along the road, so the profile's slope over it is the sine of the road's angle;
+    // the grade is rise over run, its tangent (0.5 % more at 10 %).
+    const double sine = std::clamp(slope / opt.grid_m, -0.99, 0.99);
+    g[static_cast<std::size_t>(c)] = std::clamp(sine / std::sqrt(1.0 - sine * sine), -opt.max_grade, opt.max_grade);
   }
   for (std::size_t i = 0; i < n; ++i) {
     const double x = s[i] / opt.grid_m;  // cell centres are at (c + 0.5) grid; interpolate between them

@@ -25,7 +25,10 @@ struct ElevationGrade {
 /// Grade per sample from elevation: distance from the speed (trapezoid); each sample-to-sample elevation step
 /// steeper than max_grade_step over its distance (plus tolerance) is dropped (a glitch shifts nothing after it);
 /// the corrected profile is averaged on a distance grid and differentiated by a least-squares cubic over
-/// filter_length_m (Savitzky-Golay; off-centre at the ends). Standing still keeps the grade of where the car stands.
+/// filter_length_m (Savitzky-Golay; off-centre at the ends), the slope along the road taken as the sine of the
+/// road's angle and the grade given as its tangent. Standing still keeps the grade of where the car stands, and an
+/// elevation that drifts while the car stands (a GPS re-fix at a light) is one place's, not a climb. Used by the
+/// diagnosis for recordings and by the cycle reader for an `elevation_m` column.
 /// Weights w_j, j = first..last, such that sum_j w_j y_j is the slope at j = 0 (per grid step) of the least-squares
 /// cubic through the points (j, y_j) (a lower order where there are under four points). Symmetric windows give the
 /// Savitzky-Golay first-derivative filter.
