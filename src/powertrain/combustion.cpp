@@ -53,10 +53,13 @@ double CombustionPowertrain::max_wheel_force_n(int gear, double speed_mps, doubl
 
 void add_alternator_load(double power_w, double alternator_efficiency, double marginal_efficiency,
                          const FuelParams& fuel, PowerFlow& flow) {
-  const double fuel_w = power_w / (alternator_efficiency * marginal_efficiency);
-  flow.aux_power_w += power_w;
+  // The accessories' row holds the alternator's shaft power, its loss included, as for the accessories a running
+  // engine carries (a start-stop recharge put the alternator's loss in the engine's row: session 22's outside testing).
+  const double shaft_w = power_w / alternator_efficiency;
+  const double fuel_w = shaft_w / marginal_efficiency;
+  flow.aux_power_w += shaft_w;
   flow.fuel_power_w += fuel_w;
-  flow.engine_loss_w += fuel_w - power_w;
+  flow.engine_loss_w += fuel_w - shaft_w;
   flow.fuel_rate_m3_per_s += fuel_w / fuel.energy_j_per_m3();
 }
 
