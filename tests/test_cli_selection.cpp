@@ -78,6 +78,26 @@ std::vector<std::string> csv_fields(const std::string& line) {
 
 // The CSV says what the JSON says, a column per field (own, wheel load, capacity and diameter change were JSON only
 // until session 21), every line as wide as the header, and an unknown capacity is an empty cell.
+// A candidate the tyre model has no solution for at the car's load (it deflects to the rim) is unfit with the model's
+// own reason, and has no figures: the table and CSV read NaN, the reason named only capacity and diameter, and the
+// JSON said it followed its trace (session 22's outside testing).
+TEST(CliSelection, ACandidateWithoutAModelSolutionIsUnfitWithItsReasonAndNoFigures) {
+  const std::string tiny = (rollsim::test::temp_dir() / "tiny.yaml").string();
+  std::ofstream(tiny) << "name: tiny\nsize: \"125/30 R13\"\npressure_bar: 1.0\nmax_load_kg: 100\n";
+  const std::string args = "compare --vehicle ev --tyre " + tiny;
+  const CmdResult text = run(args), csv = run(args + " --csv"), json = run(args + " --json");
+  for (const CmdResult* r : {&text, &csv, &json}) {
+    ASSERT_EQ(r->exit_code, 0) << r->err;
+    EXPECT_EQ(r->out.find("NaN"), std::string::npos) << r->out;
+    EXPECT_EQ(r->out.find("nan"), std::string::npos) << r->out;
+    EXPECT_NE(r->out.find("reaches the rim"), std::string::npos) << r->out;
+  }
+  const std::string last = lines(json.out).back();
+  EXPECT_NE(last.find("\"followed_trace\": null"), std::string::npos) << last;
+  EXPECT_NE(last.find("\"kwh_per_10km\": null"), std::string::npos) << last;
+  EXPECT_NE(last.find("\"fits\": false"), std::string::npos) << last;
+}
+
 TEST(CliSelection, CompareCsvCarriesTheJsonsFieldsOnEveryLine) {
   const std::string args = "compare --vehicle ev --tyre low-rrc --tyre 175-65R15 --tyre tyres/catalogue/205-55R16.yaml "
                            "--cycle nedc --replay --threads 1";

@@ -210,6 +210,18 @@ TEST(SelectionCompare, ALightTruckTyresCapacityIsUnknownNotThePassengerRating) {
   EXPECT_NEAR(load_capacity_at_pressure_n(p), p.max_load_n * std::pow(2.1 / 2.5, 0.585), 1e-9);
 }
 
+// A diameter exactly the tolerance larger is within it: 628.3 mm against 610 mm computes as 3.0000000000000027 %, and
+// was refused as "+3.0 % from 610 mm (tolerance 3 %)" (session 22's outside testing).
+TEST(SelectionCompare, ADiameterChangeOfExactlyTheToleranceFits) {
+  TyreSpec bigger = tyre("nominal");
+  bigger.state.geometry.outer_radius_m *= 1.03;
+  const FitCheck f = check_fit(vehicle("ev"), tyre("nominal"), bigger, 3.0);
+  EXPECT_NEAR(f.diameter_change_pct, 3.0, 1e-12);
+  EXPECT_TRUE(f.fits) << f.reason;
+  bigger.state.geometry.outer_radius_m *= 1.0001;
+  EXPECT_FALSE(check_fit(vehicle("ev"), tyre("nominal"), bigger, 3.0).fits);
+}
+
 namespace {
 
 // A trace that ramps to `top_kmh` at 2 m/s^2, holds it for 60 s and stops: nothing beyond a car's top speed.

@@ -46,8 +46,8 @@ void print_table(const selection::Comparison& c, bool replay) {
   auto row = [&](const selection::CandidateResult& r, const std::string& rank) {
     std::vector<std::string> cells{rank, r.tyre.name + (r.is_own ? " (own)" : ""), selection::tyre_size_text(r.tyre),
                                    fixed(units::pa_to_bar(r.tyre.state.pressure_pa), 1),
-                                   fixed(r.rrc_80 * 1e3, 3), fixed(r.rr_power_80_w, 1),
-                                   fixed(r.value, c.shows_range ? 4 : 3),
+                                   r.simulated ? fixed(r.rrc_80 * 1e3, 3) : "-", r.simulated ? fixed(r.rr_power_80_w, 1) : "-",
+                                   r.simulated ? fixed(r.value, c.shows_range ? 4 : 3) : "-",
                                    r.simulated ? signed_fixed(r.diff_pct, 2) : "-"};
     if (c.shows_range) cells.push_back(r.simulated && std::isfinite(r.range_change_km) ? signed_fixed(r.range_change_km, 1) : "-");
     cells.push_back(r.fit.fits ? "ok (" + signed_fixed(r.fit.diameter_change_pct, 1) + " % dia., load " +
@@ -89,12 +89,12 @@ void print_csv(const selection::Comparison& c, bool header) {
   auto emit = [&](const selection::CandidateResult& r, int rank) {
     std::cout << q(c.vehicle) << "," << q(c.cycle) << "," << (rank > 0 ? std::to_string(rank) : "") << "," << q(r.tyre.name)
               << "," << q(selection::tyre_size_text(r.tyre)) << "," << fixed(units::pa_to_bar(r.tyre.state.pressure_pa), 2)
-              << "," << fixed(r.rrc_80, 6) << "," << fixed(r.rr_power_80_w, 2) << ","
-              << fixed(r.value, 5) << "," << c.unit << "," << fixed(r.diff_pct, 3) << ","
+              << "," << known_or_empty(r.rrc_80, 6, r.simulated) << "," << known_or_empty(r.rr_power_80_w, 2, r.simulated) << ","
+              << known_or_empty(r.value, 5, r.simulated) << "," << c.unit << "," << known_or_empty(r.diff_pct, 3, r.simulated) << ","
               << (c.shows_range && std::isfinite(r.range_km) ? fixed(r.range_km, 2) : "") << ","
               << (c.shows_range && std::isfinite(r.range_change_km) ? fixed(r.range_change_km, 2) : "") << "," << (r.fit.fits ? "yes" : "no") << ","
-              << q(r.fit.reason) << "," << (r.trace.followed ? "yes" : "no") << ","
-              << fixed(units::mps_to_kmh(r.trace.max_deficit_mps), 2) << "," << (r.is_own ? "yes" : "no") << ","
+              << q(r.fit.reason) << "," << (r.simulated ? (r.trace.followed ? "yes" : "no") : "") << ","
+              << known_or_empty(units::mps_to_kmh(r.trace.max_deficit_mps), 2, r.simulated) << "," << (r.is_own ? "yes" : "no") << ","
               << known_or_empty(r.fit.wheel_load_n, 1, true) << ","
               << known_or_empty(r.fit.capacity_n, 1, r.fit.capacity_n > 0.0) << ","
               << known_or_empty(r.fit.diameter_change_pct, 3, true) << "\n";

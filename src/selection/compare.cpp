@@ -48,7 +48,8 @@ FitCheck check_fit(const Vehicle& vehicle, const TyreSpec& own, const TyreSpec& 
     reasons.push_back("load " + fixed(f.wheel_load_n, 0) + " N > " + fixed(f.capacity_n, 0) +
                       " N capacity at " + fixed(units::pa_to_bar(candidate.state.pressure_pa), 1) + " bar");
   }
-  if (std::abs(f.diameter_change_pct) > diameter_tolerance_pct) {
+  // A change that is the tolerance to rounding (628.3 mm against 610 mm: 3.0000000000000027 %) is within it.
+  if (std::abs(f.diameter_change_pct) > diameter_tolerance_pct * (1.0 + 1e-12)) {
     reasons.push_back("diameter " + fixed(d_new * 1e3, 0) + " mm is " +
                       (f.diameter_change_pct > 0 ? "+" : "") + fixed(f.diameter_change_pct, 1) + " % from " +
                       fixed(d_own * 1e3, 0) + " mm (tolerance " + format_value(diameter_tolerance_pct) + " %)");
@@ -147,8 +148,12 @@ Comparison compare_tyres(const Vehicle& vehicle, const std::vector<TyreSpec>& ca
     // must: an own tyre overloaded at its pressure was ranked beside the tyres that fit while a candidate that
     // carried more was not (outside testing, session 20).
     const bool rankable = c.simulated && c.fit.fits;
-    if (!c.simulated && c.fit.fits) c.fit = {false, c.fit.wheel_load_n, c.fit.capacity_n, c.fit.diameter_change_pct,
-                                            "does not fit: " + c.error};
+    // A tyre the model has no solution for at the car's load says so, beside any fit check it fails (the reason
+    // named only the capacity and diameter, and its figures read NaN: session 22's outside testing).
+    if (!c.simulated) {
+      c.fit.reason = (c.fit.fits ? "does not fit: " : c.fit.reason + "; ") + c.error;
+      c.fit.fits = false;
+    }
     (rankable ? cmp.ranked : cmp.unfit).push_back(c);
   }
   std::stable_sort(cmp.ranked.begin(), cmp.ranked.end(),

@@ -72,7 +72,8 @@ std::vector<JsonObject> comparison_json(const Comparison& c) {
         .add(c.unit, r.value)
         .add("diff_pct", r.diff_pct);
     if (c.shows_range) j.add("range_km", r.range_km).add("range_change_km", r.range_change_km);
-    j.add("followed_trace", r.trace.followed).add("max_deficit_kmh", units::mps_to_kmh(r.trace.max_deficit_mps));
+    if (r.simulated) j.add("followed_trace", r.trace.followed).add("max_deficit_kmh", units::mps_to_kmh(r.trace.max_deficit_mps));
+    else j.add_null("followed_trace").add_null("max_deficit_kmh");  // a run that never happened
     j.add("fits", r.fit.fits).add("reason", r.fit.reason);
     out.push_back(j);
   };
