@@ -163,6 +163,7 @@ std::vector<double> ConventionalPowertrain::braking_regime_speeds_mps(double whe
   // The answer is constant between neighbouring candidates: read it once in each gap, and keep the candidates
   // between two gaps that differ (once per replay of every validate row, so the reading is not doubled).
   std::vector<double> s;
+  if (candidates.empty()) return s;
   Operating op;
   bool below = fuel_cut_off(0.5 * candidates.front(), wheel_radius_m, op);
   for (std::size_t k = 0; k < candidates.size(); ++k) {
