@@ -395,8 +395,8 @@ class ForwardSystem final : public OdeSystem {
 
   void roots(double t, const double* y, double* g) override {
     const double v = y[kSpeed];
-    g[0] = shifts_up_ > 0.0 ? v - shifts_up_ : 1.0;
-    g[1] = shifts_down_ > 0.0 ? v - shifts_down_ : 1.0;
+    g[0] = shifts_up_ > 0.0 ? v - (shifts_up_ + kShiftMargin_mps) : 1.0;
+    g[1] = shifts_down_ > 0.0 ? v - (shifts_down_ - kShiftMargin_mps) : 1.0;
     const double demand_n = force_request(t, y);
     const double force_n = max_force(gear, v);
     g[2] = gear > 1 && max_force(gear - 1, v) > force_n ? force_n - demand_n : 1.0;
@@ -414,6 +414,14 @@ class ForwardSystem final : public OdeSystem {
     if (scheduled > 1) shifts_down_ = m_.powertrain->shift_speeds_mps(scheduled).back();
   }
   int scheduled_gear() const { return scheduled_gear_; }
+
+  /// The schedule's gear from `current` at `speed_mps`, shifting only where the speed is past a shift speed by
+  /// kShiftMargin_mps, as the roots shift.
+  int schedule_gear(double speed_mps, int current) const {
+    const int up = m_.powertrain->select_gear(speed_mps - kShiftMargin_mps, current);
+    if (up > current) return up;
+    return std::min(current, m_.powertrain->select_gear(speed_mps + kShiftMargin_mps, current));
+  }
 
   /// Where a kicked-down gear's engine reaches its top speed: the next gear up (to the schedule's) that gives force.
   int upshift_from_top_speed(int engaged, double speed_mps) const {
@@ -513,6 +521,12 @@ class ForwardSystem final : public OdeSystem {
 
  private:
   static constexpr double kKickdownReturn = 0.9;  // hysteresis: back up only with 10 % reserve in the higher gear
+  // A trace that holds a shift speed (NEDC's 15 km/h cruise against camry_2018's 1->2 upshift at 15 km/h) is
+  // followed to within the speed's tolerance, 1e-4 m/s: on that knife-edge the gear of a whole cruise was decided
+  // by the integrator's error, and the fuel jumped 0.6 % between neighbouring tyre pressures (session 22's outside
+  // testing). The schedule shifts 0.01 km/h past its speeds, 28 times the tolerance, and a held speed keeps its gear
+  // as the replay's (which compares the trace's exact speed) does.
+  static constexpr double kShiftMargin_mps = 0.01 / 3.6;
   double max_force(int g, double speed_mps) const { return m_.powertrain->max_wheel_force_n(g, speed_mps, m_.wheel_radius_m); }
   std::size_t segment(double t, bool left_continuous) {
     std::size_t i = c_.segment_index(t, hint_);
@@ -575,7 +589,7 @@ SimulationResult simulate_forward(const VehicleModel& m, const DriveCycle& c, co
     }
   }
   {
-    const int scheduled = m.powertrain->select_gear(y0[kSpeed], 1);
+    const int scheduled = sys.schedule_gear(y0[kSpeed], 1);
     sys.set_gears(scheduled, scheduled);
     sys.set_window_end(c.time_s.size() > 1 ? c.time_s[1] : c.time_s.front());
     sys.set_gears(scheduled, sys.kickdown_gear(scheduled, y0[kSpeed], sys.force_request(c.time_s.front(), y0.data())));
@@ -737,7 +751,7 @@ SimulationResult simulate_forward(const VehicleModel& m, const DriveCycle& c, co
       // The demand jumps at a kink of the trace: choose the gear for the segment that starts here.
       if (m.powertrain->num_gears() > 1) {
         sys.set_window_end(stops[std::min(next_stop + 1, stops.size() - 1)]);
-        const int scheduled = m.powertrain->select_gear(y[kSpeed], sys.scheduled_gear());
+        const int scheduled = sys.schedule_gear(y[kSpeed], sys.scheduled_gear());
         sys.set_gears(scheduled, sys.kickdown_gear(scheduled, y[kSpeed], sys.force_request(t, y.data())));
       }
       restart(t, y);
