@@ -518,7 +518,7 @@ py::dict api_sensitivity(py::object tyre, py::object vehicle, py::object cycle, 
     py::gil_scoped_release released;
     s = selection::sensitivity_of(v, t, c, at_n, speed_mps);
   }
-  if (const auto w = selection::sensitivity_trace_warning(s); !w.empty()) warn(w);
+  for (const auto& w : selection::sensitivity_warnings(s)) warn(w);
   return from_json(selection::sensitivity_json(s).str());
 }
 

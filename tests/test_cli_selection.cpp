@@ -285,6 +285,10 @@ TEST(CliSelection, SensitivityNamesWhatMattersMostAndSignsHold) {
   EXPECT_LT(num("elasticity_rr_power_pressure"), 0.0);
   EXPECT_GT(num("elasticity_rr_power_load"), 0.0);
   EXPECT_TRUE(has(r.out, "\"dominant_rr_power\"")) << r.out;
+  // The JSON holds what the table prints (the RRC column and the values were missing: session 22's outside testing).
+  EXPECT_NEAR(num("elasticity_rrc_load"), num("elasticity_rr_power_load") - 1.0, 1e-9);
+  EXPECT_NEAR(num("value_pressure_bar"), 2.1, 1e-12);
+  EXPECT_NEAR(num("value_outer_diameter_mm"), 2.0 * 25.4 * 14 / 2 + 2 * 0.7 * 175, 1.0);  // 175/70 R14 from its size
   const CmdResult table = run("sensitivity --vehicle ice --cycle nedc");
   ASSERT_EQ(table.exit_code, 0) << table.err;
   EXPECT_TRUE(has(table.out, "Matters most")) << table.out;

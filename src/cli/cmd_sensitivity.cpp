@@ -21,14 +21,8 @@ struct SensitivityOptionsText {
 };
 
 std::string value_text(const selection::SensitivityRow& r) {
-  switch (r.parameter) {
-    case TyreParameter::OuterDiameter:
-    case TyreParameter::SectionWidth: return fixed(r.value_si * 1e3, 1) + " mm";
-    case TyreParameter::Pressure: return fixed(units::pa_to_bar(r.value_si), 2) + " bar";
-    case TyreParameter::Load: return fixed(r.value_si, 0) + " N";
-    case TyreParameter::Speed: return fixed(units::mps_to_kmh(r.value_si), 1) + " km/h";
-  }
-  return "";
+  const selection::ParameterValue v = selection::parameter_value_in_file_units(r);
+  return fixed(v.value, v.decimals) + " " + v.unit;
 }
 
 void run_sensitivity(const SensitivityOptionsText& o) {
@@ -47,7 +41,7 @@ void run_sensitivity(const SensitivityOptionsText& o) {
 
   if (o.json) {
     std::cout << selection::sensitivity_json(s).str() << "\n";
-    if (const auto w = selection::sensitivity_trace_warning(s); !w.empty()) std::cerr << "warning: " << w << "\n";
+    for (const auto& w : selection::sensitivity_warnings(s)) std::cerr << "warning: " << w << "\n";
     return;
   }
   std::cout << "Sensitivity of tyre " << s.tyre << " at " << fixed(s.load_n, 0) << " N, "
@@ -66,7 +60,7 @@ void run_sensitivity(const SensitivityOptionsText& o) {
   for (const auto& r : s.rows) {
     std::vector<std::string> cells{r.name, value_text(r), fixed(r.power_elasticity, 3),
                                    fixed(r.rrc_elasticity, 3)};
-    if (vehicle) cells.push_back(fixed(*r.energy_elasticity, 4));
+    if (vehicle) cells.push_back(fixed(*r.energy_elasticity, 4) + (r.energy_smooth ? "" : " *"));
     t.add_row(cells);
   }
   std::cout << t.render();
@@ -76,7 +70,7 @@ void run_sensitivity(const SensitivityOptionsText& o) {
   if (vehicle) {
     std::cout << "(car: load = test mass, all wheel loads scaled together; diameter also changes the gearing)\n";
   }
-  if (const auto w = selection::sensitivity_trace_warning(s); !w.empty()) std::cout << "WARNING: " << w << "\n";
+  for (const auto& w : selection::sensitivity_warnings(s)) std::cout << "WARNING: " << w << "\n";
 }
 
 }  // namespace

@@ -131,18 +131,41 @@ JsonObject sensitivity_json(const Sensitivity& s) {
       .add("relative_step", s.relative_step).add("rr_power_w", s.rr_power_w);
   if (car) j.add("vehicle", s.vehicle).add("cycle", s.cycle).add(s.energy_unit, s.energy).add("followed_trace", s.followed_trace);
   for (const auto& r : s.rows) {
-    j.add("elasticity_rr_power_" + r.key, r.power_elasticity);
-    if (r.energy_elasticity) j.add("elasticity_" + s.energy_unit + "_" + r.key, *r.energy_elasticity);
+    const ParameterValue v = parameter_value_in_file_units(r);
+    j.add("value_" + v.key, v.value).add("elasticity_rr_power_" + r.key, r.power_elasticity).add("elasticity_rrc_" + r.key, r.rrc_elasticity);
+    if (r.energy_elasticity) {
+      j.add("elasticity_" + s.energy_unit + "_" + r.key, *r.energy_elasticity)
+          .add("elasticity_" + s.energy_unit + "_" + r.key + "_double_step", r.energy_elasticity_double_step.value_or(NAN));
+    }
   }
   j.add("dominant_rr_power", s.dominant_power);
-  if (car) j.add("dominant_energy", s.dominant_energy);
+  if (car) {
+    j.add("dominant_energy", s.dominant_energy)
+        .add("energy_elasticities_smooth", std::all_of(s.rows.begin(), s.rows.end(), [](const SensitivityRow& r) { return r.energy_smooth; }));
+  }
   return j;
 }
 
-std::string sensitivity_trace_warning(const Sensitivity& s) {
-  if (s.energy_unit.empty() || s.followed_trace) return {};
-  return "the car could not follow the cycle in the base run or a perturbed one: the energy elasticities mix the "
-         "tyre's effect with a change of the drive itself";
+std::vector<std::string> sensitivity_warnings(const Sensitivity& s) {
+  std::vector<std::string> out;
+  if (s.max_load_n > 0.0 && s.load_n > s.max_load_n) {
+    out.push_back("load " + fixed(s.load_n, 0) + " N is above the tyre's rated maximum " + fixed(s.max_load_n, 0) +
+                  " N; the RR power elasticities are outside the tyre's rating");
+  }
+  for (const auto& w : s.vehicle_warnings) out.push_back(w);
+  if (!s.energy_unit.empty() && !s.followed_trace) {
+    out.push_back("the car could not follow the cycle in the base run or a perturbed one: the energy elasticities mix "
+                  "the tyre's effect with a change of the drive itself");
+  }
+  for (const auto& r : s.rows) {
+    if (r.energy_smooth || !r.energy_elasticity) continue;
+    out.push_back("the car's " + std::string(s.energy_unit == "kwh_per_10km" ? "energy" : "fuel") + " is not smooth in " +
+                  r.name + ": steps of +-" + format_value(s.relative_step * 100) + " % give " + fixed(*r.energy_elasticity, 4) +
+                  ", steps twice as large " + fixed(*r.energy_elasticity_double_step, 4) +
+                  " (a gear, lock-up or fuel cut-off decision changes between the runs); read the trend from a "
+                  "`rollsim sweep` over a wider range");
+  }
+  return out;
 }
 
 SweepOptions sweep_options_from_request(const SweepRequest& o) {

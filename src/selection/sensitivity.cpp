@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "rollsim/common/error.hpp"
+#include "rollsim/common/units.hpp"
 #include "rollsim/selection/common.hpp"
 
 namespace rollsim::selection {
@@ -22,10 +23,27 @@ std::string dominant(const std::vector<SensitivityRow>& rows, bool energy) {
 
 }  // namespace
 
+bool elasticities_agree(double at_step, double at_double_step) {
+  constexpr double kScatter = 2e-3, kCurvature = 0.1;
+  return std::abs(at_step - at_double_step) <= kScatter + kCurvature * std::abs(at_step);
+}
+
+ParameterValue parameter_value_in_file_units(const SensitivityRow& r) {
+  switch (r.parameter) {
+    case TyreParameter::OuterDiameter: return {r.key + "_mm", r.value_si * 1e3, "mm", 1};
+    case TyreParameter::SectionWidth: return {r.key + "_mm", r.value_si * 1e3, "mm", 1};
+    case TyreParameter::Pressure: return {r.key + "_bar", units::pa_to_bar(r.value_si), "bar", 2};
+    case TyreParameter::Load: return {r.key + "_n", r.value_si, "N", 0};
+    case TyreParameter::Speed: return {r.key + "_kmh", units::mps_to_kmh(r.value_si), "km/h", 1};
+  }
+  return {};
+}
+
 Sensitivity tyre_sensitivity(const TyreSpec& tyre, double load_n, double speed_mps, double h) {
   const TyreExplanation x = explain_tyre(tyre.state, load_n, speed_mps, h);
   Sensitivity s;
   s.tyre = tyre.name;
+  s.max_load_n = tyre.max_load_n;
   s.load_n = load_n;
   s.speed_mps = speed_mps;
   s.relative_step = h;
@@ -46,13 +64,14 @@ Sensitivity vehicle_sensitivity(const Vehicle& vehicle, const TyreSpec& tyre, co
   s.energy_unit = energy_unit(vehicle);
   Vehicle base = vehicle;
   fit_tyres(base, tyre);
+  s.vehicle_warnings = check_tyre_loads(base, "--tyre '" + tyre.source + "'");
   const EnergyFigure at_base = run_forward(base, cycle);
   s.energy = at_base.value;
   s.followed_trace = at_base.trace.followed;
   for (auto& row : s.rows) {
-    double y[2];
-    const double f[2] = {1.0 + h, 1.0 - h};
-    for (int k = 0; k < 2; ++k) {
+    double y[4];
+    const double f[4] = {1.0 + h, 1.0 - h, 1.0 + 2.0 * h, 1.0 - 2.0 * h};
+    for (int k = 0; k < 4; ++k) {
       Vehicle v = vehicle;
       TyreSpec t = tyre;
       switch (row.parameter) {
@@ -74,6 +93,8 @@ Sensitivity vehicle_sensitivity(const Vehicle& vehicle, const TyreSpec& tyre, co
     }
     // d ln y / d ln x by central differences in ln x, consistent with explain_tyre.
     row.energy_elasticity = std::log(y[0] / y[1]) / std::log(f[0] / f[1]);
+    row.energy_elasticity_double_step = std::log(y[2] / y[3]) / std::log(f[2] / f[3]);
+    row.energy_smooth = elasticities_agree(*row.energy_elasticity, *row.energy_elasticity_double_step);
   }
   s.dominant_energy = dominant(s.rows, true);
   return s;

@@ -42,13 +42,15 @@ std::vector<std::string> trace_warnings(const Comparison& comparison);
 Sensitivity sensitivity_of(const std::optional<Vehicle>& vehicle, const std::optional<TyreSpec>& tyre,
                            const DriveCycle& cycle, std::optional<double> load_n, double speed_mps);
 
-/// One object: the point, RR power, every elasticity (elasticity_rr_power_<key>, elasticity_<unit>_<key>), the
-/// dominant parameters; with a car its figure and followed_trace.
+/// One object: the point, RR power, each parameter's value (value_outer_diameter_mm, value_section_width_mm,
+/// value_pressure_bar, value_load_n)
+/// and elasticities (elasticity_rr_power_<key>, elasticity_rrc_<key>, elasticity_<unit>_<key> and its
+/// ..._double_step), the dominant parameters; with a car its figure, followed_trace and energy_elasticities_smooth.
 JsonObject sensitivity_json(const Sensitivity& sensitivity);
 
-/// With a car that fell behind its cycle in the base run or a perturbed one: what that does to the energy
-/// elasticities (no "warning:" prefix); empty otherwise.
-std::string sensitivity_trace_warning(const Sensitivity& sensitivity);
+/// What a reader must know before using the figures (no "warning:" prefix): a tyre loaded past its rating, a car
+/// that fell behind its cycle in the base run or a perturbed one, an energy elasticity that is not a slope.
+std::vector<std::string> sensitivity_warnings(const Sensitivity& sensitivity);
 
 /// A sweep as given: one --param, --from, --to (and optionally --steps) per axis; numbers as text.
 struct SweepRequest {
