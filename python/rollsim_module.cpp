@@ -476,7 +476,6 @@ py::dict api_tyre_fit(py::object size_arg, py::object points, py::object label, 
   }
   const TyreFitPlan plan = plan_tyre_fit(in);
   const TyreFit fit = fit_hysteresis(plan.start, plan.request);
-  for (const auto& w : fit.warnings) warn(w);
   FittedTyreFile file;
   file.name = name;
   file.size = size;
@@ -484,9 +483,10 @@ py::dict api_tyre_fit(py::object size_arg, py::object points, py::object label, 
       in.size, pressure_bar.is_none() ? std::nullopt : std::optional(arg_as<double>(pressure_bar, "pressure_bar", "a number [bar]")),
       "pressure_bar");
   file.source = "rollsim.tyre_fit (Python)";
-  std::ostringstream json, yaml;
+  std::ostringstream json;
   write_tyre_fit_json(json, fit, plan);
-  write_fitted_tyre_yaml(yaml, file, fit);
+  const std::string yaml = fitted_tyre_file_text(file, fit);
+  for (const auto& w : fit.warnings) warn(w);
   py::dict out;
   py::list params, residuals;
   std::istringstream lines(json.str());
@@ -498,8 +498,8 @@ py::dict api_tyre_fit(py::object size_arg, py::object points, py::object label, 
   }
   out["params"] = params;
   out["residuals"] = residuals;
-  out["tyre"] = py::module_::import("yaml").attr("safe_load")(yaml.str());
-  if (!output_path.empty()) write_file_atomically(output_path, "output", [&](std::ostream& o) { o << yaml.str(); });
+  out["tyre"] = py::module_::import("yaml").attr("safe_load")(yaml);
+  if (!output_path.empty()) write_file_atomically(output_path, "output", [&](std::ostream& o) { o << yaml; });
   return out;
 }
 

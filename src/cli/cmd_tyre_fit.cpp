@@ -275,7 +275,6 @@ void run_fit(const FitOptions& o) {
   in.free = parse_free(o.free);
   const TyreFitPlan plan = plan_tyre_fit(in);
   const TyreFit fit = fit_hysteresis(plan.start, plan.request);
-  for (const auto& w : fit.warnings) std::cerr << "warning: " << w << "\n";
 
   FittedTyreFile file;
   file.name = o.name.empty() ? std::filesystem::path(o.output).stem().string() : o.name;
@@ -289,12 +288,14 @@ void run_fit(const FitOptions& o) {
   if (!o.j2452.empty()) src += ", --j2452 " + o.j2452;
   if (!o.label.empty()) src += ", --label " + o.label;
   file.source = src;
+  const std::string text = fitted_tyre_file_text(file, fit);  // a fit no file may hold is refused before it is shown
+  for (const auto& w : fit.warnings) std::cerr << "warning: " << w << "\n";
   if (o.json) {
     write_tyre_fit_json(std::cout, fit, plan);
   } else {
     print_fit(fit, plan.band, plan.iso);
   }
-  write_file_atomically(o.output, "--output", [&](std::ostream& out) { write_fitted_tyre_yaml(out, file, fit); });
+  write_file_atomically(o.output, "--output", [&](std::ostream& out) { out << text; });
   if (!o.json) std::cout << "wrote " << o.output << "\n";
 }
 

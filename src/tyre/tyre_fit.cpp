@@ -55,6 +55,22 @@ std::size_t distinct(const std::vector<RrcPoint>& pts, double RrcPoint::*field) 
   for (std::size_t i = 1; i < v.size(); ++i) n += v[i] > v[i - 1] * 1.001;
   return n;
 }
+// How many distinct conditions (pressure, load and speed together, to 0.1 %) the points hold: repeated measurements
+// of one condition fix its RRC better, not another constant (three points at two conditions freed three constants
+// and printed a 95 % interval for one the points cannot tell from another: session 22's outside testing).
+std::size_t distinct_conditions(const std::vector<RrcPoint>& pts) {
+  auto same = [](double a, double b) { return std::abs(a - b) <= 1e-3 * std::max(std::abs(a), std::abs(b)); };
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    bool repeat = false;
+    for (std::size_t k = 0; k < i && !repeat; ++k) {
+      repeat = same(pts[i].pressure_pa, pts[k].pressure_pa) && same(pts[i].load_n, pts[k].load_n) &&
+               same(pts[i].speed_mps, pts[k].speed_mps);
+    }
+    n += repeat ? 0 : 1;
+  }
+  return n;
+}
 Spread spread(const std::vector<RrcPoint>& pts) {
   return {distinct(pts, &RrcPoint::pressure_pa), distinct(pts, &RrcPoint::load_n), distinct(pts, &RrcPoint::speed_mps)};
 }
@@ -90,10 +106,10 @@ void check_request(const FitRequest& r, const std::vector<HysteresisParam>& free
                                      std::to_string(s.loads) + " load(s), " + std::to_string(s.speeds) + " speed(s)");
     }
   }
-  if (free.size() > r.points.size()) {
-    throw InputError("--free", "too few points for what is asked: " + std::to_string(r.points.size()) +
-                                   " point(s) cannot determine " + std::to_string(free.size()) + " parameters (" +
-                                   hysteresis_param_keys(free) + ")");
+  if (const std::size_t conditions = distinct_conditions(r.points); free.size() > conditions) {
+    throw InputError("--free", "too few points for what is asked: " + std::to_string(r.points.size()) + " point(s) at " +
+                                   std::to_string(conditions) + " distinct condition(s) cannot determine " +
+                                   std::to_string(free.size()) + " parameters (" + hysteresis_param_keys(free) + ")");
   }
   if (!(r.assumed_relative_uncertainty > 0.0)) {
     throw InputError("--rrc-uncertainty-pct", "must be > 0");
@@ -105,6 +121,32 @@ double model_rrc(const TyreState& t, const RrcPoint& p) {
   at.pressure_pa = p.pressure_pa;
   const SpeedPolynomial k = hysteresis_polynomial(at, p.load_n);
   return k.k0 + p.speed_mps * (k.k1_s_per_m + p.speed_mps * k.k2_s2_per_m2);
+}
+
+// Of free parameters the points move only together (the Jacobian's columns, each scaled to unit length, nearly
+// dependent), the one that leans most on the dependence; the level is never it. Distinct spreads of pressure and
+// speed do not rule this out: two conditions that differ in both tell the two constants apart only with a third.
+// Read at the start (the shared constants), where it is the points' structure; at a solution that ran off to an
+// extreme every Jacobian degenerates, and that fit is refused as a file, not explained as undetermined.
+std::optional<HysteresisParam> entangled_param(const Eigen::MatrixXd& jacobian, const std::vector<HysteresisParam>& free) {
+  if (jacobian.cols() < 2) return std::nullopt;
+  Eigen::MatrixXd unit = jacobian;
+  for (Eigen::Index k = 0; k < unit.cols(); ++k) {
+    if (!(unit.col(k).norm() > 0.0)) return std::nullopt;  // a flat column is said as such at the solution
+    unit.col(k) /= unit.col(k).norm();
+  }
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(unit, Eigen::ComputeFullV);
+  const Eigen::VectorXd& sv = svd.singularValues();
+  if (sv.size() == unit.cols() && sv[sv.size() - 1] > 1e-7 * sv[0]) return std::nullopt;
+  const Eigen::VectorXd null = svd.matrixV().col(unit.cols() - 1);
+  std::optional<HysteresisParam> out;
+  double largest = 0.0;
+  for (Eigen::Index k = 0; k < unit.cols(); ++k) {
+    if (free[static_cast<std::size_t>(k)] == HysteresisParam::RrcRef || !(std::abs(null[k]) > largest)) continue;
+    largest = std::abs(null[k]);
+    out = free[static_cast<std::size_t>(k)];
+  }
+  return out;
 }
 
 // One least-squares pass over the given free parameters; fills values, intervals and residuals. `flat` gets the free
@@ -142,6 +184,9 @@ TyreFit fit_once(const TyreState& start, const FitRequest& r, const std::vector<
   flat.clear();
   for (int k = 0; k < n; ++k)
     if (!(ls.jacobian.col(k).norm() > 1e-12 * widest)) flat.push_back(free[k]);
+  if (flat.empty()) {
+    if (const auto p = entangled_param(jacobian_at(residuals, m, x0), free)) flat.push_back(*p);
+  }
   const Eigen::MatrixXd cov =
       fit.sigma_relative * fit.sigma_relative * jtj.completeOrthogonalDecomposition().pseudoInverse();
   // A scatter estimated from few residuals is itself uncertain: Student's t with their degrees of freedom, not the
@@ -220,17 +265,8 @@ void set_hysteresis_param(HysteresisConstants& c, HysteresisParam p, double valu
   }
 }
 
-namespace {
-void check_point_pressure_kpa(double kpa, const std::string& where) {
-  if (!(kpa >= 50.0 && kpa <= 600.0)) {
-    throw InputError(where, "pressure " + format_value(kpa) + " kPa is outside a tyre's physical range: must be in "
-                                                              "[50, 600] kPa");
-  }
-}
-}  // namespace
-
 void check_rrc_point(const TyreState& tyre, const RrcPoint& p) {
-  check_point_pressure_kpa(p.pressure_pa / 1e3, p.where);
+  check_pressure_plausible_kpa(p.pressure_pa / 1e3, std::nullopt, p.where);  // the size's class: plan_tyre_fit
   const double kmh = units::mps_to_kmh(p.speed_mps);
   if (!(kmh > 0.0 && kmh <= 300.0)) {
     throw InputError(p.where, "speed " + format_value(kmh) + " km/h is not allowed: must be in (0, 300] km/h (a "
@@ -251,9 +287,10 @@ void check_rrc_point(const TyreState& tyre, const RrcPoint& p) {
 
 std::vector<HysteresisParam> identifiable_params(const std::vector<RrcPoint>& points) {
   const Spread s = spread(points);
+  const std::size_t conditions = distinct_conditions(points);
   std::vector<HysteresisParam> out{HysteresisParam::RrcRef};
   for (auto p : kAllParams) {
-    if (p == HysteresisParam::RrcRef || out.size() >= points.size()) continue;
+    if (p == HysteresisParam::RrcRef || out.size() >= conditions) continue;
     if (missing_for(p, s).empty()) out.push_back(p);
   }
   return out;
@@ -324,7 +361,7 @@ TyreFit fit_hysteresis(const TyreState& start_in, const FitRequest& r) {
     if (!changed) {
       for (auto p : undetermined) {
         fit.warnings.push_back(std::string(hysteresis_param_key(p)) + " is not determined by these points (the fit does "
-                               "not change with it" + (p == HysteresisParam::SpeedLossLoadExponent &&
+                               "not change with it, or only as another constant does" + (p == HysteresisParam::SpeedLossLoadExponent &&
                                                                hysteresis_param_value(start.hysteresis, HysteresisParam::SpeedLoss) == 0.0
                                                            ? ": it scales speed_loss_rrc_per_hz2, which is 0"
                                                            : "") +
@@ -365,7 +402,7 @@ LabelBand eu_label_band_c1(const std::string& label_class, const std::string& wh
 
 RrcPoint rrc_point_from_file_units(double pressure_kpa, double load_n, double speed_kmh, double rrc, std::string where) {
   // Checked in the file's unit: 1e308 kPa overflowed to "pressure inf kPa" in Pa (session 21).
-  if (!std::isfinite(pressure_kpa * 1e3)) check_point_pressure_kpa(pressure_kpa, where);
+  if (!std::isfinite(pressure_kpa * 1e3)) check_pressure_plausible_kpa(pressure_kpa, std::nullopt, where);
   return {pressure_kpa * 1e3, load_n, units::kmh_to_mps(speed_kmh), rrc, std::move(where)};
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 
 #include "rollsim/common/error.hpp"
 #include "rollsim/common/json.hpp"
@@ -37,6 +38,9 @@ TyreFitPlan plan_tyre_fit(const TyreFitInputs& in) {
         checked_number(*in.uncertainty_pct, in.uncertainty_where, Range::open_low(0.0, 50.0)) / 100.0;
   }
   plan.request.free = in.free;
+  // The tyre file's own rule for the size's class, so that the file reproduces its points (50-600 kPa for any tyre
+  // took 50 kPa for a passenger tyre, whose file then refused it, and refused a light-truck tyre's 655 kPa).
+  for (const auto& p : plan.request.points) check_pressure_plausible_kpa(p.pressure_pa / 1e3, in.size, p.where);
   return plan;
 }
 
@@ -66,6 +70,19 @@ double fitted_file_pressure_pa(const TyreSize& size, std::optional<double> press
   // here and 0.6 bar refused by `rollsim tyre`: session 21).
   check_pressure_plausible(checked_number(*pressure_bar, where, Range::closed(0.0, 1e3)), size, where);
   return units::bar_to_pa(*pressure_bar);
+}
+
+std::string fitted_tyre_file_text(const FittedTyreFile& file, const TyreFit& fit) {
+  std::ostringstream text;
+  write_fitted_tyre_yaml(text, file, fit);
+  try {
+    load_tyre_text(text.str(), file.name);
+  } catch (const InputError& e) {
+    throw InputError("tyre fit", "the fitted tyre is not one a tyre file may hold (" + std::string(e.what()) +
+                                     "): the points ask for more than the model can give; check their RRCs and "
+                                     "conditions, or hold constants with --free; nothing written");
+  }
+  return text.str();
 }
 
 namespace {

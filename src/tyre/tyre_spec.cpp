@@ -264,6 +264,16 @@ void check_pressure_plausible(double bar, const std::optional<TyreSize>& size, c
                                              {{"MPa", 10.0}, {"psi", kPaPerPsi / 1e5}, {"kPa", 0.01}, {"Pa", 1e-5}}));
 }
 
+void check_pressure_plausible_kpa(double kpa, const std::optional<TyreSize>& size, const std::string& where) {
+  const PressureClass c = pressure_class(size);
+  const double lo = 100.0 * kMinPlausibleBar, hi = 100.0 * c.max_bar;
+  if (kpa >= lo && kpa <= hi) return;
+  const std::string of = size ? " ('" + size->designation + "')" : "";
+  throw InputError(where, "pressure " + format_value(kpa) + " kPa is not allowed for " + c.name + of + ": must be in [" +
+                              format_value(lo) + ", " + format_value(hi) + "] kPa (such tyres run at " + c.usual + ")" +
+                              unit_slip_hint(kpa, Range::closed(lo, hi), "kPa", {{"bar", 100.0}, {"MPa", 1e3}, {"psi", kPaPerPsi / 1e3}}));
+}
+
 double iso28580_passenger_pressure_pa(const TyreSize& size) { return size.extra_load ? 250e3 : 210e3; }
 
 std::optional<double> load_index_max_load_kg(int load_index) {

@@ -48,6 +48,12 @@ std::vector<HysteresisParam> free_params_from_keys(const std::vector<std::string
 /// 28580's for the size (210 kPa, 250 kPa for extra load). Throws InputError(where, ...) outside the range.
 double fitted_file_pressure_pa(const TyreSize& size, std::optional<double> pressure_bar, const std::string& where);
 
+/// The fitted tyre file's text (write_fitted_tyre_yaml), read back as every command reads a tyre file: a fit whose
+/// constants no tyre file may hold (the points asked for a deflection exponent of 8, or ran the level to 2e-9 chasing
+/// a speed rise the model cannot give) throws InputError("tyre fit", ...) naming the key, its value and the range,
+/// so that no file is written that rollsim then refuses (session 22's outside testing).
+std::string fitted_tyre_file_text(const FittedTyreFile& file, const TyreFit& fit);
+
 /// The fit as JSON lines: one object for the fit ("kind": "fit", with the label's band and the model at its ISO
 /// point when a label was given), one per constant ("param": free with its 95 % interval, or held), one per
 /// measured point ("residual"). Files' units: kPa, km/h, percent.

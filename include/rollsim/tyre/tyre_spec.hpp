@@ -51,6 +51,8 @@ struct TyreSpec {
 /// truck 1-8, truck rims 1-10), naming `where` and the likely unit slip (MPa, psi). One rule for a tyre file's
 /// `pressure_bar`, `--pressure-bar`, a pressure sweep's ends and Python's `pressure_bar`.
 void check_pressure_plausible(double bar, const std::optional<TyreSize>& size, const std::string& where);
+/// The same rule for a pressure given in kPa (a fit's measured points), said in kPa.
+void check_pressure_plausible_kpa(double kpa, const std::optional<TyreSize>& size, const std::string& where);
 
 /// Loads and validates a tyre YAML file (strict keys; see tyres/README.md for the format).
 TyreSpec load_tyre_file(const std::string& path);
