@@ -365,6 +365,19 @@ TEST_F(DriveCycleFiles, BadInputNamesFileLineColumnAndValue) {
   EXPECT_TRUE(has(m, ": line "));
 }
 
+// A quote left open swallows the lines up to the next quote in the file; the reader stopped there and named that line
+// (d_unterm.csv: "line 59: text after a closing quote" for a quote opened on line 51; session 22's outside testing).
+// Every CSV reader shares the one reader, so a cycle file shows it as the EPA list does.
+TEST_F(DriveCycleFiles, AnUnclosedQuoteIsNamedAtTheLineWhereItOpened) {
+  std::string m = error_of("time_s,speed_kmh,note\n0,0,a\n1,\"5,b\n2,6,c\n3,7,\"d\"\n");
+  EXPECT_NE(m.find("bad.csv: line 3: a quoted cell opens here and runs over 3 lines to line 5"), std::string::npos) << m;
+  EXPECT_NE(m.find("is a closing quote missing on line 3?"), std::string::npos) << m;
+  m = error_of("time_s,speed_kmh,note\n0,0,a\n1,\"5\n\",\"b\n2,6,c\n");  // the record opens on line 3, the quote on 4
+  EXPECT_NE(m.find("bad.csv: line 4: a quoted cell opens here and is never closed"), std::string::npos) << m;
+  m = error_of("time_s,speed_kmh\n0,0\n\"1\",\"5\"x\n");  // on one line: that line, as before
+  EXPECT_NE(m.find("bad.csv: line 3: text after a closing quote"), std::string::npos) << m;
+}
+
 // A step no road could climb over the distance driven (20 m in 10 m: a GPS glitch) is dropped, and said.
 TEST_F(DriveCycleFiles, AnElevationGlitchIsDroppedAndSaid) {
   std::string text = "time_s,speed_mps,elevation_m\n";

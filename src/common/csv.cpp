@@ -116,6 +116,18 @@ std::string first_line_of(const std::string& text, std::size_t at) {
                    "'" + text + "' is a comment line; comment lines are not allowed (a header line, then data rows): delete it");
 }
 
+// Text after a quoted cell's closing quote. When the cell ran over lines, the quote that opened it is the likely
+// fault (one missing closing quote swallows the commas and line ends up to the next quote in the file), so the
+// line where it opened is named, not only the line the reader stopped at (session 22's outside testing).
+[[noreturn]] void refuse_text_after_quote(const std::string& path, std::size_t opened_line, std::size_t line) {
+  const std::string quote_rule = "a quote inside a quoted cell is written \"\"";
+  if (opened_line == line) throw InputError(path + ": line " + std::to_string(line), "text after a closing quote; " + quote_rule);
+  throw InputError(path + ": line " + std::to_string(opened_line),
+                   "a quoted cell opens here and runs over " + std::to_string(line - opened_line + 1) + " lines to line " +
+                       std::to_string(line) + ", where text follows its closing quote: is a closing quote missing on line " +
+                       std::to_string(opened_line) + "? (" + quote_rule + ")");
+}
+
 bool looks_integer(const std::string& cell) {
   const std::size_t start = (!cell.empty() && (cell[0] == '-' || cell[0] == '+')) ? 1 : 0;
   return cell.size() > start && std::all_of(cell.begin() + static_cast<std::ptrdiff_t>(start), cell.end(),
@@ -161,6 +173,7 @@ CsvTable read_csv(const std::string& path, char delimiter, std::size_t max_rows,
     std::string cell;
     bool in_quotes = false;
     bool cell_was_quoted = false;
+    std::size_t quote_line = line;  // where the last quoted cell opened
     bool record_done = false;
     while (pos < text.size() && !record_done) {
       const char c = text[pos];
@@ -183,6 +196,7 @@ CsvTable read_csv(const std::string& path, char delimiter, std::size_t max_rows,
       if (c == '"' && trim(cell).empty() && !cell_was_quoted) {
         in_quotes = true;
         cell_was_quoted = true;
+        quote_line = line;
         cell.clear();
         ++pos;
       } else if (c == delimiter) {
@@ -196,17 +210,14 @@ CsvTable read_csv(const std::string& path, char delimiter, std::size_t max_rows,
         ++line;
         record_done = true;
       } else {
-        if (cell_was_quoted && c != ' ' && c != '\t') {
-          throw InputError(path + ": line " + std::to_string(line),
-                           "text after a closing quote; a quote inside a quoted cell is written \"\"");
-        }
+        if (cell_was_quoted && c != ' ' && c != '\t') refuse_text_after_quote(path, quote_line, line);
         if (!cell_was_quoted) cell += c;
         ++pos;
       }
     }
     if (in_quotes) {
-      throw InputError(path + ": line " + std::to_string(record_line),
-                       "a quoted cell is never closed (missing \")");
+      throw InputError(path + ": line " + std::to_string(quote_line),
+                       "a quoted cell opens here and is never closed (missing \")");
     }
     cells.push_back(cell_was_quoted ? cell : trim(cell));
     const bool blank = cells.size() == 1 && cells[0].empty() && !cell_was_quoted;
