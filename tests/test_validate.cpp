@@ -1014,5 +1014,12 @@ TEST(CliValidate, ThePlotsSeriesAreTitledByTheirOwnPoints) {
   }
 }
 
+// --threads 100000 was refused as "1e+05 is not allowed" (session 22's outside testing): said as typed.
+TEST(CliValidate, AnOptionOutOfRangeIsSaidAsTyped) {
+  const auto r = test::run_rollsim("validate --epa-test-car-list " + kList + " --threads 100000");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("--threads: 100000 is not allowed"), std::string::npos) << r.err;
+}
+
 }  // namespace
 }  // namespace rollsim

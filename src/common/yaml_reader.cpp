@@ -419,7 +419,11 @@ double parse_option_number(const std::string& text, const std::string& option, R
     throw InputError(option, "'" + text + "' is not a number; " + range.describe());
   }
   if (v == 0.0) v = 0.0;  // -0 printed "-0.0" speeds and powers
-  return checked_number(v, option, range);
+  // A number is said as typed (the shortest round-trip form printed --threads 100000 as "1e+05": session 22's
+  // outside testing); NaN and infinity by their one name, whichever way they were typed.
+  if (!range.contains(v))
+    throw InputError(option, (std::isfinite(v) ? text : format_value(v)) + " is not allowed: " + range.describe_for(v));
+  return v;
 }
 
 int parse_option_count(const std::string& text, const std::string& option, Range range) {
