@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "rollsim/common/error.hpp"
+#include "rollsim/common/format.hpp"
 #include "rollsim/common/text.hpp"
 #include "rollsim/common/units.hpp"
 #include "rollsim/effects/catalogue.hpp"
@@ -69,8 +70,8 @@ double ratio_spread(int gears, TransmissionKind kind) {
 
 bool liquid(EpaFuel f) { return f == EpaFuel::petrol || f == EpaFuel::diesel || f == EpaFuel::e85; }
 
-SkipReason missing(std::string& detail, const std::string& field) {
-  detail = field + " is empty or not a number";
+SkipReason missing(std::string& detail, const EpaTestRow& row, const std::string& field) {
+  detail = field_problem(row, field);
   return SkipReason::missing_field;
 }
 SkipReason absurd(std::string& detail, const std::string& field, double value, const std::string& allowed) {
@@ -250,27 +251,27 @@ std::shared_ptr<const Powertrain> electric_of(const EpaTestRow& row) {
 // The fields of the car a result belongs to, in their physical ranges (50 mph too: a derived configuration's
 // road load is scaled to its power there).
 SkipReason check_configuration(const EpaTestRow& r, std::string& detail) {
-  if (!r.test_mass_kg) return missing(detail, "Equivalent Test Weight (lbs.)");
+  if (!r.test_mass_kg) return missing(detail, r, "Equivalent Test Weight (lbs.)");
   if (*r.test_mass_kg < 450.0 || *r.test_mass_kg > 9000.0) return absurd(detail, "test mass [kg]", *r.test_mass_kg, "450-9000 kg");
-  if (!r.road_a_n) return missing(detail, "Target Coef A (lbf)");
-  if (!r.road_b_n_s_per_m) return missing(detail, "Target Coef B (lbf/mph)");
-  if (!r.road_c_n_s2_per_m2) return missing(detail, "Target Coef C (lbf/mph**2)");
+  if (!r.road_a_n) return missing(detail, r, "Target Coef A (lbf)");
+  if (!r.road_b_n_s_per_m) return missing(detail, r, "Target Coef B (lbf/mph)");
+  if (!r.road_c_n_s2_per_m2) return missing(detail, r, "Target Coef C (lbf/mph**2)");
   if (*r.road_c_n_s2_per_m2 <= 0.0 || *r.road_c_n_s2_per_m2 > 4.0)
     return absurd(detail, "target C [N s^2/m^2]", *r.road_c_n_s2_per_m2, "more than 0, up to 4");
   for (double v_mps : {2.0, 10.0, 20.0, kRoadLoadPowerSpeed_mps, 30.0, 40.0}) {
     const double f_n = target_road_load_n(r, v_mps);
-    if (f_n <= 0.0 || f_n > 5000.0) return absurd(detail, "target road load at " + format_value(units::mps_to_kmh(v_mps)) + " km/h [N]", f_n, "0-5000 N");
+    if (f_n <= 0.0 || f_n > 5000.0) return absurd(detail, "target road load at " + significant(units::mps_to_kmh(v_mps), 4) + " km/h [N]", f_n, "0-5000 N");
   }
-  if (!r.rated_power_w) return missing(detail, "Rated Horsepower");
+  if (!r.rated_power_w) return missing(detail, r, "Rated Horsepower");
   if (*r.rated_power_w < 30e3 || *r.rated_power_w > 1.5e6) return absurd(detail, "rated power [kW]", *r.rated_power_w / 1e3, "30-1500 kW");
-  if (!r.engine_radps_per_mps) return missing(detail, "N/V Ratio");
+  if (!r.engine_radps_per_mps) return missing(detail, r, "N/V Ratio");
   const double nv = nv_rpm_per_mph(r);
   // An engine's top gear: 80 rpm/mph is 4800 rpm at 60 mph (the list's engines reach 51); an electric machine's
   // single reduction runs faster (up to 191 in the list).
   if (liquid(r.fuel) && (nv < 12.0 || nv > 80.0)) return absurd(detail, "N/V ratio of an engine's top gear [rpm/mph]", nv, "12-80");
   if (nv < 12.0 || nv > 250.0) return absurd(detail, "N/V ratio [rpm/mph]", nv, "12-250");
   if (!liquid(r.fuel)) return SkipReason::none;
-  if (!r.displacement_m3) return missing(detail, "Test Veh Displacement (L)");
+  if (!r.displacement_m3) return missing(detail, r, "Test Veh Displacement (L)");
   // In litres, as the list gives it, so that its 0.6 and 9 are inside (9e-3 m^3 x 1e3 is 9.000000000000002).
   const double litres = std::round(*r.displacement_m3 * 1e3 * 1e9) / 1e9;
   if (litres < 0.6 || litres > 9.0) return absurd(detail, "displacement [l]", litres, "0.6-9 l");
@@ -280,7 +281,7 @@ SkipReason check_configuration(const EpaTestRow& r, std::string& detail) {
     return SkipReason::absurd_field;
   }
   if (r.transmission != EpaTransmission::cvt) {
-    if (!r.gears) return missing(detail, "# of Gears");
+    if (!r.gears) return missing(detail, r, "# of Gears");
     if (*r.gears < 2 || *r.gears > 10) return absurd(detail, "# of Gears of a stepped transmission", *r.gears, "2-10");
   }
   return SkipReason::none;
@@ -310,7 +311,11 @@ SkipReason check_car_fields(const EpaTestRow& row, std::string& detail) {
     detail = "Analytically Derived FE? '" + row.adfe_flag + "' (allowed Yes or No)";
     return row.adfe_flag.empty() ? SkipReason::missing_field : SkipReason::absurd_field;
   }
-  if (const char* field = missing_derived_field(row)) return missing(detail, field);
+  if (const char* field = missing_derived_field(row)) return missing(detail, row, field);
+  // The derived configuration's road load is the tested one scaled to this power: 0 or less scaled its coefficients
+  // to 0 and was reported as "target C = 0" (session 22's outside testing).
+  if (row.derived && *row.derived->road_load_power_w <= 0.0)
+    return absurd(detail, "ADFE Total Road Load HP", *row.derived->road_load_power_w / units::kWPerHp, "more than 0 hp");
   const SkipReason why = check_configuration(result_configuration(row), detail);
   if (why != SkipReason::none && row.derived) detail = "the analytically derived configuration (ADFE columns): " + detail;
   return why;

@@ -56,6 +56,11 @@ constexpr const char* kAdfePower = "ADFE Total Road Load HP";
 
 }  // namespace
 
+std::string field_problem(const EpaTestRow& row, const std::string& column) {
+  const auto it = row.unusable.find(column);
+  return column + (it == row.unusable.end() ? " is empty" : " " + it->second);
+}
+
 const char* missing_derived_field(const EpaTestRow& row) {
   if (!row.derived) return nullptr;
   if (!row.derived->test_mass_kg) return kAdfeWeight;
@@ -120,9 +125,11 @@ std::string to_string(SkipReason r) {
     case SkipReason::other_procedure: return "test procedure not simulated";
     case SkipReason::hybrid: return "hybrid or plug-in hybrid: no hybrid model";
     case SkipReason::duplicate_test: return "the same test as an earlier line (counted once)";
+    case SkipReason::conflicting_repeat: return "test number repeated with a different vehicle or result";
     case SkipReason::inconsistent_result: return "measured result contradicts the row's own exhaust carbon";
     case SkipReason::fuel_cell: return "hydrogen fuel cell: no fuel-cell model";
     case SkipReason::unsupported_fuel: return "fuel without properties here";
+    case SkipReason::unknown_unit: return "result in a unit not given for its fuel";
     case SkipReason::missing_field: return "missing field";
     case SkipReason::absurd_field: return "field outside its physical range";
     case SkipReason::cannot_follow_cycle: return "the car from the row cannot follow the cycle (the driver keeps within 2 mph)";
@@ -145,25 +152,40 @@ std::vector<EpaTestRow> read_epa_test_car_list(const std::string& path) {
                     c_etw = col("Equivalent Test Weight (lbs.)"), c_disp = col("Test Veh Displacement (L)"),
                     c_hp = col("Rated Horsepower"), c_gears = col("# of Gears"), c_nv = col("N/V Ratio"),
                     c_a = col("Target Coef A (lbf)"), c_b = col("Target Coef B (lbf/mph)"),
-                    c_c = col("Target Coef C (lbf/mph**2)"), c_fe = col("RND_ADJ_FE"),
+                    c_c = col("Target Coef C (lbf/mph**2)"), c_fe = col(kResultColumn),
                     c_adfe = col("Analytically Derived FE?"), c_adfe_test = col("ADFE Test Number"),
                     c_adfe_power = col(kAdfePower), c_adfe_etw = col(kAdfeWeight), c_adfe_nv = col(kAdfeNv);
   const std::size_t c_bag[3] = {col("FE Bag 1"), col("FE Bag 2"), col("FE Bag 3")};
   // Required too, though optional until session 21: without them the four-bag hybrid rule and the exhaust-carbon
   // check were switched off in silence, and FE_UNIT was not read at all.
-  const std::size_t c_bag4 = col("FE Bag 4"), c_hc = col("THC (g/mi)"), c_co = col("CO (g/mi)"), c_co2 = col("CO2 (g/mi)"),
-                    c_unit = col("FE_UNIT");
+  const std::size_t c_bag4 = col(kFeBag4Column), c_hc = col(kExhaustColumns[0]), c_co = col(kExhaustColumns[1]),
+                    c_co2 = col(kExhaustColumns[2]), c_unit = col("FE_UNIT");
   if (t.rows.empty()) throw InputError(path, "no test rows: the file has the list's columns but no data line");
   std::vector<EpaTestRow> rows;
   rows.reserve(t.rows.size());
   for (std::size_t i = 0; i < t.rows.size(); ++i) {
     const auto& cells = t.rows[i];
+    EpaTestRow r;
+    // A cell that is not a finite number leaves its field empty, and its text is kept for the skip to quote (a
+    // weight of '4,500' was "empty or not a number" without the text: session 22's outside testing).
+    auto unusable = [&](std::size_t c, const std::string& why) {
+      r.unusable[t.header[c]] = "'" + trim(cells[c]) + "' " + why;
+      return std::nullopt;
+    };
     auto number = [&](std::size_t c) -> std::optional<double> {
       const auto v = parse_number(cells[c]);
-      if (!v || !std::isfinite(*v)) return std::nullopt;
+      if (trim(cells[c]).empty()) return std::nullopt;
+      if (!v) return unusable(c, "is not a number");
+      if (!std::isfinite(*v)) return unusable(c, "is not a finite number");
       return v;
     };
-    EpaTestRow r;
+    // An amount that cannot be negative (a bag's economy, an exhaust mass): a negative one is as unusable as text,
+    // not "none" (a negative FE Bag 4 read as no fourth bag, a negative CO2 switched the carbon check off).
+    auto amount = [&](std::size_t c) -> std::optional<double> {
+      const auto v = number(c);
+      if (v && *v < 0.0) return unusable(c, "is negative");
+      return v;
+    };
     r.line = t.row_line[i];
     r.test_number = trim(cells[c_test]);
     r.make = trim(cells[c_make]);
@@ -171,7 +193,8 @@ std::vector<EpaTestRow> read_epa_test_car_list(const std::string& path) {
     r.vehicle_id = trim(cells[c_id]);
     r.procedure = trim(cells[c_proc]);
     r.cycle = cycle_of(r.procedure);
-    r.fuel = fuel_of(trim(cells[c_fuel]));
+    r.fuel_text = trim(cells[c_fuel]);
+    r.fuel = fuel_of(r.fuel_text);
     r.transmission_text = trim(cells[c_trans]);
     r.transmission = transmission_of(r.transmission_text);
     r.drive_text = trim(cells[c_drive]);
@@ -185,18 +208,20 @@ std::vector<EpaTestRow> read_epa_test_car_list(const std::string& path) {
     if (const auto v = number(c_hp)) r.rated_power_w = *v * units::kWPerHp;
     // Any whole number is kept, so that a negative count is skipped as outside its range, not as missing.
     // (100 gears read as "missing" until session 21: only whole numbers under 100 were kept.)
-    if (const auto v = number(c_gears); v && *v == std::floor(*v) && std::abs(*v) < 1e6) r.gears = static_cast<int>(*v);
+    if (const auto v = number(c_gears)) {
+      if (*v == std::floor(*v) && std::abs(*v) < 1e6) r.gears = static_cast<int>(*v);
+      else unusable(c_gears, *v != std::floor(*v) ? "is not a whole number" : "is far outside any gearbox's count");
+    }
     if (const auto v = number(c_nv)) r.engine_radps_per_mps = *v * units::kRadpsPerRpm / kMpsPerMph;
     if (const auto v = number(c_a)) r.road_a_n = *v * kNPerLbf;
     if (const auto v = number(c_b)) r.road_b_n_s_per_m = *v * kNPerLbf / kMpsPerMph;
     if (const auto v = number(c_c)) r.road_c_n_s2_per_m2 = *v * kNPerLbf / (kMpsPerMph * kMpsPerMph);
     r.measured = number(c_fe);
     for (int b = 0; b < 3; ++b) r.bag_mpg[b] = number(c_bag[b]);
-    r.bag4_mpg = number(c_bag4);
-    if (!r.bag4_mpg && !trim(cells[c_bag4]).empty()) r.bag4_unreadable = trim(cells[c_bag4]);
-    r.hc_g_per_mi = number(c_hc);
-    r.co_g_per_mi = number(c_co);
-    r.co2_g_per_mi = number(c_co2);
+    r.bag4_mpg = amount(c_bag4);
+    r.hc_g_per_mi = amount(c_hc);
+    r.co_g_per_mi = amount(c_co);
+    r.co2_g_per_mi = amount(c_co2);
     r.adfe_flag = trim(cells[c_adfe]);
     if (lower_ascii(r.adfe_flag) == "yes") {
       EpaTestRow::DerivedConfiguration d;

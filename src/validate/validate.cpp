@@ -60,8 +60,9 @@ Cycles shipped_cycles() {
   return c;
 }
 
-// A measured result a car on petrol, diesel or E85 can have, in mpg.
-bool plausible_liquid_mpg(double mpg) { return mpg >= 5.0 && mpg <= 100.0; }
+// A measured result a car on petrol, diesel or E85 can have, in mpg; an electric car's, in MPGe.
+constexpr double kLiquidMpgFrom = 5.0, kLiquidMpgTo = 100.0, kElectricMpgeFrom = 60.0, kElectricMpgeTo = 250.0;
+bool plausible_liquid_mpg(double mpg) { return mpg >= kLiquidMpgFrom && mpg <= kLiquidMpgTo; }
 
 // ---- hybrids: the list does not flag them, so three rules (README) ----
 std::string vehicle_key(const EpaTestRow& r) { return lower_ascii(r.make) + "|" + lower_ascii(r.model) + "|" + r.vehicle_id; }
@@ -92,7 +93,8 @@ bool name_says_hybrid(const EpaTestRow& r) {
 struct VehicleFacts {
   bool charge_depleting_on_fuel = false;
   bool four_bag_ftp = false;  ///< an FTP of this vehicle was run with four bags, as hybrids are (SAE J1711)
-  std::string bag4_unreadable;  ///< ... or its FTP's FE Bag 4 is text the rule cannot read (read as no bag until session 22)
+  /// ... or its FTP's FE Bag 4 is something the rule cannot read, text or negative (read as no bag until session 22).
+  std::string bag4_unusable;
   /// Its FTP and HWFET results per liquid fuel: the hybrid rule compares the two on one fuel (a flex-fuel car's
   /// E85 highway against its petrol city figure read as a hybrid's: session 22's outside testing).
   struct Economy {
@@ -114,7 +116,7 @@ std::map<std::string, VehicleFacts> vehicle_facts(const std::vector<EpaTestRow>&
     auto& v = f[vehicle_key(r)];
     if (charge_depleting(r.cycle) && liquid(r.fuel)) v.charge_depleting_on_fuel = true;
     if (r.cycle == EpaCycle::ftp75 && r.bag4_mpg && *r.bag4_mpg > 0.0) v.four_bag_ftp = true;
-    if (r.cycle == EpaCycle::ftp75 && !r.bag4_unreadable.empty()) v.bag4_unreadable = r.bag4_unreadable;
+    if (r.cycle == EpaCycle::ftp75 && r.unusable.count(kFeBag4Column)) v.bag4_unusable = field_problem(r, kFeBag4Column);
     if (charge_depleting(r.cycle) && r.fuel == EpaFuel::electricity && r.measured && *r.measured > kKwhPer100MiTo)
       v.electric_result_in_mpge = true;
     // Only results in a liquid-fuel car's plausible range inform the hybrid rule: an absurd one is skipped as such.
@@ -136,12 +138,34 @@ constexpr double kHybridHighwayOverCity = 1.10;
 // to -0.2..+0.2 % (diesel); a row off by more than kCarbonBalanceTolerance carries a result that is not its own test's.
 constexpr double kCarbonBalancePetrol = 2421.0, kCarbonBalanceDiesel = 2778.0, kCarbonBalanceTolerance = 0.05;
 
+bool carbon_checked(EpaFuel f) { return f == EpaFuel::petrol || f == EpaFuel::diesel; }
+
+// A THC, CO or CO2 the row gives but that cannot be read (text, a negative mass) switched the check off in silence
+// until session 22's outside testing: "" when the check can read what the row gives.
+std::string unusable_exhaust(const EpaTestRow& r) {
+  if (!carbon_checked(r.fuel)) return "";
+  for (const char* column : kExhaustColumns) {
+    if (r.unusable.count(column)) return field_problem(r, column);
+  }
+  return "";
+}
+
 std::optional<double> carbon_balance_mpg(const EpaTestRow& r) {
-  if (r.fuel != EpaFuel::petrol && r.fuel != EpaFuel::diesel) return std::nullopt;
+  if (!carbon_checked(r.fuel)) return std::nullopt;
   if (!r.hc_g_per_mi || !r.co_g_per_mi || !r.co2_g_per_mi || *r.co2_g_per_mi <= 0.0) return std::nullopt;
   const double carbon = 0.866 * *r.hc_g_per_mi + 0.429 * *r.co_g_per_mi + 0.273 * *r.co2_g_per_mi;
   if (carbon <= 0.0) return std::nullopt;
   return (r.fuel == EpaFuel::diesel ? kCarbonBalanceDiesel : kCarbonBalancePetrol) / carbon;
+}
+
+// The list's results are in its FE_UNIT: MPG on every row, and an electric row's result is miles per gallon
+// equivalent (SOURCES.md), so an electric row may say MPGe. Another unit was read as mpg in silence until session
+// 21; MPGe on an electric row was refused until session 22's outside testing. "" for a unit the row may have.
+std::string unit_problem(const EpaTestRow& r) {
+  const std::string unit = lower_ascii(r.fe_unit);
+  if (unit == "mpg" || (unit == "mpge" && r.fuel == EpaFuel::electricity)) return "";
+  return "FE_UNIT '" + r.fe_unit + "' on " + (r.fuel == EpaFuel::electricity ? "an electric" : "a " + to_string(r.fuel)) +
+         " row (allowed: MPG for petrol, diesel and E85 rows; MPG or MPGe for electric rows)";
 }
 
 // ---- what each row is and whether it runs ----
@@ -158,15 +182,17 @@ void classify(const EpaTestRow& r, const std::map<std::string, VehicleFacts>& fa
   if (r.cycle == EpaCycle::cold || r.fuel == EpaFuel::cold_test_fuel) return skip(SkipReason::cold_test);
   if (r.cycle == EpaCycle::other) return skip(SkipReason::other_procedure, "'" + r.procedure + "'");
   if (r.fuel == EpaFuel::hydrogen) return skip(SkipReason::fuel_cell);
-  if (r.fuel == EpaFuel::other) return skip(SkipReason::unsupported_fuel);
+  if (r.fuel == EpaFuel::other)
+    return skip(SkipReason::unsupported_fuel,
+                "Test Fuel Type Description '" + r.fuel_text + "' (known: a description naming gasoline, diesel or E85, "
+                "Electricity, Hydrogen, or a Cold CO test fuel, as the list's 'Tier 2 Cert Gasoline')");
   if (liquid(r.fuel)) {
     const VehicleFacts& v = facts.at(vehicle_key(r));
     if (charge_depleting(r.cycle) || v.charge_depleting_on_fuel)
       return skip(SkipReason::hybrid, "plug-in: charge-depleting tests on a liquid fuel");
     if (name_says_hybrid(r)) return skip(SkipReason::hybrid, "named so: '" + r.model + "'");
-    if (!v.bag4_unreadable.empty())
-      return skip(SkipReason::absurd_field, "its FTP's FE Bag 4 '" + v.bag4_unreadable +
-                                                "' is not a number, so whether it was run with four bags (a hybrid) is unknown");
+    if (!v.bag4_unusable.empty())
+      return skip(SkipReason::absurd_field, "its FTP's " + v.bag4_unusable + ", so whether it was run with four bags (a hybrid) is unknown");
     if (v.four_bag_ftp)
       return skip(SkipReason::hybrid, "its FTP was run with four bags (FE Bag 4 given), the hybrids' procedure of SAE "
                                       "J1711 (40 CFR 600.115-11(c)); mild (48 V) hybrids are tested so too");
@@ -178,13 +204,10 @@ void classify(const EpaTestRow& r, const std::map<std::string, VehicleFacts>& fa
   } else if (!charge_depleting(r.cycle)) {
     return skip(SkipReason::other_procedure, "electric car on '" + r.procedure + "' (not a charge-depleting test)");
   }
-  // The list's values are in its FE_UNIT; it gives MPG on every row (MPGe for an electric car), and another unit
-  // was read as mpg in silence until session 21.
-  if (lower_ascii(r.fe_unit) != "mpg")
-    return skip(SkipReason::absurd_field, "FE_UNIT '" + r.fe_unit + "' (the list's results are in MPG, MPGe for electric cars)");
-  if (!r.measured) return skip(SkipReason::no_measured_result);
+  if (const std::string problem = unit_problem(r); !problem.empty()) return skip(SkipReason::unknown_unit, problem);
+  if (!r.measured) return skip(SkipReason::no_measured_result, field_problem(r, kResultColumn));
   o.measured = *r.measured;
-  if (r.fuel == EpaFuel::electricity && reads_as_kwh_per_100mi(o.measured)) {
+  if (r.fuel == EpaFuel::electricity && lower_ascii(r.fe_unit) == "mpg" && reads_as_kwh_per_100mi(o.measured)) {
     // See the data's SOURCES.md: some electric rows give 17-35 "MPG"; read as kWh per 100 miles, unless the
     // vehicle's other charge-depleting results are in MPGe (the list's EQS 450+: 138 on the UDDS, 38.1 on the
     // highway, which would be 88.5 MPGe): then neither reading can be trusted.
@@ -194,9 +217,19 @@ void classify(const EpaTestRow& r, const std::map<std::string, VehicleFacts>& fa
     o.measured = 100.0 * kKwhPerGallonEquivalent / o.measured;
     o.measured_from_kwh_per_100mi = true;
   }
-  const bool plausible = r.fuel == EpaFuel::electricity ? o.measured >= 60.0 && o.measured <= 250.0
-                                                        : plausible_liquid_mpg(o.measured);
-  if (!plausible) return skip(SkipReason::absurd_measured_result, format_value(*r.measured) + " " + o.unit);
+  // An electric row's 8-60 "MPG" is said with the MPGe it was read as.
+  const std::string measured_text =
+      format_value(*r.measured) +
+      (o.measured_from_kwh_per_100mi ? " \"MPG\", read as kWh per 100 miles: " + significant(o.measured, 4) : "") + " " + o.unit;
+  const bool electric = r.fuel == EpaFuel::electricity;
+  const bool plausible = electric ? o.measured >= kElectricMpgeFrom && o.measured <= kElectricMpgeTo : plausible_liquid_mpg(o.measured);
+  if (!plausible)
+    return skip(SkipReason::absurd_measured_result,
+                measured_text + " (allowed for " + (electric ? "an electric car: " : "a petrol, diesel or E85 car: ") +
+                    format_value(electric ? kElectricMpgeFrom : kLiquidMpgFrom) + "-" +
+                    format_value(electric ? kElectricMpgeTo : kLiquidMpgTo) + " " + o.unit + ")");
+  if (const std::string problem = unusable_exhaust(r); !problem.empty())
+    return skip(SkipReason::absurd_field, problem + ", so the result cannot be checked against the row's exhaust carbon");
   if (const auto carbon_mpg = carbon_balance_mpg(r); carbon_mpg && std::abs(o.measured / *carbon_mpg - 1.0) > kCarbonBalanceTolerance)
     return skip(SkipReason::inconsistent_result,
                 format_value(o.measured) + " mpg where its HC, CO and CO2 give " + fixed(*carbon_mpg, 1) +
@@ -387,6 +420,27 @@ ErrorStats error_stats(const std::vector<double>& e) {
   return s;
 }
 
+// "Aston Martin DBS (7002PT7056) at 17.7 MPG": what a repeated test number must agree on.
+std::string vehicle_and_result(const EpaTestRow& r) {
+  return r.make + " " + r.model + " (" + r.vehicle_id + ") at " + (r.measured ? format_value(*r.measured) + " " + r.fe_unit : "no result");
+}
+
+// The list repeats a test on one line per aftertreatment device (or averaging group, or set coefficients): such
+// lines agree on the vehicle and its result, and count once. A test number given again on another vehicle or with
+// another result is not that test; it was counted once as the earlier line until session 22's outside testing.
+void mark_repeat(const EpaTestRow& earlier, const EpaTestRow& r, RowOutcome& o) {
+  if (vehicle_key(earlier) != vehicle_key(r) || earlier.measured != r.measured) {
+    o.skip = SkipReason::conflicting_repeat;
+    o.skip_detail = "line " + std::to_string(earlier.line) + " gives test " + r.test_number + " as " +
+                    vehicle_and_result(earlier) + ", this line as " + vehicle_and_result(r);
+    return;
+  }
+  o.repeat_of_line = earlier.line;
+  if (o.skip != SkipReason::none) return;  // a repeat keeps the reason its test is not simulated
+  o.skip = SkipReason::duplicate_test;
+  o.skip_detail = "test " + r.test_number + " is line " + std::to_string(earlier.line);
+}
+
 }  // namespace
 
 double ftp75_weighted_mpg(double bag1_gal, double bag2_gal, double bag3_gal, double bag1_miles, double bag2_miles) {
@@ -404,17 +458,11 @@ Validation validate_epa_list(const std::vector<EpaTestRow>& rows, unsigned threa
   Validation v;
   v.rows.resize(rows.size());
   const auto facts = vehicle_facts(rows);
-  // The list repeats a test on one line per aftertreatment device (or averaging group): each counts once.
-  std::map<std::string, std::size_t> first_line;
+  std::map<std::string, std::size_t> first_index;
   for (std::size_t i = 0; i < rows.size(); ++i) {
-    RowOutcome& o = v.rows[i];
-    classify(rows[i], facts, o);
-    const auto [at, first] = first_line.emplace(rows[i].test_number, rows[i].line);
-    if (first || rows[i].test_number.empty()) continue;
-    o.repeat_of_line = at->second;
-    if (o.skip != SkipReason::none) continue;  // a repeat keeps the reason its test is not simulated
-    o.skip = SkipReason::duplicate_test;
-    o.skip_detail = "test " + rows[i].test_number + " is line " + std::to_string(at->second);
+    classify(rows[i], facts, v.rows[i]);
+    const auto [at, first] = first_index.emplace(rows[i].test_number, i);
+    if (!first && !rows[i].test_number.empty()) mark_repeat(rows[at->second], rows[i], v.rows[i]);
   }
 
   const Cycles cycles = shipped_cycles();

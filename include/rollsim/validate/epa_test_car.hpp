@@ -1,6 +1,7 @@
 // The EPA Test Car List as rollsim reads it: one dynamometer test per row, in SI, with the test it is and what it measured.
 #pragma once
 
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -16,16 +17,18 @@ enum class EpaTransmission { automatic, cvt, clutch, other };
 /// Why a row is not simulated. `none` for a simulated row.
 enum class SkipReason {
   none,
-  no_measured_result,     ///< RND_ADJ_FE empty
+  no_measured_result,     ///< RND_ADJ_FE empty or not a number
   absurd_measured_result, ///< outside what any car of its kind achieves (e.g. 4599 mpg)
   air_conditioning_test,  ///< SC03: no cabin or air-conditioning model
   cold_test,              ///< Cold CO and the 20 degF charge-depleting FTP: no cold-ambient model
   other_procedure,        ///< a test procedure rollsim does not know
   hybrid,                 ///< hybrid or plug-in hybrid (identified by rule, see README)
   duplicate_test,         ///< a test the list already gave on an earlier line (one line per aftertreatment device)
+  conflicting_repeat,     ///< an earlier line's test number on another vehicle or with another result
   inconsistent_result,    ///< the measured economy contradicts the row's own exhaust carbon (the carbon balance)
   fuel_cell,              ///< hydrogen fuel cell
-  unsupported_fuel,       ///< E85 and other fuels without properties here
+  unsupported_fuel,       ///< a fuel the list does not use, so without properties here
+  unknown_unit,           ///< FE_UNIT is not a unit the row's fuel's results are given in
   missing_field,          ///< a field the car needs is empty or not a number
   absurd_field,           ///< a field outside its physical range
   cannot_follow_cycle,    ///< the car built from the row cannot deliver what the trace demands (its power is absurd)
@@ -42,6 +45,7 @@ struct EpaTestRow {
   std::string test_number;
   std::string make, model, vehicle_id;
   std::string procedure;      ///< as written
+  std::string fuel_text;      ///< "Test Fuel Type Description" as written
   EpaCycle cycle = EpaCycle::other;
   EpaFuel fuel = EpaFuel::other;
   EpaTransmission transmission = EpaTransmission::other;
@@ -62,8 +66,6 @@ struct EpaTestRow {
   /// FE Bag 4: given only where the FTP was run with four bags (the hot start as a whole UDDS), the hybrids'
   /// procedure of SAE J1711 (40 CFR 600.115-11(c)).
   std::optional<double> bag4_mpg;
-  /// FE Bag 4 as written where it is not a number ('n/a'): the four-bag rule cannot read it (empty otherwise).
-  std::string bag4_unreadable;
   /// THC, CO and CO2 [g/mi] as measured over the row's test; empty where the row gives none.
   std::optional<double> hc_g_per_mi, co_g_per_mi, co2_g_per_mi;
   /// "Analytically Derived FE?" Yes: the result was not measured on the vehicle the row describes. EPA derived it
@@ -76,7 +78,17 @@ struct EpaTestRow {
     std::optional<double> test_mass_kg, engine_radps_per_mps, road_load_power_w;
   };
   std::optional<DerivedConfiguration> derived;
+  /// The number columns the row fills with something the field cannot be, by column name: "'4,500' is not a number",
+  /// "'-5' is negative" (for amounts that cannot be). Such a field is left empty, and a skip quotes this.
+  std::map<std::string, std::string> unusable;
 };
+
+inline constexpr const char* kResultColumn = "RND_ADJ_FE";
+inline constexpr const char* kFeBag4Column = "FE Bag 4";
+inline constexpr const char* kExhaustColumns[] = {"THC (g/mi)", "CO (g/mi)", "CO2 (g/mi)"};
+
+/// "COLUMN '4,500' is not a number" where the row gives the column something unusable, "COLUMN is empty" otherwise.
+std::string field_problem(const EpaTestRow& row, const std::string& column);
 
 /// The row's target road load [N] at `speed_mps`, A + B v + C v^2; the row must hold all three coefficients.
 double target_road_load_n(const EpaTestRow& row, double speed_mps);
