@@ -1144,5 +1144,25 @@ TEST(CliValidate, AnOptionOutOfRangeIsSaidAsTyped) {
   EXPECT_NE(r.err.find("--threads: 100000 is not allowed"), std::string::npos) << r.err;
 }
 
+// The figure's title said "EPA Test Car List 2022" whatever the file's Model Year (d_y2023.csv; session 22's
+// outside testing).
+TEST(CliValidate, ThePlotsTitleGivesTheListsModelYears) {
+  if (report::find_gnuplot().empty()) GTEST_SKIP() << "gnuplot not installed";
+  const auto lines = list_head(4);
+  const auto svg = test::temp_dir() / "years.svg";
+  auto title_of = [&](const std::vector<std::string>& rows) {
+    const auto r = validate_lines(lines, rows, "--threads 1 --plot " + svg.string());
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    std::ifstream in(svg);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const auto at = text.find("EPA Test Car List");
+    return at == std::string::npos ? text : text.substr(at, text.find(':', at) - at);
+  };
+  EXPECT_EQ(title_of({list_line_with(lines, 2, {{"Model Year", "2023"}})}), "EPA Test Car List 2023");
+  EXPECT_EQ(title_of({list_line_with(lines, 2, {{"Model Year", "2021"}}), list_line_with(lines, 4, {{"Model Year", "2023"}})}),
+            "EPA Test Car List 2021-2023");
+  EXPECT_EQ(title_of({list_line_with(lines, 2, {{"Model Year", ""}})}), "EPA Test Car List");
+}
+
 }  // namespace
 }  // namespace rollsim

@@ -2,12 +2,14 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <limits>
 #include <map>
+#include <set>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -99,6 +101,18 @@ void print_summary(const validate::Validation& v) {
   for (const auto& [why, n] : skipped) std::cout << "  " << n << "  " << why << "\n";
 }
 
+// "EPA Test Car List 2022" (or "2021-2023") from the rows' Model Year: the title said 2022 whatever the file held
+// (session 22's outside testing). A year that is not four digits, or no Model Year column, leaves the year out.
+std::string list_title(const validate::Validation& v) {
+  std::set<std::string> years;
+  for (const auto& o : v.rows) {
+    const std::string& y = o.row->model_year;
+    if (y.size() == 4 && std::all_of(y.begin(), y.end(), [](unsigned char c) { return std::isdigit(c); })) years.insert(y);
+  }
+  if (years.empty()) return "EPA Test Car List";
+  return "EPA Test Car List " + *years.begin() + (years.size() > 1 ? "-" + *years.rbegin() : "");
+}
+
 // Predicted against measured, one series per powertrain, with the line of perfect agreement.
 void plot(const validate::Validation& v, const std::string& file) {
   namespace fs = std::filesystem;
@@ -130,7 +144,7 @@ void plot(const validate::Validation& v, const std::string& file) {
   std::ofstream gp(work / "plot.gp");
   gp << report::gnuplot_terminal("svg size 800,700 dynamic font 'Sans,12'")
      << "set output " << report::gnuplot_string(figure.string()) << "\n"
-     << "set title 'EPA Test Car List 2022: rollsim from certification data against the dynamometer'\n"
+     << "set title " << report::gnuplot_string(list_title(v) + ": rollsim from certification data against the dynamometer") << "\n"
      << "set xlabel 'measured [mpg or mpge]'\nset ylabel 'predicted [mpg or mpge]'\n"
      << "set logscale xy\nset grid\nset key top left\nset size square\n";
   // Both axes over the data's own span (gnuplot's log autoscale widens to whole decades: 1-1000 for 9-200 mpg).

@@ -160,6 +160,8 @@ std::vector<EpaTestRow> read_epa_test_car_list(const std::string& path) {
   // check were switched off in silence, and FE_UNIT was not read at all.
   const std::size_t c_bag4 = col(kFeBag4Column), c_hc = col(kExhaustColumns[0]), c_co = col(kExhaustColumns[1]),
                     c_co2 = col(kExhaustColumns[2]), c_unit = col("FE_UNIT");
+  // Optional: only the figure's title reads it.
+  const std::optional<std::size_t> c_year = t.column("Model Year");
   if (t.rows.empty()) throw InputError(path, "no test rows: the file has the list's columns but no data line");
   std::vector<EpaTestRow> rows;
   rows.reserve(t.rows.size());
@@ -192,6 +194,7 @@ std::vector<EpaTestRow> read_epa_test_car_list(const std::string& path) {
     r.model = trim(cells[c_model]);
     r.vehicle_id = trim(cells[c_id]);
     r.procedure = trim(cells[c_proc]);
+    if (c_year) r.model_year = trim(cells[*c_year]);
     r.cycle = cycle_of(r.procedure);
     r.fuel_text = trim(cells[c_fuel]);
     r.fuel = fuel_of(r.fuel_text);

@@ -45,6 +45,7 @@ struct EpaTestRow {
   std::string test_number;
   std::string make, model, vehicle_id;
   std::string procedure;      ///< as written
+  std::string model_year;     ///< "Model Year" as written; empty where the list has no such column
   std::string fuel_text;      ///< "Test Fuel Type Description" as written
   EpaCycle cycle = EpaCycle::other;
   EpaFuel fuel = EpaFuel::other;
