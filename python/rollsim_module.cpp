@@ -327,8 +327,8 @@ py::list api_sweep(py::object tyre, py::object axes_arg, py::object load_n, py::
     py::gil_scoped_release released;
     r = selection::sweep_tyre(t, so);
   }
-  if (r.stopped) {
-    warn(*r.stopped + " (the " + std::to_string(r.points.size()) + " valid points of " +
+  if (r.outside_domain) {
+    warn(*r.outside_domain + " (the " + std::to_string(r.points.size()) + " valid points of " +
          std::to_string(r.planned_points) + " are returned)");
   }
   for (const std::string& w : selection::sweep_warnings(r)) warn(w);
@@ -591,13 +591,13 @@ the fitting tyres ranked best first (rank 1..), then the unfit ones (rank None, 
 files are skipped with a warning. followed_trace is False (with max_deficit_kmh [km/h] and a warning) where the car
 could not follow the cycle on that tyre: its figure is then for a slower drive.)");
 
-  m.def("sweep", &api_sweep, "tyre"_a, "axes"_a, py::kw_only(), "load_n"_a = py::none(), "speed_kmh"_a = 80.0,
+  m.def("sweep", &api_sweep, "tyre"_a, "axes"_a, py::kw_only(), "load_n"_a = py::none(), "speed_kmh"_a = py::none(),
         "vehicle"_a = py::none(), "cycle"_a = py::none(), "threads"_a = py::none(),
         R"(A sweep of one or two tyre parameters (`rollsim sweep --json`).
 
 tyre: file, shipped name or dict. axes: [(param, from, to[, steps])], param one of pressure [bar], diameter [mm],
 width [mm], load [N], load-pct [%], speed [km/h]; steps default 11. load_n [N] (default 80 % of the maximum
-load), speed_kmh [km/h]. With vehicle (and cycle, default 'nedc'; a cycle without a vehicle is an error) each
+load), speed_kmh [km/h] (default 80; not with a speed axis). With vehicle (and cycle, default 'nedc'; a cycle without a vehicle is an error) each
 point is a forward simulation of the car (on `threads` threads, default every core). Returns a list of dicts, one
 per point: the swept values (pressure_bar, diameter_mm, width_mm, load_n, load_pct, speed_kmh), the load_n and
 speed_kmh evaluated at when not swept, rrc,

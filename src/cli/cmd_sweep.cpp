@@ -169,7 +169,7 @@ void run_sweep(const SweepOptionsText& o, const ProcessGroup& group) {
 
   // Nothing valid: the reason, and no file (a header-only CSV was left, and --plot said only "no valid point").
   if (r.points.empty()) {
-    throw InputError("--param", (r.stopped ? *r.stopped : std::string("no point was computed")) +
+    throw InputError("--param", (r.outside_domain ? *r.outside_domain : std::string("no point was computed")) +
                                     " (no valid point of " + std::to_string(r.planned_points) + "; nothing written)");
   }
   std::string table;
@@ -188,8 +188,8 @@ void run_sweep(const SweepOptionsText& o, const ProcessGroup& group) {
   if (o.output.empty()) std::cout << table;
   if (group.is_root())
     for (const std::string& w : selection::sweep_warnings(r)) std::cerr << "warning: " << w << "\n";
-  if (r.stopped) {
-    throw InputError("--param", *r.stopped + " (the " + std::to_string(r.points.size()) + " valid points of " +
+  if (r.outside_domain) {
+    throw InputError("--param", *r.outside_domain + " (the " + std::to_string(r.points.size()) + " valid points of " +
                                     std::to_string(r.planned_points) + " were written)");
   }
 }

@@ -201,7 +201,13 @@ SweepOptions sweep_options_from_request(const SweepRequest& o) {
       throw InputError("--load-n", "not allowed with --param " + sweep_param_key(a.param) + ", which sets the load");
     }
   }
-  so.speed_kmh = parse_option_number(o.speed_kmh, "--speed-kmh", Range::closed(0.0, 500.0));
+  for (const auto& a : so.axes) {
+    // Silently ignored until session 22 (outside testing), where --load-n beside a load axis was refused.
+    if (!o.speed_kmh.empty() && a.param == SweepParam::Speed) {
+      throw InputError("--speed-kmh", "not allowed with --param speed, which sets the speed");
+    }
+  }
+  if (!o.speed_kmh.empty()) so.speed_kmh = parse_option_number(o.speed_kmh, "--speed-kmh", Range::closed(0.0, 500.0));
   if (!o.threads.empty()) so.threads = static_cast<unsigned>(parse_option_count(o.threads, "--threads", Range::closed(1, 1024)));
   return so;
 }

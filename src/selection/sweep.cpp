@@ -226,12 +226,22 @@ void check_options(const TyreSpec& tyre, const SweepOptions& o) {
   }
 }
 
-std::string stop_message(const std::vector<SweepAxis>& axes, const std::vector<double>& at, const std::string& why,
-                         const std::vector<SweepPoint>& valid) {
-  std::string s = "sweep stopped at " + describe_point(axes, at) + ": " + why;
-  s += valid.empty() ? "; no valid point" : "; last valid point " + describe_point(axes, valid.back().values);
-  return s;
-}
+// Points outside the model's domain are left out and counted, the first one said. A sweep stopped at its first
+// such point until session 22, which is right only for an axis that leaves the domain as it rises (load): a pressure,
+// diameter or width range leaves it as it falls, so a range starting at 1 bar wrote nothing ("no valid point") and a
+// pressure x load grid lost every row after the corner where 1 bar met the heaviest load.
+struct OutsideDomain {
+  std::size_t count = 0;
+  std::string first;
+  void add(const std::vector<SweepAxis>& axes, const std::vector<double>& at, const std::string& why) {
+    if (count++ == 0) first = describe_point(axes, at) + ": " + why;
+  }
+  std::optional<std::string> message(std::size_t planned) const {
+    if (count == 0) return std::nullopt;
+    return std::to_string(count) + " of " + std::to_string(planned) + " points are outside the model's domain and were "
+           "left out; the first, at " + first;
+  }
+};
 
 }  // namespace
 
@@ -243,6 +253,7 @@ SweepResult sweep_tyre(const TyreSpec& tyre, const SweepOptions& o) {
   const auto pts = grid(o.axes, kMaxTyreSweepPoints, "a tyre sweep");
   r.planned_points = pts.size();
   r.points.reserve(pts.size());
+  OutsideDomain outside;
   for (const auto& values : pts) {
     const PointSetup s = setup(tyre, o, values);
     try {
@@ -253,11 +264,11 @@ SweepResult sweep_tyre(const TyreSpec& tyre, const SweepOptions& o) {
       p.rr = evaluate_rolling_resistance(s.tyre.state, s.load_n, units::kmh_to_mps(s.speed_kmh));
       r.points.push_back(p);
     } catch (const ModelDomainError& e) {
-      r.stopped = stop_message(o.axes, values, e.what(), r.points);
-      break;
+      outside.add(o.axes, values, e.what());
     }
-    if (o.progress) o.progress(r.points.size(), pts.size());
+    if (o.progress) o.progress(r.points.size() + outside.count, pts.size());
   }
+  r.outside_domain = outside.message(pts.size());
   return r;
 }
 
@@ -315,6 +326,7 @@ SweepResult sweep_vehicle(const Vehicle& vehicle, const TyreSpec& tyre, const Dr
     return bytes;
   };
   const auto results = map_cases(o.map_cases, pts.size(), o.threads, body, o.progress);
+  OutsideDomain outside;
   for (std::size_t i = 0; i < pts.size(); ++i) {
     const PointSetup ps = setup(tyre, o, pts[i]);
     SweepPoint p{pts[i], ps.load_n, ps.speed_kmh, {}, 0.0, {}};
@@ -326,11 +338,12 @@ SweepResult sweep_vehicle(const Vehicle& vehicle, const TyreSpec& tyre, const Dr
     take(in, p.overcharge);
     take(in, error);
     if (!error.empty()) {
-      r.stopped = stop_message(o.axes, pts[i], error, r.points);
-      break;
+      outside.add(o.axes, pts[i], error);
+      continue;
     }
     r.points.push_back(std::move(p));
   }
+  r.outside_domain = outside.message(pts.size());
   return r;
 }
 
@@ -381,7 +394,7 @@ std::vector<std::string> sweep_warnings(const SweepResult& r) {
 
 std::string sweep_csv(const SweepResult& r) {
   std::ostringstream out;
-  SweepPoint names_only;  // the header needs no point: a sweep that stopped at its first still has one
+  SweepPoint names_only;  // the header needs no point: a sweep with no valid point still has one
   names_only.values.resize(r.axes.size());
   for (const auto& [name, value] : sweep_point_columns(r, names_only)) out << name << ",";
   out << "rrc,rr_force_n,rr_power_w,deflection_m";

@@ -56,7 +56,7 @@ std::vector<std::string> sensitivity_warnings(const Sensitivity& sensitivity);
 struct SweepRequest {
   std::vector<std::string> params, from, to, steps;
   std::string load_n;              ///< empty: 80 % of the maximum load
-  std::string speed_kmh = "80";
+  std::string speed_kmh;           ///< empty: 80 km/h; refused beside a speed axis, which sets the speed
   std::string threads;             ///< empty: every core
 };
 /// Parses and checks the axes, load, speed and threads (errors name the option, value and what is allowed).

@@ -70,8 +70,9 @@ struct SweepResult {
   std::string energy_unit;             ///< vehicle sweeps
   std::vector<SweepPoint> points;      ///< valid points in sweep order
   std::size_t planned_points = 0;
-  /// Set when the sweep left the model's domain: the point where it stopped and why.
-  std::optional<std::string> stopped;
+  /// Set when points are outside the model's domain (left out; the rest are computed, whichever end of a range or
+  /// corner of a grid they are at): how many, the first, and why.
+  std::optional<std::string> outside_domain;
   double max_load_n = 0.0;             ///< the tyre's rated maximum load; 0 when unknown
 };
 
