@@ -535,13 +535,17 @@ TEST(TyreFitPlan, LabelAloneIsOneIsoPointWithTheBandAsItsUncertainty) {
   in.label_class = "B";
   const TyreFitPlan plan = plan_tyre_fit(in);
   ASSERT_EQ(plan.request.points.size(), 1u);
-  // Regulation (EU) 2020/740, class B: 6.6-7.7 kg/t, declared to 0.1, so 6.55-7.75; load index 91 is 615 kg.
+  // Regulation (EU) 2020/740, class B: 6.6-7.7 kg/t, declared to 0.1, so 6.55-7.75 on ISO 28580's 2.0 m drum; the
+  // point is the band's geometric middle brought to a flat road, sqrt(1 / (1 + r)) with r = 8 in + 0.55 x 205 mm
+  // (Clark's relation, as SAE J2452 and ISO 28580 take it); load index 91 is 615 kg.
   const RrcPoint& p = plan.request.points[0];
-  EXPECT_NEAR(p.rrc, 7.15e-3, 1e-12);
+  const double r_m = 8 * 0.0254 + 0.55 * 0.205;
+  EXPECT_NEAR(p.rrc, std::sqrt(6.55e-3 * 7.75e-3) * std::sqrt(1.0 / (1.0 + r_m)), 1e-12);
   EXPECT_NEAR(p.pressure_pa, 210e3, 1e-9);
   EXPECT_NEAR(p.load_n, 0.8 * 615.0 * 9.80665, 1e-9);
   EXPECT_NEAR(p.speed_mps, 80.0 / 3.6, 1e-12);
-  EXPECT_NEAR(plan.request.assumed_relative_uncertainty, 0.6 / 7.15 / std::sqrt(3.0), 1e-12);
+  // 1.96 of it spans 95 % of the band's log width: a uniform band's 95 % interval, inside the band.
+  EXPECT_NEAR(1.96 * plan.request.assumed_relative_uncertainty, 0.95 * 0.5 * std::log(7.75 / 6.55), 1e-12);
   // With a measured point the label only checks the fit: the point is the data.
   in.points.push_back({210e3, 4500.0, 80.0 / 3.6, 0.0085, "point"});
   const TyreFitPlan with_point = plan_tyre_fit(in);

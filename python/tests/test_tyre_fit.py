@@ -36,12 +36,15 @@ class TyreFit(unittest.TestCase):
         self.assertEqual(len(r["residuals"]), 3)
 
     def test_a_label_alone_is_its_band_middle_at_iso_28580_conditions(self):
-        # Class B: 6.6-7.7 kg/t declared to 0.1, so 6.55-7.75, middle 7.15; load index 91: 615 kg, 80 % of it.
+        # Class B: 6.6-7.7 kg/t declared to 0.1, so 6.55-7.75 on ISO 28580's 2.0 m drum, geometric middle
+        # sqrt(6.55 x 7.75); on a flat road x sqrt(1 / (1 + r)), r = 8 in + 0.55 x 205 mm; load index 91: 615 kg, 80 %.
         with tempfile.TemporaryDirectory() as d:
             path = os.path.join(d, "t.yaml")
             r = rollsim.tyre_fit("205/55 R16 91V", label="B", output=path)
             got = rollsim.tyre(path, pressure_bar=2.1, load_n=0.8 * 615 * 9.80665, speed_kmh=80)["rrc"]
-        self.assertAlmostEqual(got / 7.15e-3, 1.0, places=8)  # the file keeps 9 significant digits
+        flat = (6.55e-3 * 7.75e-3) ** 0.5 * (1.0 / (1.0 + 8 * 0.0254 + 0.55 * 0.205)) ** 0.5
+        self.assertAlmostEqual(got / flat, 1.0, places=8)  # the file keeps 9 significant digits
+        self.assertAlmostEqual(r["fit"]["iso_rrc_kg_per_t"], (6.55 * 7.75) ** 0.5, places=6)
         self.assertTrue(r["fit"]["inside_label_band"])
 
     def test_the_command_line_prints_the_same_json_lines(self):

@@ -68,7 +68,7 @@ std::vector<HysteresisParam> parse_free(const std::string& text) {
 
 std::string pct(double x, int d = 2) { return fixed(x * 100.0, d); }
 
-void print_fit(const TyreFit& fit, const std::optional<LabelBand>& band, const std::optional<RrcPoint>& iso) {
+void print_fit(const TyreFit& fit, const TyreFitPlan& plan) {
   report::TextTable t({"constant", "value", "95 % low", "95 % high", "note"});
   t.set_left_aligned(0);
   t.set_left_aligned(4);
@@ -110,16 +110,14 @@ void print_fit(const TyreFit& fit, const std::optional<LabelBand>& band, const s
   } else {
     std::cout << "(each point's residual: --json, one residual line per point)\n";
   }
-  if (band && iso) {
-    TyreState at = fit.tyre;
-    at.pressure_pa = iso->pressure_pa;
-    const double rrc = evaluate_rolling_resistance(at, iso->load_n, iso->speed_mps).rrc;
-    const bool inside = band->contains(rrc);
-    std::cout << "EU label class " << band->label_class << " (C1, Regulation (EU) 2020/740): RRC "
-              << fixed(band->rrc_min * 1e3, 2) << (band->open_below ? " (open below)" : "") << " - "
-              << fixed(band->rrc_max * 1e3, 2) << (band->open_above ? " (open above)" : "")
-              << " kg/t; the fitted tyre at ISO 28580 conditions: " << fixed(rrc * 1e3, 2) << " kg/t, "
-              << (inside ? "inside" : "OUTSIDE") << " the band\n";
+  if (const auto c = label_check(fit, plan)) {
+    const LabelBand& band = *plan.band;
+    std::cout << "EU label class " << band.label_class << " (C1, Regulation (EU) 2020/740): RRC "
+              << fixed(band.rrc_min * 1e3, 2) << (band.open_below ? " (open below)" : "") << " - "
+              << fixed(band.rrc_max * 1e3, 2) << (band.open_above ? " (open above)" : "")
+              << " kg/t on ISO 28580's 2.0 m drum; the fitted tyre at ISO 28580 conditions: " << fixed(c->drum_rrc * 1e3, 2)
+              << " kg/t on the drum (" << fixed(c->flat_rrc * 1e3, 2) << " on a flat road, x " << fixed(c->drum_to_flat, 4)
+              << "), " << (c->inside ? "inside" : "OUTSIDE") << " the band\n";
   }
 }
 
@@ -293,7 +291,7 @@ void run_fit(const FitOptions& o) {
   if (o.json) {
     write_tyre_fit_json(std::cout, fit, plan);
   } else {
-    print_fit(fit, plan.band, plan.iso);
+    print_fit(fit, plan);
   }
   write_file_atomically(o.output, "--output", [&](std::ostream& out) { out << text; });
   if (!o.json) std::cout << "wrote " << o.output << "\n";

@@ -1,5 +1,7 @@
 #include "rollsim/tyre/tyre_fit.hpp"
 
+#include "rollsim/tyre/j2452.hpp"
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -265,6 +267,15 @@ void set_hysteresis_param(HysteresisConstants& c, HysteresisParam p, double valu
   }
 }
 
+namespace {
+void check_rrc_range(double rrc, const std::string& where) {
+  if (!(rrc >= 0.001 && rrc <= 0.05)) {
+    throw InputError(where, "RRC " + format_value(rrc) + " is outside a tyre's physical range: must be in "
+                                                          "[0.001, 0.05] (1-50 kg/t; car tyres measure 5-15 kg/t)");
+  }
+}
+}  // namespace
+
 void check_rrc_point(const TyreState& tyre, const RrcPoint& p) {
   check_pressure_plausible_kpa(p.pressure_pa / 1e3, std::nullopt, p.where);  // the size's class: plan_tyre_fit
   const double kmh = units::mps_to_kmh(p.speed_mps);
@@ -272,10 +283,7 @@ void check_rrc_point(const TyreState& tyre, const RrcPoint& p) {
     throw InputError(p.where, "speed " + format_value(kmh) + " km/h is not allowed: must be in (0, 300] km/h (a "
                                                              "rolling tyre; RRC is not defined at standstill)");
   }
-  if (!(p.rrc >= 0.001 && p.rrc <= 0.05)) {
-    throw InputError(p.where, "RRC " + format_value(p.rrc) + " is outside a tyre's physical range: must be in "
-                                                              "[0.001, 0.05] (1-50 kg/t; car tyres measure 5-15 kg/t)");
-  }
+  check_rrc_range(p.rrc, p.where);
   TyreState at = tyre;
   at.pressure_pa = p.pressure_pa;
   try {
@@ -432,7 +440,7 @@ std::vector<RrcPoint> load_measured_rrc_csv(const std::string& path) {
   return out;
 }
 
-RrcPoint iso28580_point(const TyreSize& size, double rrc, const std::string& where) {
+RrcPoint iso28580_point(const TyreSize& size, double drum_rrc, const std::string& where) {
   if (!size.load_index) {
     throw InputError(where, "the size '" + size.designation + "' has no load index, so the ISO 28580 load (80 % of "
                             "the load index's load) is unknown; give the size with its load index, e.g. '205/55 R16 91V'");
@@ -444,12 +452,15 @@ RrcPoint iso28580_point(const TyreSize& size, double rrc, const std::string& whe
                             "(85 % of the load index's load, at its load-inflation table's pressure) and its label "
                             "bands are not built; give its measured point(s) as KPA,LOAD_N,KMH,RRC");
   }
+  check_rrc_range(drum_rrc, where);
   RrcPoint p;
   p.pressure_pa = iso28580_passenger_pressure_pa(size);
   p.load_n = 0.8 * *load_index_max_load_kg(*size.load_index) * units::kStandardGravity_mps2;
   p.speed_mps = units::kmh_to_mps(80.0);
-  p.rrc = rrc;
-  p.where = where;
+  // A label's or test report's value was taken flat until session 22 (outside testing): 13-15 % above the flat road
+  // the model and a J2452 set's correction give, for the same tyre.
+  p.rrc = drum_rrc * drum_to_flat_factor(kIso28580DrumRadius_m, size.outer_radius_m);
+  p.where = where + " (ISO 28580 drum; flat road " + significant(p.rrc, 4) + ")";
   return p;
 }
 

@@ -19,7 +19,7 @@ TyreFitPlan plan_tyre_fit(const TyreFitInputs& in) {
   plan.start.geometry.rim_radius_m = in.size.rim_diameter_m / 2.0;
   if (in.label_class) {
     plan.band = eu_label_band_c1(*in.label_class, in.label_where);
-    plan.iso = iso28580_point(in.size, plan.band->rrc_mid(), in.label_where);
+    plan.iso = iso28580_point(in.size, std::sqrt(plan.band->rrc_min * plan.band->rrc_max), in.label_where);
   }
   plan.request.points = in.points;
   if (in.j2452) {
@@ -30,8 +30,10 @@ TyreFitPlan plan_tyre_fit(const TyreFitInputs& in) {
   }
   if (plan.band && plan.request.points.empty()) {
     plan.request.points.push_back(*plan.iso);
-    plan.request.assumed_relative_uncertainty =
-        0.5 * (plan.band->rrc_max - plan.band->rrc_min) / plan.band->rrc_mid() / std::sqrt(3.0);
+    // The level's interval is symmetric in its logarithm: centred on the band's geometric middle, 1.96 standard
+    // errors span 95 % of the band's log width, as a uniform band's 95 % interval does. Half-width / sqrt 3, the
+    // uniform's own standard deviation, gave +-1.13 half-widths, wider than the band (session 22's outside testing).
+    plan.request.assumed_relative_uncertainty = 0.95 * 0.5 * std::log(plan.band->rrc_max / plan.band->rrc_min) / 1.96;
   }
   if (in.uncertainty_pct) {
     plan.request.assumed_relative_uncertainty =
@@ -42,6 +44,18 @@ TyreFitPlan plan_tyre_fit(const TyreFitInputs& in) {
   // took 50 kPa for a passenger tyre, whose file then refused it, and refused a light-truck tyre's 655 kPa).
   for (const auto& p : plan.request.points) check_pressure_plausible_kpa(p.pressure_pa / 1e3, in.size, p.where);
   return plan;
+}
+
+std::optional<LabelCheck> label_check(const TyreFit& fit, const TyreFitPlan& plan) {
+  if (!plan.band || !plan.iso) return std::nullopt;
+  TyreState at = fit.tyre;
+  at.pressure_pa = plan.iso->pressure_pa;
+  LabelCheck c;
+  c.flat_rrc = evaluate_rolling_resistance(at, plan.iso->load_n, plan.iso->speed_mps).rrc;
+  c.drum_to_flat = drum_to_flat_factor(kIso28580DrumRadius_m, plan.start.geometry.outer_radius_m);
+  c.drum_rrc = c.flat_rrc / c.drum_to_flat;
+  c.inside = plan.band->contains(c.drum_rrc);
+  return c;
 }
 
 std::vector<HysteresisParam> free_params_from_keys(const std::vector<std::string>& keys, const std::string& where) {
@@ -99,15 +113,14 @@ void write_tyre_fit_json(std::ostream& out, const TyreFit& fit, const TyreFitPla
       .add("sigma_pct", 100.0 * fit.sigma_relative)
       .add("interval_quantile", fit.interval_quantile)
       .add("sigma_from_residuals", fit.sigma_from_residuals);
-  if (plan.band && plan.iso) {
-    TyreState at = fit.tyre;
-    at.pressure_pa = plan.iso->pressure_pa;
-    const double rrc = evaluate_rolling_resistance(at, plan.iso->load_n, plan.iso->speed_mps).rrc;
+  if (const auto c = label_check(fit, plan)) {
     head.add("label_class", std::string(1, plan.band->label_class))
         .add("label_rrc_min_kg_per_t", kg_per_t(plan.band->rrc_min))
         .add("label_rrc_max_kg_per_t", kg_per_t(plan.band->rrc_max))
-        .add("iso_rrc_kg_per_t", 1e3 * rrc)
-        .add("inside_label_band", plan.band->contains(rrc));
+        .add("iso_rrc_kg_per_t", 1e3 * c->drum_rrc)
+        .add("iso_flat_rrc_kg_per_t", 1e3 * c->flat_rrc)
+        .add("iso_drum_to_flat", c->drum_to_flat)
+        .add("inside_label_band", c->inside);
   }
   out << head.str() << '\n';
   for (const auto& p : fit.params) {

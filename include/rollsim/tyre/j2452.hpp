@@ -19,6 +19,9 @@ struct J2452Set {
 
 /// The drum radius of the shipped Michelin sets (data/tyres/SOURCES.md) [m].
 inline constexpr double kJ2452DrumRadius_m = 0.85;
+/// ISO 28580's drum radius [m]: results on another drum are corrected to a 2.0 m diameter, and the EU label
+/// (Regulation (EU) 2020/740, through UN R117 Annex 6) gives that value.
+inline constexpr double kIso28580DrumRadius_m = 1.0;
 /// A drum radius a user gave [m], if in (0.1, 10) m; otherwise InputError(where, ...) naming it and the range.
 double checked_drum_radius_m(double radius_m, const std::string& where);
 

@@ -96,7 +96,6 @@ struct LabelBand {
   double rrc_max = 0.0;
   bool open_below = false;  ///< class A has no lower edge in the regulation; rrc_min is our assumption
   bool open_above = false;  ///< class E has no upper edge; rrc_max is our assumption
-  double rrc_mid() const { return 0.5 * (rrc_min + rrc_max); }
   /// Whether an RRC is of this class: an open end has no edge (A holds 5.0 kg/t, E 13.0; our closing edges are for
   /// the label-alone uncertainty only), and an edge holds a value computed onto it (6.549999999999998 is 6.55).
   bool contains(double rrc) const {
@@ -110,8 +109,10 @@ struct LabelBand {
 LabelBand eu_label_band_c1(const std::string& label_class, const std::string& where);
 
 /// The ISO 28580 test point of a C1 tyre: 80 km/h, 80 % of the load index's load, 210 kPa (standard load)
-/// or 250 kPa (extra load). Throws InputError(where, ...) without a load index.
-RrcPoint iso28580_point(const TyreSize& size, double rrc, const std::string& where);
+/// or 250 kPa (extra load). `drum_rrc` is on ISO 28580's 2.0 m drum, as a label or a test report gives it; the
+/// point holds the flat-road RRC the model predicts (drum_to_flat_factor with the size's outer radius, as for a
+/// J2452 set), and its `where` says so. Throws InputError(where, ...) without a load index.
+RrcPoint iso28580_point(const TyreSize& size, double drum_rrc, const std::string& where);
 
 /// A point given in files' units (kPa, N, km/h, RRC) as the fit takes it (SI), named `where`.
 RrcPoint rrc_point_from_file_units(double pressure_kpa, double load_n, double speed_kmh, double rrc, std::string where);

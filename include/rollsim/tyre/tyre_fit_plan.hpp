@@ -34,11 +34,19 @@ struct TyreFitPlan {
   std::optional<RrcPoint> iso;    ///< the ISO 28580 point where the band applies
 };
 
-/// A label alone is one point at ISO 28580 conditions at the band's middle, with the band as its uncertainty
-/// (uniform over the band: half-width / sqrt 3); with points, the band only checks the fit. Throws InputError for
+/// A label alone is one point at ISO 28580 conditions at the band's geometric middle, with the band as its
+/// uncertainty (its 95 % interval is 95 % of the band's log width); with points, the band only checks the fit. Throws InputError for
 /// a label class outside A-E, a label on a size without load index, a drum radius outside (0.1, 10) m or an
 /// uncertainty outside (0, 50] %.
 TyreFitPlan plan_tyre_fit(const TyreFitInputs& in);
+
+/// The fitted tyre against the label's band, which is on ISO 28580's 2.0 m drum: the model's flat-road RRC at the
+/// ISO point, the same on the drum (flat / drum_to_flat), and whether the band holds it.
+struct LabelCheck {
+  double flat_rrc = 0.0, drum_rrc = 0.0, drum_to_flat = 1.0;
+  bool inside = false;
+};
+std::optional<LabelCheck> label_check(const TyreFit& fit, const TyreFitPlan& plan);
 
 /// The constants named by `keys` (hysteresis_param_key), with the level always among them (the tyre's own).
 /// Throws InputError(where, ...) naming a key that is not a constant and the allowed ones.
