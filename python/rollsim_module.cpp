@@ -486,6 +486,7 @@ py::dict api_tyre_fit(py::object size_arg, py::object points, py::object label, 
   std::ostringstream json;
   write_tyre_fit_json(json, fit, plan);
   const std::string yaml = fitted_tyre_file_text(file, fit);
+  for (const auto& w : plan.warnings) warn(w);
   for (const auto& w : fit.warnings) warn(w);
   py::dict out;
   py::list params, residuals;

@@ -721,6 +721,11 @@ TEST(CliTyreFit, BadInputGetsOneNamedErrorAndNoFile) {
       {"--size '205/55 R16 91V' --point 210,3000,80,0.04 --point 210,6000,80,0.002", {"tyre fit", "'model.load_exponent'", "[-5, 5]"}},
       // A passenger tyre's points are held to a passenger tyre file's pressures (50 kPa was fitted, then refused).
       {"--size '205/55 R16 91V' --point 50,4500,80,0.008", {"--point 50,4500,80,0.008", "passenger tyre", "[100, 500] kPa"}},
+      // A trailing comma was a field dropped ('0.008,' read as 0.008), a drum radius without a drum set was ignored,
+      // and a speed was said as its conversion (999.9999999999999 km/h): session 22's outside testing.
+      {"--size '205/55 R16 91V' --point 0.008,", {"--point 0.008,", "expected KPA,LOAD_N,KMH,RRC"}},
+      {"--size '205/55 R16 91V' --point 0.008 --drum-radius-m 2", {"--drum-radius-m", "J2452 set only"}},
+      {"--size '205/55 R16 91V' --point 210,4500,1000,0.008", {"speed 1000 km/h is not allowed"}},
       // Three points at two conditions determine two constants, not three.
       {"--size '205/55 R16 91V' --point 210,4500,40,0.0075 --point 250,4500,80,0.0078 --point 210,4500,40,0.0076 "
        "--free rrc_ref,frequency_slope_per_hz,deflection_exponent", {"--free", "2 distinct condition(s)"}},
@@ -822,6 +827,15 @@ TEST(TyreFit, RepeatedConditionsFreeNoMoreConstantsThanTheyTellApart) {
   EXPECT_NEAR(f.residuals[0].relative_error, m / 0.0075 - 1.0, 1e-6);
   EXPECT_NEAR(f.residuals[2].relative_error, m / 0.0076 - 1.0, 1e-6);
   EXPECT_NEAR(f.residuals[1].relative_error, 0.0, 1e-6);
+}
+
+// A point loaded past the size's rating is fitted and said, as `rollsim tyre` says it (it was silent: 20 kN on a
+// load index 91 tyre, 615 kg = 6031 N; session 22's outside testing).
+TEST(CliTyreFit, APointLoadedPastTheRatingIsSaid) {
+  const auto out = temp_dir() / "overloaded.yaml";
+  const CmdResult r = fit("--size '205/55 R16 91V' --point 210,20000,80,0.008 --output '" + out.string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(has(r.err, "warning: --point 210,20000,80,0.008: load 20000 N is above the tyre's rated maximum 6031 N")) << r.err;
 }
 
 // A light-truck tyre's points may be at a light-truck tyre's pressures (655 kPa was refused: 50-600 kPa for any size).

@@ -46,6 +46,8 @@ std::vector<std::string> split(const std::string& text, char sep) {
   std::vector<std::string> out;
   std::stringstream ss(text);
   for (std::string cell; std::getline(ss, cell, sep);) out.push_back(trim(cell));
+  // getline drops a last empty field: '0.008,' read as one field and '--free rrc_ref,' as one key (session 22).
+  if (!text.empty() && text.back() == sep) out.emplace_back();
   return out;
 }
 
@@ -287,6 +289,7 @@ void run_fit(const FitOptions& o) {
   if (!o.label.empty()) src += ", --label " + o.label;
   file.source = src;
   const std::string text = fitted_tyre_file_text(file, fit);  // a fit no file may hold is refused before it is shown
+  for (const auto& w : plan.warnings) std::cerr << "warning: " << w << "\n";
   for (const auto& w : fit.warnings) std::cerr << "warning: " << w << "\n";
   if (o.json) {
     write_tyre_fit_json(std::cout, fit, plan);

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "rollsim/common/error.hpp"
+#include "rollsim/common/format.hpp"
 #include "rollsim/common/json.hpp"
 #include "rollsim/common/units.hpp"
 #include "rollsim/common/yaml_reader.hpp"
@@ -22,6 +23,10 @@ TyreFitPlan plan_tyre_fit(const TyreFitInputs& in) {
     plan.iso = iso28580_point(in.size, std::sqrt(plan.band->rrc_min * plan.band->rrc_max), in.label_where);
   }
   plan.request.points = in.points;
+  if (in.drum_radius_m && !in.j2452) {
+    throw InputError(in.drum_where, "applies to a J2452 set only (its test drum); there is none: an ISO 28580 point or "
+                                    "label is on ISO 28580's 2.0 m drum, and --point KPA,LOAD_N,KMH,RRC is a flat-road RRC");
+  }
   if (in.j2452) {
     J2452Set set = *in.j2452;
     set.rolling_radius_m = in.size.outer_radius_m;
@@ -43,6 +48,17 @@ TyreFitPlan plan_tyre_fit(const TyreFitInputs& in) {
   // The tyre file's own rule for the size's class, so that the file reproduces its points (50-600 kPa for any tyre
   // took 50 kPa for a passenger tyre, whose file then refused it, and refused a light-truck tyre's 655 kPa).
   for (const auto& p : plan.request.points) check_pressure_plausible_kpa(p.pressure_pa / 1e3, in.size, p.where);
+  // A point loaded past the size's rating is allowed but said, as `rollsim tyre` says it (session 22).
+  if (in.size.load_index) {
+    const double rated_n = *load_index_max_load_kg(*in.size.load_index) * units::kStandardGravity_mps2;
+    for (const auto& p : in.points) {
+      if (p.load_n > rated_n) {
+        plan.warnings.push_back(p.where + ": load " + fixed(p.load_n, 0) + " N is above the tyre's rated maximum " +
+                                fixed(rated_n, 0) + " N (load index " + std::to_string(*in.size.load_index) +
+                                "); the fit there is outside the tyre's rating");
+      }
+    }
+  }
   return plan;
 }
 

@@ -32,6 +32,7 @@ struct TyreFitPlan {
   FitRequest request;
   std::optional<LabelBand> band;  ///< the label's RRC band
   std::optional<RrcPoint> iso;    ///< the ISO 28580 point where the band applies
+  std::vector<std::string> warnings;  ///< what is allowed but said (a point loaded past the size's rating)
 };
 
 /// A label alone is one point at ISO 28580 conditions at the band's geometric middle, with the band as its
