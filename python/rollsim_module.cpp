@@ -65,13 +65,32 @@ T arg_as(py::handle arg, const std::string& where, const std::string& expected) 
   if constexpr (std::is_base_of_v<py::object, T>) {
     if (!py::isinstance<T>(x)) throw InputError(where, "expected " + expected);
   }
+  // pybind takes True as the number 1 (session 22's outside testing: pressure_bar=True read 1 bar).
+  if constexpr (std::is_arithmetic_v<T>) {
+    if (py::isinstance<py::bool_>(x) || py::isinstance(x, py::module_::import("numpy").attr("bool_")))
+      throw InputError(where, "a bool is not allowed: expected " + expected);
+  }
+  T out;
   try {
-    return x.cast<T>();
+    out = x.cast<T>();
   } catch (const py::cast_error&) {
+    // A str with a lone surrogate (a non-UTF-8 file name from os.listdir) cannot be UTF-8 (session 22).
+    if (std::is_same_v<T, std::string> && py::isinstance<py::str>(x)) throw InputError(where, "a str that is not valid Unicode text (a lone surrogate?) is not allowed");
+    throw InputError(where, "expected " + expected);
+  } catch (const py::error_already_set&) {  // e.g. len() of a 0-d numpy array given for a list (session 22)
     throw InputError(where, "expected " + expected);
   } catch (const py::type_error&) {  // a Python type wrapper (py::sequence, py::dict) given another type
     throw InputError(where, "expected " + expected);
   }
+  // A NUL ends a path for the C library: 'ev.yaml\0junk' read ev.yaml, and an output was written elsewhere
+  // than named (session 22); Python's own open() refuses it.
+  if constexpr (std::is_same_v<T, std::string>) {
+    if (out.find('\0') != std::string::npos) throw InputError(where, "a NUL character in a name or path is not allowed");
+  } else if constexpr (std::is_same_v<T, std::vector<std::string>>) {
+    for (const auto& s : out)
+      if (s.find('\0') != std::string::npos) throw InputError(where, "a NUL character in a name or path is not allowed");
+  }
+  return out;
 }
 
 // A dict's values as json.dumps takes them: numpy scalars become Python numbers and arrays lists (what a script
@@ -135,7 +154,9 @@ py::array_t<double> number_array(py::handle x, const std::string& where) {
   // count of days (session 20), where a number option given text is an error.
   if (kind != "i" && kind != "u" && kind != "f")
     throw InputError(where, "expected a number or an array of numbers, not " + py::str(data.attr("dtype")).cast<std::string>());
-  auto a = py::array_t<double, py::array::forcecast>::ensure(data);
+  // c_style: a column view (a[:, 0]) or a reversed one was read as if its elements were adjacent, computing every
+  // figure at the wrong speeds or from memory past the array (session 22's outside testing); a copy when needed.
+  auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(data);
   if (!a) throw InputError(where, "expected a number or an array of numbers");
   return a;
 }
@@ -175,7 +196,7 @@ std::optional<TyreSpec> tyre_from(py::handle t) {
 DriveCycle cycle_arrays(py::handle c);
 DriveCycle cycle_from(py::handle c) {
   const py::object path = fspath_or_self(c);
-  const DriveCycle cycle = py::isinstance<py::str>(path) ? load_cycle(path.cast<std::string>(), "--cycle") : cycle_arrays(c);
+  const DriveCycle cycle = py::isinstance<py::str>(path) ? load_cycle(arg_as<std::string>(path, "cycle", "a cycle name or path (str)"), "--cycle") : cycle_arrays(c);
   // What the trace holds that a user should hear of, as warnings, as the CLI's load_cycle_noted says it on stderr.
   if (const std::string note = ignored_columns_note(cycle); !note.empty()) warn(note);
   for (const auto& n : cycle.notes) warn(n);
@@ -316,7 +337,10 @@ py::list api_sweep(py::object tyre, py::object axes_arg, py::object load_n, py::
   req.threads = number_text(threads, "threads");
   const selection::SweepOptions so = selection::sweep_options_from_request(req);
   if (!cycle.is_none() && vehicle.is_none()) throw InputError("cycle", "needs vehicle: a tyre alone drives no cycle");
-  const TyreSpec t = *tyre_from(tyre);
+  const std::optional<TyreSpec> given = tyre_from(tyre);
+  // None was dereferenced: the interpreter died (session 22's outside testing).
+  if (!given) throw InputError("tyre", "missing: give the tyre to sweep, e.g. '175-70R14'");
+  const TyreSpec& t = *given;
   selection::SweepResult r;
   if (!vehicle.is_none()) {
     const Vehicle v = vehicle_from(vehicle);
@@ -326,6 +350,10 @@ py::list api_sweep(py::object tyre, py::object axes_arg, py::object load_n, py::
   } else {
     py::gil_scoped_release released;
     r = selection::sweep_tyre(t, so);
+  }
+  if (r.points.empty()) {  // as the command line refuses it (an empty list and a warning: session 22)
+    throw InputError("axes", (r.outside_domain ? *r.outside_domain : std::string("no point was computed")) + " (no valid point of " +
+                                 std::to_string(r.planned_points) + ")");
   }
   if (r.outside_domain) {
     warn(*r.outside_domain + " (the " + std::to_string(r.points.size()) + " valid points of " +
@@ -445,6 +473,7 @@ py::dict api_tyre_fit(py::object size_arg, py::object points, py::object label, 
   const std::string output_path = output.is_none() ? "" : arg_as<std::string>(output, "output", "a file path (str)");
   if (!output.is_none() && output_path.empty()) throw InputError("output", "an empty path: give a file path, or leave output out");
   const std::string measured_path = measured.is_none() ? "" : arg_as<std::string>(measured, "measured", "a CSV path (str)");
+  if (!measured.is_none() && measured_path.empty()) throw InputError("measured", "an empty path is not allowed: give a CSV path or None");
   if (!output_path.empty()) check_output_file(output_path, "output", {measured_path});
   TyreFitInputs in;
   in.size = parse_tyre_size(size, "size");
@@ -505,8 +534,8 @@ py::dict api_tyre_fit(py::object size_arg, py::object points, py::object label, 
 }
 
 py::dict api_sensitivity(py::object tyre, py::object vehicle, py::object cycle, py::object load_n, py::object speed_kmh) {
-  const double speed_mps = units::kmh_to_mps(
-      parse_option_number(number_text(speed_kmh, "speed_kmh"), "--speed-kmh", Range::open_low(0.0, 500.0)));
+  const double speed_mps = units::kmh_to_mps(speed_kmh.is_none() ? 80.0
+      : parse_option_number(number_text(speed_kmh, "speed_kmh"), "--speed-kmh", Range::open_low(0.0, 500.0)));
   std::optional<Vehicle> v;
   if (!vehicle.is_none()) v = vehicle_from(vehicle);
   const std::optional<TyreSpec> t = tyre_from(tyre);
@@ -614,7 +643,7 @@ model's domain stops with a warning and returns the valid points.)");
 
 size: designation, e.g. '205/55 R16 91V' (a load index is needed for ISO points and labels). points: a list of
 (pressure_kpa [kPa], load_n [N], speed_kmh [km/h], rrc [-]) or of RRCs alone (at ISO 28580 conditions); label: EU
-label class 'A'..'E' (alone: one ISO point at the band's middle); measured: a CSV path of measured points
+label class 'A'..'E' (alone: one ISO point at the band's geometric middle, on ISO 28580's 2.0 m drum); measured: a CSV path of measured points
 (pressure_kpa,load_n,speed_kmh,rrc; the command line's --measured), added to points; j2452: (alpha, beta, a, b, c) of a J2452 set,
 sampled and corrected from a drum of drum_radius_m [m, default 0.85]; free: constants to fit (default: what the
 points determine); rrc_uncertainty_pct [%]; pressure_bar [bar] and name of the tyre file; output: a path to write
@@ -623,7 +652,7 @@ point], 'tyre': the tyre file as a dict, which tyre(...) and simulate(tyre=...) 
 as the command line.)");
 
   m.def("sensitivity", &api_sensitivity, "tyre"_a = py::none(), py::kw_only(), "vehicle"_a = py::none(),
-        "cycle"_a = py::none(), "load_n"_a = py::none(), "speed_kmh"_a = 80.0,
+        "cycle"_a = py::none(), "load_n"_a = py::none(), "speed_kmh"_a = py::none(),
         R"(Elasticities of a tyre's RR power and RRC, and with a car of its energy or fuel (`rollsim sensitivity --json`).
 
 tyre: file, shipped name or dict (default: the car's own); vehicle: file, shipped name or dict (its energy

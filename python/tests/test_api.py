@@ -340,6 +340,34 @@ class InputErrors(unittest.TestCase):
         with self.assertRaisesRegex(rollsim.InputError, "speed_kmh"):
             rollsim.simulate(cycle={"time_s": [0, 1, 2], "speed_kmh": [0, 5]})
 
+    def test_session_22_outside_testing(self):
+        import numpy as np
+        # sweep(None, ...) killed the interpreter (a None tyre dereferenced).
+        with self.assertRaisesRegex(rollsim.InputError, "tyre: missing"):
+            rollsim.sweep(None, [("pressure", 2, 3, 2)])
+        # A column view was read as if contiguous: [30, 1, 80] km/h for a[:, 0], memory past the array when reversed.
+        g = np.array([[30.0, 1.0], [80.0, 2.0], [130.0, 3.0]])
+        self.assertEqual(list(rollsim.tyre("175-70R14", speed_kmh=g[:, 0])["speed_kmh"]), [30.0, 80.0, 130.0])
+        self.assertEqual(list(rollsim.tyre("175-70R14", speed_kmh=np.array([130.0, 80.0, 30.0])[::-1])["speed_kmh"]), [30.0, 80.0, 130.0])
+        # A NUL in a path read or wrote another file than named.
+        with self.assertRaisesRegex(rollsim.InputError, "NUL"):
+            rollsim.tyre("175-70R14\x00junk")
+        # No valid point is an error, as on the command line (it was [] and a warning).
+        with self.assertRaisesRegex(rollsim.InputError, "no valid point of 2"):
+            rollsim.sweep("175-70R14", [("pressure", 2, 3, 2)], load_n=1)
+        # True was the number 1.
+        with self.assertRaisesRegex(rollsim.InputError, "bool"):
+            rollsim.tyre("175-70R14", pressure_bar=True)
+        # A lone surrogate and a 0-d array raised RuntimeError / TypeError naming no argument.
+        with self.assertRaisesRegex(rollsim.InputError, "cycle"):
+            rollsim.simulate("ev", cycle="\udcff")
+        with self.assertRaisesRegex(rollsim.InputError, "tyres"):
+            rollsim.compare("ev", tyres=np.array("low-rrc"))
+        with self.assertRaisesRegex(rollsim.InputError, "measured"):
+            rollsim.tyre_fit("205/55 R16 91V", points=[0.0072], measured="")
+        # speed_kmh=None is the default, 80 km/h.
+        self.assertEqual(rollsim.sensitivity("175-70R14", speed_kmh=None), rollsim.sensitivity("175-70R14"))
+
     def test_wrong_types_name_the_argument(self):
         # Session 16's outside testing: these raised RuntimeError "Unable to cast Python instance to C++ type" (or a
         # TypeError about 'sequence') naming no argument.
