@@ -1052,6 +1052,15 @@ bool simulated(const test::CmdResult& r) { return r.out.find("\"error_pct\": ") 
 // A negative or unreadable THC, CO or CO2 switched the exhaust-carbon check off, and the row was simulated in silence
 // (d_co2neg.csv, d_co2txt.csv); a negative FE Bag 4 was read as "no fourth bag" (d_bag4neg.csv). Session 22's
 // outside testing. Each is now the row's skip, naming the column and the text; FE Bag 4 = 0 stays the list's "none".
+// Line 2 of the list with one cell replaced is skipped, its reason starting with `said`.
+void expect_line_2_skipped(const std::vector<std::string>& lines, const std::string& column, const std::string& value,
+                           const std::string& said) {
+  const auto r = validate_lines(lines, {list_line_with(lines, 2, {{column, value}})});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_FALSE(simulated(r)) << column << " " << value << ": " << r.out;
+  EXPECT_NE(r.out.find("\"skipped\": \"" + said), std::string::npos) << column << " " << value << ": " << r.out;
+}
+
 TEST(CliValidate, AnUnusableExhaustOrFourthBagIsANamedSkipNotASilentRow) {
   const auto lines = list_head(2);  // line 2: an Aston Martin DBS FTP, simulated
   const auto plain = validate_lines(lines, {lines[1]});
@@ -1064,10 +1073,7 @@ TEST(CliValidate, AnUnusableExhaustOrFourthBagIsANamedSkipNotASilentRow) {
         {"THC (g/mi)", "-0.04", "THC (g/mi) '-0.04' is negative"},
         {"CO (g/mi)", "n/a", "CO (g/mi) 'n/a' is not a number"},
         {"FE Bag 4", "-5", "its FTP's FE Bag 4 '-5' is negative, so whether it was run with four bags (a hybrid) is unknown"}}) {
-    const auto r = validate_lines(lines, {list_line_with(lines, 2, {{column, value}})});
-    ASSERT_EQ(r.exit_code, 0) << r.err;
-    EXPECT_FALSE(simulated(r)) << column << " " << value << ": " << r.out;
-    EXPECT_NE(r.out.find("\"skipped\": \"field outside its physical range: " + said), std::string::npos) << r.out;
+    expect_line_2_skipped(lines, column, value, "field outside its physical range: " + said);
   }
 }
 
@@ -1127,9 +1133,7 @@ TEST(CliValidate, ASkipQuotesTheValueAndWhatIsAllowed) {
         {"RND_ADJ_FE", "177", "measured result outside any car of its kind: 177 mpg (allowed for a petrol, diesel or E85 car: 5-100 mpg)"},
         {"Test Fuel Type Description", "Kerosene", "fuel without properties here: Test Fuel Type Description 'Kerosene' (known: "},
         {"Target Coef A (lbf)", "-200", "field outside its physical range: target road load at 7.2 km/h [N] = "}}) {
-    const auto r = validate_lines(lines, {list_line_with(lines, 2, {{column, value}})});
-    ASSERT_EQ(r.exit_code, 0) << r.err;
-    EXPECT_NE(r.out.find("\"skipped\": \"" + said), std::string::npos) << value << ": " << r.out;
+    expect_line_2_skipped(lines, column, value, said);
   }
   const auto derived = validate_lines(lines, {list_line_with(lines, 341, {{"ADFE Total Road Load HP", "0"}})});
   ASSERT_EQ(derived.exit_code, 0) << derived.err;
