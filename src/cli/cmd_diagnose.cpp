@@ -80,6 +80,9 @@ void run_diagnose(const DiagnoseCliOptions& o) {
   std::size_t report_files = 0;
   if (!o.report.empty()) {
     const auto report = render_diagnosis_report(o.report, d, "rollsim diagnose: " + v.name);
+    // The report's own names in its folder: a recording or vehicle file kept there as energy.svg or report.html was
+    // replaced (session 22's outside testing).
+    for (const auto& f : report) check_not_an_input(f.path, "--report", inputs);
     report_files = report.size();
     files.insert(files.end(), report.begin(), report.end());
   }

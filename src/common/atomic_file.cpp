@@ -80,16 +80,21 @@ fs::path temporary_for(const fs::path& target) {
 
 }  // namespace
 
-void check_output_file(const std::string& path, const std::string& option, const std::vector<std::string>& inputs) {
+void check_not_an_input(const std::string& path, const std::string& option, const std::vector<std::string>& inputs) {
   std::error_code ec;
-  if (path.empty()) throw InputError(option, "an empty file name");
-  if (fs::is_directory(path, ec)) throw InputError(where(option, path), "is a folder; give a file name");
   for (const auto& in : inputs) {
     if (!in.empty() && fs::equivalent(path, in, ec)) {
       throw InputError(where(option, path), "is the same file as the input '" + in +
                                                 "', which writing it would destroy; give another file name");
     }
   }
+}
+
+void check_output_file(const std::string& path, const std::string& option, const std::vector<std::string>& inputs) {
+  std::error_code ec;
+  if (path.empty()) throw InputError(option, "an empty file name");
+  if (fs::is_directory(path, ec)) throw InputError(where(option, path), "is a folder; give a file name");
+  check_not_an_input(path, option, inputs);
   const Destination d = destination_of(path);
   if (d.in_place) {
     if (::access(d.path.c_str(), W_OK) != 0) throw InputError(where(option, path), "cannot write there: " + std::string(std::strerror(errno)));
@@ -132,10 +137,14 @@ void write_files_atomically(const std::vector<OutputFile>& files) {
   std::vector<Destination> dest;
   for (const auto& f : files) dest.push_back(destination_of(f.path));
   std::vector<fs::path> temporaries(files.size());
+  // Folders made here, deepest last: a failed write removes them too, so nothing is left (a failed diagnosis left
+  // its --report folders behind: session 22's outside testing).
+  std::vector<fs::path> created;
   auto discard = [&] {
     std::error_code ec;
     for (const auto& t : temporaries)
       if (!t.empty()) fs::remove(t, ec);
+    for (auto it = created.rbegin(); it != created.rend(); ++it) fs::remove(*it, ec);  // only if empty
   };
   auto put = [&](const OutputFile& f, const fs::path& at, bool in_place) {
     std::ofstream out(at, std::ios::binary | (in_place ? std::ios::app : std::ios::trunc));
@@ -154,7 +163,12 @@ void write_files_atomically(const std::vector<OutputFile>& files) {
   for (std::size_t i = 0; i < files.size(); ++i) {
     if (dest[i].in_place) continue;
     std::error_code ec;
+    std::vector<fs::path> missing;
+    for (fs::path p = fs::absolute(folder_of(dest[i].path.string()), ec); !p.empty() && !fs::exists(p, ec) && p != p.parent_path();
+         p = p.parent_path())
+      missing.push_back(p);
     fs::create_directories(folder_of(dest[i].path.string()), ec);
+    created.insert(created.end(), missing.rbegin(), missing.rend());
     temporaries[i] = temporary_for(dest[i].path);
     put(files[i], temporaries[i], false);
   }

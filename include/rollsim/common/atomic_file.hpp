@@ -14,6 +14,8 @@ namespace rollsim {
 /// `inputs` (the same file under any name), and its folder exists and is writable (a symlink's target's folder; a
 /// device or pipe must be writable itself). Throws InputError naming `option` and the path otherwise.
 void check_output_file(const std::string& path, const std::string& option, const std::vector<std::string>& inputs = {});
+/// Only the part of it that keeps an input from being overwritten: for files an output names itself (a report's).
+void check_not_an_input(const std::string& path, const std::string& option, const std::vector<std::string>& inputs);
 
 /// Checks that no two of a command's outputs (path, option) are one file. Throws InputError naming both.
 void check_outputs_distinct(const std::vector<std::pair<std::string, std::string>>& path_and_option);

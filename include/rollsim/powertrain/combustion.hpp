@@ -46,6 +46,7 @@ class CombustionPowertrain final : public Powertrain {
   int select_gear(double speed_mps, int current_gear) const override;
   std::vector<double> shift_speeds_mps(int gear) const override;
   std::vector<double> braking_regime_speeds_mps(double wheel_radius_m) const override;
+  std::vector<double> traction_regime_speeds_mps(double wheel_radius_m) const override;
   int num_gears() const override { return static_cast<int>(p_.gearbox.ratios.size()); }
   double max_wheel_force_n(int gear, double speed_mps, double wheel_radius_m) const override;
   const FuelParams* fuel() const override { return &p_.fuel; }

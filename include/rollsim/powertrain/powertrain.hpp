@@ -86,6 +86,9 @@ class Powertrain {
   /// the speed does not feel, so a simulation splits its steps where a deceleration falls through them. Ascending;
   /// empty by default. `wheel_radius_m` as for deliver().
   virtual std::vector<double> braking_regime_speeds_mps(double /*wheel_radius_m*/) const { return {}; }
+  /// Speeds [m/s] at which the most force a gear gives kinks (an engine's limiter cutting in and at its end), for a
+  /// replay to split an acceleration's steps there. Empty by default.
+  virtual std::vector<double> traction_regime_speeds_mps(double /*wheel_radius_m*/) const { return {}; }
 
   /// The traction battery, or nullptr when the powertrain has none.
   virtual const BatteryParams* battery() const { return nullptr; }
