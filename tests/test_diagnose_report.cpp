@@ -410,6 +410,25 @@ TEST(DiagnoseReportCli, CamryRecordingsGiveAReportAndAnUnwritableDirFailsFirst) 
   ASSERT_EQ(ok.exit_code, 0) << ok.text;
   EXPECT_TRUE(fs::exists(out + "/report.html"));
   EXPECT_TRUE(fs::exists(out + ".json"));
+
+  // A recording kept in the report's folder under one of the report's names was replaced by the figure (session 22's
+  // outside testing); it is refused as any output that is an input is, and nothing is written.
+  const std::string kept = ::testing::TempDir() + "/diag_cli_kept";
+  fs::remove_all(kept);
+  fs::create_directories(kept);
+  fs::copy_file(dir + "61811012_test_data.csv", kept + "/energy.svg");
+  const auto before = fs::file_size(kept + "/energy.svg");
+  const auto clash = run_cli("diagnose " + vehicle + "--recording '" + kept + "/energy.svg' --report '" + kept + "'");
+  EXPECT_EQ(clash.exit_code, 2) << clash.text;
+  EXPECT_NE(clash.text.find("is the same file as the input"), std::string::npos) << clash.text;
+  EXPECT_EQ(fs::file_size(kept + "/energy.svg"), before);
+  EXPECT_FALSE(fs::exists(kept + "/report.html"));
+  // A write that fails leaves no folder it made for the report (they were left behind).
+  const std::string made = ::testing::TempDir() + "/diag_cli_made";
+  fs::remove_all(made);
+  const auto full = run_cli("diagnose " + vehicle + recs + " --report '" + made + "/a/b' --json /dev/full");
+  EXPECT_EQ(full.exit_code, 2) << full.text;
+  EXPECT_FALSE(fs::exists(made)) << full.text;
 }
 
 }  // namespace
