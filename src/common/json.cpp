@@ -8,6 +8,12 @@
 
 namespace rollsim {
 
+std::string yaml_double_quoted(const std::string& text) {
+  std::string quoted = json_string(text);
+  for (auto at = quoted.find('\x7f'); at != std::string::npos; at = quoted.find('\x7f', at)) quoted.replace(at, 1, "\\x7f");
+  return quoted;
+}
+
 std::string json_string(const std::string& text) {
   std::string out = "\"";
   for (const char ch : valid_utf8(text)) {  // JSON is UTF-8: a Latin-1 name made the whole line unreadable

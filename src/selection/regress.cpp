@@ -102,9 +102,7 @@ std::string yaml_scalar(const std::string& text) {
   std::strtod(text.c_str(), &end);
   const bool number = !text.empty() && end == text.c_str() + text.size();
   if (std::regex_match(text, plain) && !std::regex_match(text, special) && !number) return text;
-  std::string quoted = json_string(text);
-  for (auto at = quoted.find('\x7f'); at != std::string::npos; at = quoted.find('\x7f', at)) quoted.replace(at, 1, "\\x7f");
-  return quoted;
+  return yaml_double_quoted(text);
 }
 
 }  // namespace

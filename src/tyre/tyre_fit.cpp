@@ -1,5 +1,6 @@
 #include "rollsim/tyre/tyre_fit.hpp"
 
+#include "rollsim/common/json.hpp"
 #include "rollsim/tyre/j2452.hpp"
 
 #include <algorithm>
@@ -471,15 +472,6 @@ namespace {
 
 std::string num(double v) { return significant(v, 9); }
 
-std::string yaml_quoted(const std::string& s) {
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') out += '\\';
-    out += c;
-  }
-  return out + "\"";
-}
-
 }  // namespace
 
 std::string sigma_source(const TyreFit& fit) {
@@ -507,10 +499,10 @@ void write_fitted_tyre_yaml(std::ostream& out, const FittedTyreFile& file, const
     for (auto p : fit.held) out << " " << hysteresis_param_key(p);
     out << "\n";
   }
-  out << "name: " << yaml_quoted(file.name) << "\n";
-  out << "size: " << yaml_quoted(file.size) << "\n";
+  out << "name: " << yaml_double_quoted(file.name) << "\n";
+  out << "size: " << yaml_double_quoted(file.size) << "\n";
   out << "pressure_bar: " << num(file.pressure_pa / 1e5) << "\n";
-  out << "source: " << yaml_quoted(file.source) << "\n";
+  out << "source: " << yaml_double_quoted(file.source) << "\n";
   out << "model:\n  kind: hysteresis\n";
   out << "  reference_pressure_bar: " << num(h.reference_pressure_pa / 1e5) << "\n";
   out << "  reference_load_n: " << num(h.reference_load_n) << "\n";

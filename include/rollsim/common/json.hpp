@@ -8,6 +8,9 @@ namespace rollsim {
 
 /// `text` as a quoted JSON string: quote and backslash escaped, control characters as \n, \t, \r or \u00XX.
 std::string json_string(const std::string& text);
+/// The same as a YAML double-quoted scalar, which reads back as `text` (JSON's escapes are YAML's, and DEL, which
+/// YAML does not print, is escaped too): names written into YAML files.
+std::string yaml_double_quoted(const std::string& text);
 
 /// Builds one JSON object on one line, keys in insertion order. Non-finite numbers are written as null
 /// (JSON has no NaN), strings are escaped.
