@@ -88,6 +88,18 @@ TEST_F(SimLimitsCli, StandstillOnlyTraceSaysPerDistanceFiguresAreUndefined) {
   }
 }
 
+// A trace that covers micrometres is no drive either: 6,003,380 kWh/10 km was the standing auxiliaries over 1.4 um
+// (session 22's outside testing).
+TEST_F(SimLimitsCli, ATraceOfMicrometresHasNoPerDistanceFigures) {
+  const std::string cycle = write("tiny.csv", "time_s,speed_kmh\n0,0\n0.001,0.01\n0.002,0\n10,0\n");
+  for (const char* mode : {"", " --replay"}) {
+    const auto out = run_rollsim(std::string("simulate --vehicle ev") + mode + " --cycle " + cycle);
+    ASSERT_EQ(out.exit_code, 0) << out.err;
+    EXPECT_TRUE(has(out.out, "the trace covers only 2.78e-06 m, under 1 m: per-distance figures")) << mode << out.out;
+    EXPECT_FALSE(has(out.out, "energy at the battery terminals")) << mode << out.out;
+  }
+}
+
 // Values beyond physical bounds: one error naming the file, the line or key, the value and what is allowed;
 // exit 2, nothing on stdout (they printed inf or NaN with exit 0, or failed inside CVODES).
 TEST_F(SimLimitsCli, CycleValuesBeyondPhysicalBoundsAreNamedErrors) {

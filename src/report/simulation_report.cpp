@@ -63,7 +63,10 @@ std::string summary_text(const SimulationResult& r, bool solver_stats) {
     << fixed(km / (r.duration_s / units::kSPerHour), 1) << " km/h\n";
   if (!r.moved()) {
     const std::string what = r.fuel ? "l/100 km, CO2 g/km" : "kWh/10 km, range";
-    if (r.distance_m > 0.0) {
+    if (r.distance_m > 0.0 && r.trace_distance_m < SimulationResult::kMinTraceDistance_m) {
+      o << "  the trace covers only " << significant(r.trace_distance_m, 3) << " m, under "
+        << format_value(SimulationResult::kMinTraceDistance_m) << " m: per-distance figures (" << what << ") are undefined\n";
+    } else if (r.distance_m > 0.0) {
       o << "  the car covered only " << fixed(r.distance_m / 1000.0, 3) << " km of the trace's "
         << fixed(r.trace_distance_m / 1000.0, 3) << " km: per-distance figures (" << what
         << ") and the shares of its traction are undefined (the powertrain cannot drive this trace)\n";

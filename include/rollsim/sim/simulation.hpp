@@ -171,9 +171,13 @@ struct SimulationResult {
 
   /// Per-distance figures exist only for a run that drove its trace: a standstill-only trace has none, and neither has
   /// a car that covered less than kMinShareOfTraceDriven of it (a motor of 0.25 N m: 10^8 kWh/10 km over millimetres,
-  /// a figure of no drive). They are NaN then.
-  bool moved() const { return distance_m > 0.0 && distance_m >= kMinShareOfTraceDriven * trace_distance_m; }
+  /// a figure of no drive), nor a trace that covers under kMinTraceDistance_m (1.4 um read 6,003,380 kWh/10 km: the
+  /// standing auxiliaries over a distance of no drive; session 22's outside testing). They are NaN then.
+  bool moved() const {
+    return distance_m > 0.0 && trace_distance_m >= kMinTraceDistance_m && distance_m >= kMinShareOfTraceDriven * trace_distance_m;
+  }
   static constexpr double kMinShareOfTraceDriven = 0.1;
+  static constexpr double kMinTraceDistance_m = 1.0;
   /// Energy taken from the sources [J]: battery terminals plus fuel (lower heating value).
   double source_energy_j() const;
   /// Battery-terminal energy per distance in kWh/10 km (the platform study's unit).
