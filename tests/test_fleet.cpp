@@ -70,6 +70,16 @@ TEST(Fleet, AMissingRecordingNamesTheManifestLineAndColumn) {
   EXPECT_TRUE(r.out.empty()) << r.out;
 }
 
+// A misspelt column was ignored: 'Tyre' and 'scale' named nothing and the group ran without them (session 22's
+// outside testing). Every column is one the manifest reads.
+TEST(Fleet, AMisspeltColumnIsRefusedNotIgnored) {
+  const std::string path = write_manifest("misspelt.csv", "vehicle,recording,preset,Tyre\ntwizy,nowhere.csv,rsk_twizy,x\n");
+  const auto r = test::run_rollsim("diagnose --fleet '" + path + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("misspelt.csv: line 1: unknown column 'Tyre' (misspelt?); allowed: vehicle, recording, group, tyre"),
+            std::string::npos) << r.err;
+}
+
 // --json was checked against the manifest alone: a recording or vehicle file it names was overwritten with the
 // fleet's JSON, exit 0 (session 21's outside testing). Refused before any diagnosis, as a single diagnosis refuses.
 TEST(Fleet, JsonOntoAFileTheManifestNamesIsRefused) {

@@ -51,6 +51,14 @@ FleetManifest read_fleet_manifest(const std::string& path) {
     return c;
   };
   const auto vehicle = col("vehicle", true), recording = col("recording", true);
+  // A column the manifest does not know is a misspelling, not a note: 'Tyre' or 'scale' was ignored, and the groups
+  // diagnosed without the tyre or scales they named (session 22's outside testing).
+  constexpr const char* kColumns[] = {"vehicle", "recording", "group", "tyre", "preset", "columns", "scales"};
+  for (const auto& h : t.header) {
+    if (std::find(std::begin(kColumns), std::end(kColumns), h) == std::end(kColumns))
+      throw InputError(path + ": line " + std::to_string(t.header_line),
+                       "unknown column '" + h + "' (misspelt?); allowed: vehicle, recording, group, tyre, preset, columns, scales");
+  }
   const auto group = col("group", false), tyre = col("tyre", false), preset = col("preset", false),
              columns = col("columns", false), scales = col("scales", false);
   const std::filesystem::path dir = std::filesystem::path(path).parent_path();
