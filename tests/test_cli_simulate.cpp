@@ -132,3 +132,13 @@ TEST(CliSimulate, OverloadedTyreRunsWithAWarning) {
   EXPECT_NE(r.out.find("kWh/10 km"), std::string::npos);
 }
 
+
+// A car with other tyres behind than in front names both: the Twizy's own 125/145 set read "125-80R13" beside a
+// --tyre 125-80R13 run of other figures (session 22's outside testing).
+TEST(CliSimulate, ACarWithTwoTyreSizesNamesBoth) {
+  const auto table = run("simulate --vehicle twizy --cycle nedc --cycle udds");
+  ASSERT_EQ(table.exit_code, 0) << table.text;
+  EXPECT_NE(table.text.find("nedc   front 125-80R13 / rear 145-80R13"), std::string::npos) << table.text;
+  const auto json = run("simulate --vehicle twizy --json");
+  EXPECT_NE(json.text.find("\"tyre\": \"front 125-80R13 / rear 145-80R13\""), std::string::npos) << json.text;
+}

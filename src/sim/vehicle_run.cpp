@@ -6,7 +6,14 @@ namespace rollsim {
 
 VehicleRun run_vehicle(const Vehicle& base, const std::optional<TyreSpec>& tyre, const DriveCycle& cycle, bool replay,
                        const SimulationOptions& options) {
-  VehicleRun run{base, base.front_tyre ? base.front_tyre->name : "coast-down", {}, {}};
+  // A car with other tyres behind than in front is labelled with both: the front's name alone made its row read as
+  // the same tyre all round (session 22's outside testing: twizy's 125/145 beside --tyre 125-80R13).
+  const bool mixed = base.front_tyre && base.rear_tyre && base.front_tyre->name != base.rear_tyre->name;
+  VehicleRun run{base,
+                 !base.front_tyre ? std::string("coast-down")
+                 : mixed          ? "front " + base.front_tyre->name + " / rear " + base.rear_tyre->name
+                                  : base.front_tyre->name,
+                 {}, {}};
   if (tyre) {
     fit_tyres(run.vehicle, *tyre);
     run.tyre_label = tyre->name;
