@@ -430,6 +430,9 @@ TEST_F(OutsideTesting, ABatteryChargedPastFullIsSaid) {
 TEST_F(OutsideTesting, OptionsThatCannotApplyAreRefused) {
   expect_refused("diagnose-bench --seeds 1 --null-seeds 2 --vehicle ice", "--vehicle 'ice': is not electric");
   expect_refused("diagnose-bench --seeds 1 --null-seeds 2 --only zzz", "--only: matches no row's label");
+  // Its counts are read as every command's are (--threads 0 ran; 'abc' was "not in range": session 22).
+  expect_refused("diagnose-bench --threads 0", "--threads: 0 is not allowed: must be in [1, 1024]");
+  expect_refused("diagnose-bench --seeds abc", "--seeds: 'abc' is not a number; must be in [1, 1000]");
   expect_refused("diagnose --vehicle twizy --preset rsk_twizy --recording '" + std::string(ROLLSIM_SHARED_DIR) +
                      "/data/recordings/rsk_renault_twizy/T1_07_01_2021.csv' --engine-start hot",
                  "--engine-start: applies to a combustion engine's start");
