@@ -336,7 +336,8 @@ TEST_F(Hardening, AFailedWriteToStdoutIsAnErrorNotExitZero) {
   const std::string binary = other && *other ? other : ROLLSIM_BINARY;
   const fs::path err = dir_ / "err.txt";
   for (const std::string args : {"sweep --tyre nominal --param pressure --from 2 --to 3", "tyre nominal --json",
-                                 "simulate --vehicle ev --replay", "regress tests/energy_baseline.yaml"}) {
+                                 "simulate --vehicle ev --replay", "regress tests/energy_baseline.yaml",
+                                 "--help", "simulate --help", "--version"}) {  // the last three exited 0 (session 22)
     const std::string cmd = "cd '" + std::string(ROLLSIM_SOURCE_DIR) + "' && '" + binary + "' " + args + " >/dev/full 2>'" +
                             err.string() + "'";
     const int status = std::system(cmd.c_str());

@@ -115,8 +115,9 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     // --help and --version answer with exit 0; every other parse error is bad input, exit 2 like the rest (CLI11's
     // own codes, 105-109, would tell a script nothing more).
+    // The help and version text go to stdout too, and a failed write there is said (it exited 0: session 22).
     const int code = app.exit(e);
-    return code == 0 ? 0 : 2;
+    return code == 0 ? checked_stdout(group, 0) : 2;
   } catch (const rollsim::InputError& e) {
     return report(group, e, true, 2);
   } catch (const rollsim::ModelDomainError& e) {
