@@ -218,6 +218,10 @@ TEST(Simulation, AGearboxIsCheckedGearByGear) {
   expect_vehicle_error("vehicles/ice.yaml", "upshift_speeds_kmh: [16, 33, 48, 65]", "upshift_speeds_kmh: [16, 48, 33, 65]",
                        "key 'powertrain.gearbox.upshift_speeds_kmh': upshift 3 at 33 km/h is not above upshift 2 at 48 km/h");
   expect_vehicle_error("vehicles/ice.yaml", "idle_speed_rpm: 800", "idle_speed_rpm: 7000", "6300 must exceed idle_speed_rpm 7000");
+  // Unit slips that ran: a displacement in m^3, a heating value in GJ/kg.
+  expect_vehicle_error("vehicles/ice.yaml", "displacement_l: 1.6", "displacement_l: 0.0016", "must be in [0.05, 30]");
+  expect_vehicle_error("vehicles/ice.yaml", "lower_heating_value_mj_per_kg: 42.9", "lower_heating_value_mj_per_kg: 0.0429",
+                       "must be in [10, 150]");
 }
 
 TEST(Simulation, BadVehicleFilesAreRejectedWithTheKey) {

@@ -18,7 +18,7 @@ double pct(YamlMap& m, const std::string& key, double fallback_pct) {
 
 EngineMapParams read_engine_block(YamlMap m) {
   EngineMapParams e;
-  e.displacement_m3 = m.number("displacement_l", Range::open_low(0.0, 30.0)) * units::kM3PerLitre;
+  e.displacement_m3 = m.number("displacement_l", Range::closed(0.05, 30.0)) * units::kM3PerLitre;  // as vehicle.cpp
   e.indicated_efficiency = m.number("gross_indicated_efficiency", Range::open_low(0.0, 0.6));
   // Friction mep f0 + f1 N + f2 N^2 with N in 1000 rpm, as Heywood writes eq. 13.19.
   const double per_krpm = 1000.0 * kRadpsPerRpm;
