@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
 #include <numbers>
 
 namespace rollsim {
@@ -30,29 +31,27 @@ std::vector<double> CombustionPowertrain::shift_speeds_mps(int gear) const {
   return s;
 }
 
-// Braking in gear g, the engine is cut off above its cut-off speed and idles declutched below it.
-std::vector<double> CombustionPowertrain::braking_regime_speeds_mps(double wheel_radius_m) const {
-  const auto& g = p_.gearbox;
+namespace {
+constexpr double kLimiterStart = 0.98;  // of the engine's top speed
+
+// The road speeds at which the engine turns at each of `engine_radps` in each gear, ascending.
+std::vector<double> road_speeds_mps(const GearboxParams& g, std::initializer_list<double> engine_radps, double wheel_radius_m) {
   std::vector<double> s;
-  if (p_.engine.fuel_cut_min_speed_radps <= 0.0) return s;  // cut off at any speed
-  for (double r : g.ratios) s.push_back(p_.engine.fuel_cut_min_speed_radps * wheel_radius_m / (r * g.final_drive_ratio));
+  for (double r : g.ratios)
+    for (double w : engine_radps) s.push_back(w * wheel_radius_m / (r * g.final_drive_ratio));
   std::sort(s.begin(), s.end());
   return s;
 }
-
-namespace {
-constexpr double kLimiterStart = 0.98;  // of the engine's top speed
 }  // namespace
 
+// Braking in gear g, the engine is cut off above its cut-off speed and idles declutched below it.
+std::vector<double> CombustionPowertrain::braking_regime_speeds_mps(double wheel_radius_m) const {
+  if (p_.engine.fuel_cut_min_speed_radps <= 0.0) return {};  // cut off at any speed
+  return road_speeds_mps(p_.gearbox, {p_.engine.fuel_cut_min_speed_radps}, wheel_radius_m);
+}
+
 std::vector<double> CombustionPowertrain::traction_regime_speeds_mps(double wheel_radius_m) const {
-  const auto& g = p_.gearbox;
-  std::vector<double> s;
-  for (double r : g.ratios) {
-    for (double engine_radps : {kLimiterStart * p_.engine.max_speed_radps, p_.engine.max_speed_radps})
-      s.push_back(engine_radps * wheel_radius_m / (r * g.final_drive_ratio));
-  }
-  std::sort(s.begin(), s.end());
-  return s;
+  return road_speeds_mps(p_.gearbox, {kLimiterStart * p_.engine.max_speed_radps, p_.engine.max_speed_radps}, wheel_radius_m);
 }
 
 double CombustionPowertrain::max_wheel_force_n(int gear, double speed_mps, double wheel_radius_m) const {

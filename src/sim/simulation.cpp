@@ -399,7 +399,7 @@ class ForwardSystem final : public OdeSystem {
     g[1] = shifts_down_ > 0.0 ? v - (shifts_down_ - kShiftMargin_mps) : 1.0;
     const double demand_n = force_request(t, y);
     const double force_n = max_force(gear, v);
-    g[2] = gear > 1 && kicks_down_to(gear - 1, gear, v) ? force_n - demand_n : 1.0;
+    g[2] = gear > 1 && kicks_down_to(gear - 1, force_n, v) ? force_n - demand_n : 1.0;
     g[3] = gear < scheduled_gear_ ? kKickdownReturn * max_force(gear + 1, v) - demand_n : -1.0;
     g[4] = gear < scheduled_gear_ && !(force_n > 0.0) ? -1.0 : 1.0;
   }
@@ -434,16 +434,20 @@ class ForwardSystem final : public OdeSystem {
   /// kKickdownHeadroom_mps faster (kicks_down_to).
   int kickdown_gear(int from, double speed_mps, double demand_n) const {
     int g = from;
-    while (g > 1 && demand_n > max_force(g, speed_mps) && kicks_down_to(g - 1, g, speed_mps)) --g;
+    while (g > 1) {
+      const double force_n = max_force(g, speed_mps);
+      if (!(demand_n > force_n && kicks_down_to(g - 1, force_n, speed_mps))) break;
+      --g;
+    }
     return g;
   }
-  /// Whether `lower` gives more force than `gear` at `speed_mps` and still does kKickdownHeadroom_mps faster. At
+  /// Whether `lower` gives more force than `force_n` (the gear above's at `speed_mps`) there and still does
+  /// kKickdownHeadroom_mps faster. At
   /// its engine's top speed a gear gives none, and a kick-down into the gear just left there (its top-speed upshift,
   /// on a climb the next gear cannot hold) shifted back and forth at one instant for ever (ice.yaml at 85 km/h on
   /// 15 %: session 22's outside testing). With the headroom the car falls back in the higher gear until the lower
   /// one has 1 km/h to give, as an automatic that will not hunt at the limiter.
-  bool kicks_down_to(int lower, int gear, double speed_mps) const {
-    const double force_n = max_force(gear, speed_mps);
+  bool kicks_down_to(int lower, double force_n, double speed_mps) const {
     return max_force(lower, speed_mps) > force_n && max_force(lower, speed_mps + kKickdownHeadroom_mps) > force_n;
   }
 

@@ -132,7 +132,6 @@ double model_rrc(const TyreState& t, const RrcPoint& p) {
 // Read at the start (the shared constants), where it is the points' structure; at a solution that ran off to an
 // extreme every Jacobian degenerates, and that fit is refused as a file, not explained as undetermined.
 std::optional<HysteresisParam> entangled_param(const Eigen::MatrixXd& jacobian, const std::vector<HysteresisParam>& free) {
-  if (jacobian.cols() < 2) return std::nullopt;
   Eigen::MatrixXd unit = jacobian;
   for (Eigen::Index k = 0; k < unit.cols(); ++k) {
     if (!(unit.col(k).norm() > 0.0)) return std::nullopt;  // a flat column is said as such at the solution
@@ -187,7 +186,7 @@ TyreFit fit_once(const TyreState& start, const FitRequest& r, const std::vector<
   flat.clear();
   for (int k = 0; k < n; ++k)
     if (!(ls.jacobian.col(k).norm() > 1e-12 * widest)) flat.push_back(free[k]);
-  if (flat.empty()) {
+  if (flat.empty() && n >= 2) {  // one constant is never entangled: no start Jacobian on the one-point path
     if (const auto p = entangled_param(jacobian_at(residuals, m, x0), free)) flat.push_back(*p);
   }
   const Eigen::MatrixXd cov =

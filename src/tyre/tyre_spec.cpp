@@ -254,24 +254,26 @@ const char* kFormat =
 
 }  // namespace
 
-void check_pressure_plausible(double bar, const std::optional<TyreSize>& size, const std::string& where) {
+namespace {
+// The class's plausible inflation in the unit it was given (`per_bar` of them to a bar), said in that unit.
+void check_pressure_in(double value, double per_bar, const std::string& unit, const std::string& lead,
+                       std::initializer_list<UnitSlip> slips, const std::optional<TyreSize>& size, const std::string& where) {
   const PressureClass c = pressure_class(size);
-  if (bar >= kMinPlausibleBar && bar <= c.max_bar) return;
+  const double lo = per_bar * kMinPlausibleBar, hi = per_bar * c.max_bar;
+  if (value >= lo && value <= hi) return;
   const std::string of = size ? " ('" + size->designation + "')" : "";
-  throw InputError(where, format_value(bar) + " bar is not allowed for " + c.name + of + ": must be in [" + format_value(kMinPlausibleBar) +
-                              ", " + format_value(c.max_bar) + "] bar (such tyres run at " + c.usual + ")" +
-                              unit_slip_hint(bar, Range::closed(kMinPlausibleBar, c.max_bar), "bar",
-                                             {{"MPa", 10.0}, {"psi", kPaPerPsi / 1e5}, {"kPa", 0.01}, {"Pa", 1e-5}}));
+  throw InputError(where, lead + format_value(value) + " " + unit + " is not allowed for " + c.name + of + ": must be in [" +
+                              format_value(lo) + ", " + format_value(hi) + "] " + unit + " (such tyres run at " + c.usual + ")" +
+                              unit_slip_hint(value, Range::closed(lo, hi), unit, slips));
+}
+}  // namespace
+
+void check_pressure_plausible(double bar, const std::optional<TyreSize>& size, const std::string& where) {
+  check_pressure_in(bar, 1.0, "bar", "", {{"MPa", 10.0}, {"psi", kPaPerPsi / 1e5}, {"kPa", 0.01}, {"Pa", 1e-5}}, size, where);
 }
 
 void check_pressure_plausible_kpa(double kpa, const std::optional<TyreSize>& size, const std::string& where) {
-  const PressureClass c = pressure_class(size);
-  const double lo = 100.0 * kMinPlausibleBar, hi = 100.0 * c.max_bar;
-  if (kpa >= lo && kpa <= hi) return;
-  const std::string of = size ? " ('" + size->designation + "')" : "";
-  throw InputError(where, "pressure " + format_value(kpa) + " kPa is not allowed for " + c.name + of + ": must be in [" +
-                              format_value(lo) + ", " + format_value(hi) + "] kPa (such tyres run at " + c.usual + ")" +
-                              unit_slip_hint(kpa, Range::closed(lo, hi), "kPa", {{"bar", 100.0}, {"MPa", 1e3}, {"psi", kPaPerPsi / 1e3}}));
+  check_pressure_in(kpa, 100.0, "kPa", "pressure ", {{"bar", 100.0}, {"MPa", 1e3}, {"psi", kPaPerPsi / 1e3}}, size, where);
 }
 
 double iso28580_passenger_pressure_pa(const TyreSize& size) { return size.extra_load ? 250e3 : 210e3; }
