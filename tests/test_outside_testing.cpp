@@ -816,6 +816,22 @@ TEST_F(OutsideTesting, VehicleUnitSlipsAreNamedAtTheirOwnKey) {
   EXPECT_TRUE(has(r.err, "warning: " + soc + ": key 'powertrain.battery.initial_soc_pct': 0.95 % is a battery all but empty")) << r.err;
 }
 
+// An engine weaker than its own accessories (0.2 kW against 300 W through a 60 % alternator) had a negative force
+// limit, -1e11 N near standstill, and CVODE failed at the first launch: exit 1 with no key named (session 22's notes).
+TEST_F(OutsideTesting, AnEngineTooWeakForItsAccessoriesIsNamed) {
+  const std::string ice = write("weak.yaml", shipped_vehicle_with("ice.yaml", "max_power_kw: 88", "max_power_kw: 0.2"));
+  expect_refused("simulate --vehicle '" + ice + "'",
+                 "key 'powertrain.engine.max_power_kw': 0.2 kW cannot carry the accessories: aux_power_w 300 W through "
+                 "alternator_efficiency 0.6 takes 0.500 kW of the engine; allowed: above 0.500 kW");
+  const std::string map = write("weak_map.yaml", shipped_vehicle_with("camry_2018_map.yaml", "max_power_kw: 151", "max_power_kw: 0.1"));
+  expect_refused("simulate --vehicle '" + map + "'", "key 'powertrain.engine.max_power_kw': 0.1 kW cannot carry the accessories");
+  // Just above the accessories the car runs and says it could not follow the trace.
+  const std::string weak = write("weaker.yaml", shipped_vehicle_with("ice.yaml", "max_power_kw: 88", "max_power_kw: 0.6"));
+  const CmdResult r = run_rollsim("simulate --vehicle '" + weak + "'");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(has(r.out, "could not follow the trace")) << r.out;
+}
+
 // U3: a tab in the indentation gave yaml-cpp's "illegal map value" alone.
 TEST_F(OutsideTesting, ATabIndentedYamlLineIsNamed) {
   const std::string tyre = write("tab.yaml", "size: \"185/65 R15 88H\"\npressure_bar: 2.5\nmodel:\n\tcoulomb_damping_n: 170\n");

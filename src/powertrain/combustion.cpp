@@ -62,7 +62,8 @@ double CombustionPowertrain::max_wheel_force_n(int gear, double speed_mps, doubl
   const double engine_radps = v / wheel_radius_m * ratio;
   if (engine_radps >= e.max_speed_radps) return 0.0;
   double force_n = e.max_torque_nm * ratio * g.efficiency / wheel_radius_m;
-  if (v > 0.0) force_n = std::min(force_n, (e.max_power_w - p_.aux_power_w / p_.alternator_efficiency) * g.efficiency / v);
+  // The file reader refuses an engine too weak for its accessories; a power left below zero would brake as -1/v.
+  if (v > 0.0) force_n = std::min(force_n, std::max(0.0, e.max_power_w - p_.aux_power_w / p_.alternator_efficiency) * g.efficiency / v);
   // The limiter cuts in over the last 2 % of the top speed, not at once: a force that stepped to zero there held a
   // car in its top gear at the limit by chattering, 1.4 million solver steps for one NEDC (session 22).
   const double cut_from_radps = kLimiterStart * e.max_speed_radps;

@@ -120,6 +120,7 @@ ConventionalPowertrainParams read_engine_map_powertrain(YamlMap& pt) {
   p.fuel = read_fuel(pt.map("fuel"));
   p.aux_power_w = read_aux_power_w(pt);
   p.alternator_efficiency = pt.number_or("alternator_efficiency", 1.0, Range::efficiency());
+  check_engine_carries_accessories(p.engine.max_power_w, p.aux_power_w, p.alternator_efficiency, pt.map("engine").where("max_power_kw"));
   return p;
 }
 

@@ -12,6 +12,10 @@ FuelParams read_fuel(YamlMap m);
 /// `aux_power_w` of a powertrain block [W]: 0 (left out) or a road vehicle's electrical load, at least 10 W.
 double read_aux_power_w(YamlMap& pt);
 
+/// Refuses an engine whose `max_power_kw` (at `where`) cannot carry the accessories' shaft power, aux_power_w over the
+/// alternator's efficiency: the power left for the wheels would be negative.
+void check_engine_carries_accessories(double max_power_w, double aux_power_w, double alternator_efficiency, const std::string& where);
+
 /// `powertrain: {type: engine_map, ...}`: an engine with a fuel map (EngineMap) behind a transmission that picks
 /// its own ratio (ConventionalPowertrain). Every key in the file's units, each with its bounds.
 ConventionalPowertrainParams read_engine_map_powertrain(YamlMap& pt);

@@ -169,6 +169,7 @@ double top_speed_in_gear_mps(double max_speed_radps, double ratio, double radius
 // `driven_radius_m`: the driven wheels' radius, which with the gearing says where each gear runs out of revs.
 CombustionPowertrainParams read_combustion(YamlMap& pt, double driven_radius_m) {
   CombustionPowertrainParams p;
+  std::string max_power_where;
   {
     YamlMap m = pt.map("engine");
     auto& e = p.engine;
@@ -182,6 +183,7 @@ CombustionPowertrainParams read_combustion(YamlMap& pt, double driven_radius_m) 
     e.max_speed_radps = m.number("max_speed_rpm", Range::open_low(0.0, 1e5)) * kRadPerSPerRpm;
     e.max_torque_nm = m.number("max_torque_nm", Range::open_low(0.0, 1e5));
     e.max_power_w = m.number("max_power_kw", Range::open_low(0.0, 5000.0)) * 1e3;
+    max_power_where = m.where("max_power_kw");
     e.fuel_cut_min_speed_radps = m.number_or("fuel_cut_min_speed_rpm", 1.2 * e.idle_speed_radps / kRadPerSPerRpm,
                                              Range::closed(0.0, 1e5)) * kRadPerSPerRpm;
     if (e.max_speed_radps <= e.idle_speed_radps)
@@ -232,10 +234,21 @@ CombustionPowertrainParams read_combustion(YamlMap& pt, double driven_radius_m) 
   p.fuel = read_fuel(pt.map("fuel"));
   p.aux_power_w = read_aux_power_w(pt);
   p.alternator_efficiency = pt.number_or("alternator_efficiency", 1.0, Range::efficiency());
+  check_engine_carries_accessories(p.engine.max_power_w, p.aux_power_w, p.alternator_efficiency, max_power_where);
   return p;
 }
 
 }  // namespace
+
+// 0.2 kW against ice.yaml's 500 W of accessory shaft power left a negative force, -1e11 N near standstill, and CVODE
+// failed at the first launch (session 22's outside testing).
+void check_engine_carries_accessories(double max_power_w, double aux_power_w, double alternator_efficiency, const std::string& where) {
+  const double shaft_w = aux_power_w / alternator_efficiency;
+  if (max_power_w > shaft_w) return;
+  throw InputError(where, format_value(max_power_w / 1e3) + " kW cannot carry the accessories: aux_power_w " + format_value(aux_power_w) +
+                              " W through alternator_efficiency " + format_value(alternator_efficiency) + " takes " +
+                              fixed(shaft_w / 1e3, 3) + " kW of the engine; allowed: above " + fixed(shaft_w / 1e3, 3) + " kW");
+}
 
 // Zero leaves the auxiliaries out; a few watts are no car's electrical load (its control units alone draw tens).
 double read_aux_power_w(YamlMap& pt) {
