@@ -832,6 +832,14 @@ TEST_F(OutsideTesting, AnEngineTooWeakForItsAccessoriesIsNamed) {
   EXPECT_TRUE(has(r.out, "could not follow the trace")) << r.out;
 }
 
+// Options that did nothing where they were given were ignored in silence (session 22's notes).
+TEST_F(OutsideTesting, OptionsThatWouldDoNothingAreRefused) {
+  expect_refused("sweep --tyre nominal --param pressure --from 2 --to 3 --base100", "--base100: needs --plot");
+  expect_refused("sweep --tyre nominal --param pressure --from 2 --to 3 --threads 2", "--threads: needs --vehicle");
+  expect_refused("simulate --vehicle ev --replay --stats", "--stats: reports CVODE's work, and --replay runs no ODE solver");
+  EXPECT_EQ(run_rollsim("simulate --vehicle ev --stats").exit_code, 0);
+}
+
 // U3: a tab in the indentation gave yaml-cpp's "illegal map value" alone.
 TEST_F(OutsideTesting, ATabIndentedYamlLineIsNamed) {
   const std::string tyre = write("tab.yaml", "size: \"185/65 R15 88H\"\npressure_bar: 2.5\nmodel:\n\tcoulomb_damping_n: 170\n");

@@ -36,6 +36,8 @@ struct Run {
 };
 
 void run_simulate(const SimulateOptions& o) {
+  // It printed nothing in silence (session 22's notes).
+  if (o.stats && o.replay) throw InputError("--stats", "reports CVODE's work, and --replay runs no ODE solver: give one of them");
   const Vehicle base = load_vehicle_file(resolve_data_file(o.vehicle, "vehicles", ".yaml", "--vehicle"));
   std::vector<std::string> inputs = vehicle_input_files(base);
   std::vector<std::optional<TyreSpec>> tyre_sets;

@@ -137,6 +137,10 @@ void run_sweep(const SweepOptionsText& o, const ProcessGroup& group) {
   if (o.tyre.empty()) throw InputError("--tyre", "missing: give the tyre to sweep, e.g. --tyre 175-70R14");
   if (o.replay && o.vehicle.empty()) throw InputError("--replay", "needs --vehicle: a tyre alone is not simulated");
   if (!o.cycle.empty() && o.vehicle.empty()) throw InputError("--cycle", "needs --vehicle: a tyre alone drives no cycle");
+  // Both were ignored in silence (session 22's notes): a tyre sweep is one thread, and base 100 is a plot's scale.
+  if (!o.request.threads.empty() && o.vehicle.empty())
+    throw InputError("--threads", "needs --vehicle: only a vehicle sweep runs on threads, a tyre sweep takes milliseconds");
+  if (o.base100 && o.plot.empty()) throw InputError("--base100", "needs --plot: it scales the plot, the CSV keeps RRC as it is");
   const std::string cycle = o.cycle.empty() ? "nedc" : o.cycle;
   selection::SweepOptions so = selection::sweep_options_from_request(o.request);
   so.replay = o.replay;
