@@ -304,9 +304,11 @@ py::list api_compare(py::object vehicle, py::object tyre_names, py::object cycle
   selection::CompareOptions copt;
   copt.diameter_tolerance_pct =
       selection::parse_diameter_tolerance_pct(number_text(diameter_tolerance_pct, "diameter_tolerance_pct"));
-  const selection::CandidateList list =
-      selection::load_candidates(tyres, !catalogue.is_none(),
-                                 catalogue.is_none() ? "" : arg_as<std::string>(catalogue, "catalogue", "a folder path (str)"));
+  const std::string folder = catalogue.is_none() ? "" : arg_as<std::string>(catalogue, "catalogue", "a folder path (str)");
+  // "" compared the shipped catalogue, as None does (session 22's notes).
+  if (!catalogue.is_none() && folder.empty())
+    throw InputError("catalogue", "'' is no folder; leave catalogue out (None) for the shipped tyres/catalogue");
+  const selection::CandidateList list = selection::load_candidates(tyres, !catalogue.is_none(), folder);
   for (const auto& b : list.broken) warn("skipped broken catalogue file: " + b);
   const Vehicle v = vehicle_from(vehicle);
   const DriveCycle c = cycle_from(cycle);

@@ -152,6 +152,15 @@ class SelectionApi(unittest.TestCase):
         self.assertEqual(sum("could not follow" in str(w.message) for w in caught), len(rows))
         self.assertTrue(all(r["followed_trace"] for r in rollsim.compare("ev", tyres=["175-65R15"])))
 
+    def test_an_empty_catalogue_path_is_refused(self):
+        # It compared the shipped catalogue, as None does (session 22's notes); so did the CLI's --catalogue "".
+        with self.assertRaises(rollsim.InputError) as caught:
+            rollsim.compare("ev", catalogue="")
+        self.assertIn("leave catalogue out (None)", str(caught.exception))
+        _, err, code = cli("compare", "--vehicle", "ev", "--catalogue", "", expect_ok=False)
+        self.assertEqual(code, 2)
+        self.assertIn("--catalogue: needs a value here, and an empty one is none", err)
+
     def test_sensitivity_matches_cli(self):
         expected, _, _ = cli("sensitivity", "--vehicle", "ev", "--cycle", "nedc", "--json")
         self.assertEqual([rollsim.sensitivity(vehicle="ev")], expected)
