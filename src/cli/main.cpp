@@ -68,7 +68,7 @@ std::string empty_option_value(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a.rfind("--", 0) != 0 || a == "--") continue;
-    if (a.back() == '=') return a.substr(0, a.size() - 1);
+    if (a.find('=') == a.size() - 1) return a.substr(0, a.size() - 1);  // `--x=`, not `--x=a=`
     if (i + 1 < argc && argv[i + 1][0] == '\0') return a;
   }
   return "";
