@@ -811,6 +811,17 @@ TEST_F(OutsideTesting, VehicleUnitSlipsAreNamedAtTheirOwnKey) {
   CmdResult r = run_rollsim("simulate --vehicle '" + lb + "'");
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(has(r.err, "exceeds its rated maximum 6031 N; is body.test_mass_kg in lb? (3596 lb = 1631 kg)")) << r.err;
+  const std::string fmep = write("fmep.yaml", shipped_vehicle_with("ice.yaml", "friction_mep_bar: 0.97 ", "friction_mep_bar: 0.097 "));
+  r = run_rollsim("simulate --vehicle '" + fmep + "'");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(has(r.err, "warning: " + fmep + ": key 'powertrain.engine.friction_mep_bar': 0.097 bar is below any running "
+                         "engine's friction (0.4-2.5 bar at low speed); is it in MPa? (0.097 MPa = 0.97 bar)")) << r.err;
+  // A coast-down C typed per (m/s)^2 (here 0.016476 lbf/mph^2 read in N/(m/s)^2 and put in N/(km/h)^2: 0.41).
+  const std::string cd = write("cd.yaml", shipped_vehicle_with("camry_2018.yaml", "c_lbf_per_mph2: 0.016476", "c_lbf_per_mph2: 0.21"));
+  r = run_rollsim("simulate --vehicle '" + cd + "' --replay");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(has(r.err, "key 'coastdown.c_lbf_per_mph2': 0.21 lbf/mph^2 is the drag of Cd A = 7.8 m^2 at 1.2 kg/m^3, more "
+                         "than any car or van of")) << r.err;
   const std::string soc = write("soc.yaml", shipped_vehicle_with("ev.yaml", "initial_soc_pct: 95", "initial_soc_pct: 0.95"));
   r = run_rollsim("simulate --vehicle '" + soc + "'");
   EXPECT_TRUE(has(r.err, "warning: " + soc + ": key 'powertrain.battery.initial_soc_pct': 0.95 % is a battery all but empty")) << r.err;

@@ -70,6 +70,30 @@ BodyParams read_body(YamlMap m) {
                           " m); wheel_radius_m is only for a car without tyres (coast-down road load): remove it, or the tyres");
 }
 
+// C is the body's drag, 0.5 rho Cd A: a car's or a van's Cd A is 0.5-2 m^2, a lorry's or a bus's up to ~6 m^2. A C
+// typed per (m/s)^2 into c_n_per_kmh2 (13 x too large) read as a car with the drag of three lorries, unwarned
+// (session 22's notes). Warned, not refused: the file may describe an odd vehicle.
+void warn_implausible_coastdown_c(const YamlMap& m, const CoastdownParams& c, double test_mass_kg, std::vector<std::string>& warnings) {
+  constexpr double kAirDensity_kg_per_m3 = 1.2;
+  const double cda_m2 = c.c_n_s2_per_m2 / (0.5 * kAirDensity_kg_per_m3);
+  const bool light = test_mass_kg < 3500.0;
+  const double most_m2 = light ? 2.5 : 10.0;
+  if (cda_m2 <= most_m2) return;
+  const bool us = m.has("c_lbf_per_mph2");
+  const std::string drag = " is the drag of Cd A = " + fixed(cda_m2, 1) + " m^2 at " + format_value(kAirDensity_kg_per_m3) +
+                           " kg/m^3, more than any " + (light ? "car or van" : "road vehicle") + " of " +
+                           format_value(std::round(test_mass_kg)) + " kg (up to " + format_value(most_m2) + " m^2)";
+  if (us) {
+    const double lbf_per_mph2 = c.c_n_s2_per_m2 / units::kNPerLbf * units::kMpsPerMph * units::kMpsPerMph;
+    warnings.push_back(m.where("c_lbf_per_mph2") + ": " + format_value(lbf_per_mph2) + " lbf/mph^2" + drag);
+    return;
+  }
+  const double per_kmh2 = c.c_n_s2_per_m2 * units::kMpsPerKmh * units::kMpsPerKmh;
+  warnings.push_back(m.where("c_n_per_kmh2") + ": " + format_value(per_kmh2) + " N/(km/h)^2" + drag + "; is it per (m/s)^2? (" +
+                     format_value(per_kmh2) + " N/(m/s)^2 = " + significant(per_kmh2 * units::kMpsPerKmh * units::kMpsPerKmh, 3) +
+                     " N/(km/h)^2)");
+}
+
 CoastdownParams read_coastdown(YamlMap m) {
   CoastdownParams c;
   const bool us = m.has("a_lbf") || m.has("b_lbf_per_mph") || m.has("c_lbf_per_mph2");
@@ -167,7 +191,7 @@ ElectricPowertrainParams read_electric(YamlMap& pt, std::vector<std::string>& wa
 double top_speed_in_gear_mps(double max_speed_radps, double ratio, double radius_m) { return max_speed_radps * radius_m / ratio; }
 
 // `driven_radius_m`: the driven wheels' radius, which with the gearing says where each gear runs out of revs.
-CombustionPowertrainParams read_combustion(YamlMap& pt, double driven_radius_m) {
+CombustionPowertrainParams read_combustion(YamlMap& pt, double driven_radius_m, std::vector<std::string>& warnings) {
   CombustionPowertrainParams p;
   std::string max_power_where;
   {
@@ -177,6 +201,13 @@ CombustionPowertrainParams read_combustion(YamlMap& pt, double driven_radius_m) 
     e.displacement_m3 = m.number("displacement_l", Range::closed(0.05, 30.0)) * units::kM3PerLitre;
     e.indicated_efficiency = m.number("indicated_efficiency", Range::open_low(0.0, 0.6));
     e.friction_mep_pa = m.number("friction_mep_bar", Range::closed(0.0, 20.0)) * units::kPaPerBar;
+    // A running engine's friction mep is 0.4-2.5 bar at low speed (Heywood fig. 13-13; EPA's A25A-FKS map: 0.45
+    // without pumping); 0.097 ran as a tenth of the friction, unwarned (session 22's notes). 0 stays silent: a Willans
+    // line with the friction left out on purpose.
+    if (const double bar = e.friction_mep_pa / units::kPaPerBar; bar > 0.0 && bar < 0.3)
+      warnings.push_back(m.where("friction_mep_bar") + ": " + format_value(bar) +
+                         " bar is below any running engine's friction (0.4-2.5 bar at low speed); is it in MPa? (" +
+                         format_value(bar) + " MPa = " + format_value(10.0 * bar) + " bar)");
     e.friction_mep_pa_s_per_rad =
         m.number_or("friction_mep_bar_per_1000rpm", 0.0, Range::closed(0.0, 10.0)) * units::kPaPerBar / (1000.0 * kRadPerSPerRpm);
     e.idle_speed_radps = m.number("idle_speed_rpm", Range::open_low(0.0, 1e4)) * kRadPerSPerRpm;
@@ -310,7 +341,10 @@ Vehicle load_vehicle(YamlMap root) {
     throw InputError(body.where("front_axle_load_fraction"),
                      format_value(v.body.front_axle_load_fraction) + " is not allowed with tyres: must be in [0.1, 0.9] (each "
                      "axle's tyres roll under their share of the weight; 0 and 1 are for a coast-down car)");
-  if (auto c = root.optional_map("coastdown")) v.coastdown = read_coastdown(*c);
+  if (auto c = root.optional_map("coastdown")) {
+    v.coastdown = read_coastdown(*c);
+    warn_implausible_coastdown_c(*c, *v.coastdown, v.body.test_mass_kg, v.warnings);
+  }
   if (!v.front_tyre && !v.coastdown)
     throw InputError(root.where("tyres"), "a vehicle needs tyres (tyres: {all: FILE}) or coastdown coefficients");
   if (!v.front_tyre && !(v.body.wheel_radius_m > 0.0))
@@ -322,7 +356,7 @@ Vehicle load_vehicle(YamlMap root) {
     v.powertrain = read_electric(pt, v.warnings);
   } else if (type == "combustion") {
     const std::optional<TyreSpec>& driven = v.body.driven_axle == DrivenAxle::rear ? v.rear_tyre : v.front_tyre;
-    v.powertrain = read_combustion(pt, driven ? driven->state.geometry.outer_radius_m : v.body.wheel_radius_m);
+    v.powertrain = read_combustion(pt, driven ? driven->state.geometry.outer_radius_m : v.body.wheel_radius_m, v.warnings);
   } else if (type == "engine_map") {
     v.powertrain = read_engine_map_powertrain(pt);
   } else {
