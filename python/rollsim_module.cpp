@@ -184,10 +184,13 @@ Vehicle vehicle_from(py::handle v) {
   if (py::isinstance<py::dict>(v)) return load_vehicle_text(dict_json(v, "vehicle dict"), "vehicle dict");
   return load_vehicle_file(vehicle_path(v));
 }
+std::string tyre_path(py::handle t) {
+  return resolve_data_file(arg_as<std::string>(t, "tyre", kNameOrDict), "tyres", ".yaml", "--tyre");
+}
 std::optional<TyreSpec> tyre_from(py::handle t) {
   if (t.is_none()) return std::nullopt;
   if (py::isinstance<py::dict>(t)) return load_tyre_text(dict_json(t, "tyre dict"), "tyre dict");
-  return load_tyre_file(resolve_data_file(arg_as<std::string>(t, "tyre", kNameOrDict), "tyres", ".yaml", "--tyre"));
+  return load_tyre_file(tyre_path(t));
 }
 
 // A shipped name or CSV path; a dict of arrays named like the CSV columns (time_s, speed_kmh or speed_mps,
@@ -290,7 +293,12 @@ py::dict api_simulate(py::object vehicle, py::object tyre, py::object cycle, py:
   for (const auto& w : run.warnings) warn(w);
   for (const auto& c : report::run_caveats(run.result)) warn(c);  // as the command line's text and --json say them
   py::dict out;
-  out["summary"] = from_json(report::to_json(run.result, run.tyre_label).str());
+  JsonObject summary = report::to_json(run.result, run.tyre_label);
+  // As simulate --json: the files read, null for a dict, arrays or the vehicle's own tyres.
+  report::add_input_files(summary, {py::isinstance<py::dict>(vehicle) ? "" : base.source,
+                                    tyre.is_none() || py::isinstance<py::dict>(tyre) ? "" : tyre_path(tyre),
+                                    py::isinstance<py::str>(fspath_or_self(cycle)) ? c.source : ""});
+  out["summary"] = from_json(summary.str());
   py::dict columns;
   if (trace)
     for (auto& col : report::trace_columns(run.result)) columns[py::str(col.name)] = py::array_t<double>(col.values.size(), col.values.data());

@@ -129,6 +129,10 @@ class SimulateApi(unittest.TestCase):
         for cycle, tol in (((data[:, 0], data[:, 1]), 0.0), ({"time_s": data[:, 0], "speed_mps": data[:, 1] / 3.6}, 1e-7)):
             got = rollsim.simulate(vehicle=vehicle, tyre=tyre, cycle=cycle, trace=False)["summary"]
             self.assertEqual(got["cycle"], "user trace")
+            # No file was read: the summary says so where the CLI names its files.
+            self.assertEqual((got["vehicle_file"], got["tyre_file"], got["cycle_file"]), (None, None, None))
+            self.assertEqual((expected["vehicle_file"], expected["tyre_file"], expected["cycle_file"]),
+                             ("vehicles/ev.yaml", "tyres/nominal.yaml", "cycles/nedc.csv"))
             for key in ("distance_km", "aec_kwh_per_10km", "range_km"):
                 self.assertAlmostEqual(got[key] / expected[key], 1.0, delta=tol, msg=key)
             for key, kwh in expected["energy_breakdown_kwh"].items():

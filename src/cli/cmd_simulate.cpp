@@ -33,6 +33,8 @@ struct SimulateOptions {
 struct Run {
   std::string tyre_label;
   SimulationResult result;
+  std::string tyre_file;   ///< empty: the vehicle's own tyres
+  std::string cycle_file;
 };
 
 void run_simulate(const SimulateOptions& o) {
@@ -41,10 +43,13 @@ void run_simulate(const SimulateOptions& o) {
   const Vehicle base = load_vehicle_file(resolve_data_file(o.vehicle, "vehicles", ".yaml", "--vehicle"));
   std::vector<std::string> inputs = vehicle_input_files(base);
   std::vector<std::optional<TyreSpec>> tyre_sets;
+  std::vector<std::string> tyre_files;
   for (const auto& t : o.tyres) {
     inputs.push_back(resolve_data_file(t, "tyres", ".yaml", "--tyre"));
+    tyre_files.push_back(inputs.back());
     tyre_sets.emplace_back(load_tyre_file(inputs.back()));
   }
+  if (tyre_files.empty()) tyre_files.emplace_back();
 
   if (tyre_sets.empty()) tyre_sets.emplace_back(std::nullopt);
   std::vector<DriveCycle> cycles;
@@ -58,7 +63,8 @@ void run_simulate(const SimulateOptions& o) {
   sim_opt.record_trace = !o.trace_path.empty();
   std::vector<Run> runs;
   for (const auto& cycle : cycles) {
-    for (const auto& tyre : tyre_sets) {
+    for (std::size_t k = 0; k < tyre_sets.size(); ++k) {
+      const auto& tyre = tyre_sets[k];
       VehicleRun run = run_vehicle(base, tyre, cycle, o.replay, sim_opt);
       // Once per tyre set (the first cycle): an overloaded tyre is allowed but said.
       if (&cycle == &cycles.front()) {
@@ -72,7 +78,7 @@ void run_simulate(const SimulateOptions& o) {
                   << fixed(v.coastdown->a_n, 1) << " N (" << fixed(100.0 * tyre_a_n / v.coastdown->a_n, 1)
                   << " %)\n";
       }
-      runs.push_back({run.tyre_label, std::move(run.result)});
+      runs.push_back({run.tyre_label, std::move(run.result), tyre_files[k], cycle.source});
     }
   }
 
@@ -80,7 +86,12 @@ void run_simulate(const SimulateOptions& o) {
     write_file_atomically(o.trace_path, "--trace", [&](std::ostream& out) { report::write_trace_csv(out, runs.front().result); });
   }
   if (o.json) {
-    for (const auto& run : runs) std::cout << report::to_json(run.result, run.tyre_label).str() << "\n";
+    // The files too: two cycles or tyres of one name (a user's udds.csv beside the shipped one) read alike (session 22).
+    for (const auto& run : runs) {
+      JsonObject j = report::to_json(run.result, run.tyre_label);
+      report::add_input_files(j, {base.source, run.tyre_file, run.cycle_file});
+      std::cout << j.str() << "\n";
+    }
     // The text's warnings (a battery run empty, a trace not followed) go where warnings go: the JSON alone gave a
     // negative state of charge without a word (session 20).
     for (const auto& run : runs)

@@ -176,6 +176,13 @@ std::vector<std::string> run_caveats(const SimulationResult& r) {
   return out;
 }
 
+void add_input_files(JsonObject& j, const RunInputFiles& files) {
+  for (const auto& [key, path] : {std::pair{"vehicle_file", &files.vehicle}, {"tyre_file", &files.tyre}, {"cycle_file", &files.cycle}}) {
+    if (path->empty()) j.add_null(key);
+    else j.add(key, *path);
+  }
+}
+
 JsonObject to_json(const SimulationResult& r, const std::string& tyre_label) {
   JsonObject j;
   j.add("vehicle", r.vehicle).add("tyre", tyre_label).add("road_load", r.road_load).add("cycle", r.cycle);

@@ -38,6 +38,13 @@ std::vector<std::string> run_caveats(const SimulationResult& r);
 /// energy_breakdown_kwh, max_speed_error_kmh.
 JsonObject to_json(const SimulationResult& r, const std::string& tyre_label);
 
+/// The input files a run was read from, as `vehicle_file`, `tyre_file` and `cycle_file` (null where the input was
+/// not a file: the vehicle's own tyres, a Python dict or arrays). Two cycles or tyres of one name read alike without them.
+struct RunInputFiles {
+  std::string vehicle, tyre, cycle;  ///< empty: not a file
+};
+void add_input_files(JsonObject& j, const RunInputFiles& files);
+
 /// One named column of the trace, in the units its name carries (as the --trace CSV writes it).
 struct TraceColumn {
   std::string name;
