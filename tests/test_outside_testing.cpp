@@ -851,6 +851,63 @@ TEST_F(OutsideTesting, OptionsThatWouldDoNothingAreRefused) {
   EXPECT_EQ(run_rollsim("simulate --vehicle ev --stats").exit_code, 0);
 }
 
+const std::string kTwizyTrip = std::string(ROLLSIM_SHARED_DIR) + "/data/recordings/rsk_renault_twizy/T1_07_01_2021.csv";
+
+std::string line_with(const std::string& text, const std::string& head) {
+  std::istringstream in(text);
+  for (std::string l; std::getline(in, l);)
+    if (l.find(head) != std::string::npos) return l;
+  return "";
+}
+
+// A BMS re-estimate of the state of charge (+3 % or -3 % in 1 s at 12 km/h, 660 kW into a Twizy) was read as energy,
+// in silence, and turned the verdict (session 23's outside testing): it is said, and no window spans it, so the two
+// steps give the same diagnosis.
+TEST_F(OutsideTesting, AnImpossibleStateOfChargeStepIsSaidAndNoWindowSpansIt) {
+  std::map<std::string, std::string> result;
+  for (const double step : {3.0, -3.0}) {
+    const std::string text = recording_edited(kTwizyTrip, [&](int n, std::vector<std::string>& f) {
+      if (n >= 2000) f[2] = std::to_string(std::stod(f[2]) + step);
+    });
+    const std::string path = write(step > 0 ? "up.csv" : "down.csv", text);
+    const CmdResult r = run_rollsim("diagnose --vehicle twizy --preset rsk_twizy --recording '" + path + "'");
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_TRUE(has(r.out, "state-of-charge step(s) larger than the battery could make in the time")) << r.out;
+    EXPECT_TRUE(has(r.out, (step > 0 ? "; 3.00 % at t = 40075 s" : "; -3.00 % at t = 40075 s"))) << r.out;
+    result[path] = line_with(r.out, "uncalibrated trip energy error") + line_with(r.out, "verdict:");
+  }
+  EXPECT_EQ(result.begin()->second, result.rbegin()->second);
+}
+
+// Twenty trips two hours apart in one file read a mean power of 54 W over the gaps (the trip draws 2706 W), windows of
+// 1670 s, and the speed's distance counted each trip's last speed through the gap: a false units warning (session 23).
+TEST_F(OutsideTesting, GapsBetweenTripsAreNotDriving) {
+  const std::string trip = slurp(kTwizyTrip);
+  const std::string body = trip.substr(trip.find('\n') + 1);
+  std::string second;
+  std::istringstream in(body);
+  for (std::string l; std::getline(in, l);) {
+    std::vector<std::string> f;
+    std::stringstream ss(l);
+    for (std::string c; std::getline(ss, c, ',');) f.push_back(c);
+    int h = 0, m = 0, sec = 0;
+    ASSERT_EQ(std::sscanf(f[1].c_str(), "%d:%d:%d", &h, &m, &sec), 3) << f[1];
+    const int t = h * 3600 + m * 60 + sec + 4 * 3600;  // the trip ends before 12:00: 4 h later it is the same day
+    char clock[16];
+    std::snprintf(clock, sizeof clock, "%02d:%02d:%02d", t / 3600, t / 60 % 60, t % 60);
+    f[1] = clock;
+    for (std::size_t i = 0; i < f.size(); ++i) second += (i ? "," : "") + f[i];
+    second += "\n";
+  }
+  const CmdResult one = run_rollsim("diagnose --vehicle twizy --preset rsk_twizy --recording '" + kTwizyTrip + "'");
+  const CmdResult two = run_rollsim("diagnose --vehicle twizy --preset rsk_twizy --recording '" + write("two.csv", trip + second) + "'");
+  ASSERT_EQ(two.exit_code, 0) << two.err;
+  const std::string mean = line_with(one.out, "SOC quantum");
+  EXPECT_FALSE(mean.empty()) << one.out;
+  EXPECT_EQ(line_with(two.out, "SOC quantum"), mean);
+  EXPECT_FALSE(has(two.out + two.err, "is the speed in the unit its mapping says")) << two.out << two.err;
+}
+
 // U3: a tab in the indentation gave yaml-cpp's "illegal map value" alone.
 TEST_F(OutsideTesting, ATabIndentedYamlLineIsNamed) {
   const std::string tyre = write("tab.yaml", "size: \"185/65 R15 88H\"\npressure_bar: 2.5\nmodel:\n\tcoulomb_damping_n: 170\n");

@@ -191,6 +191,10 @@ double gps_track_m(const Recording& r) {
     const double step_m = std::hypot((lat[i] - lat[last]) * north_m_per_deg, (lon[i] - lon[last]) * east_m_per_deg);
     const double reach_m = 3.0 * std::max(r.speed_mps[i], r.speed_mps[last]) * (r.time_s[i] - r.time_s[last]) + 50.0;
     if (!std::isfinite(step_m) || step_m > reach_m) continue;  // a glitch: measure from the last good fix
+    if (r.time_s[i] - r.time_s[i - 1] > kReportedGap_s) {  // a gap: unrecorded, as the speed's distance leaves it out
+      last = i;
+      continue;
+    }
     track_m += step_m;
     last = i;
   }

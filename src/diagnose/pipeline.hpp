@@ -30,6 +30,7 @@ struct Observations {
   std::vector<Window> windows;
   std::vector<std::vector<double>> dt_s;        // per recording, per segment
   std::vector<std::vector<double>> measured_w;  // per recording, per sample (empty for SOC)
+  std::vector<std::vector<char>> break_before;   // per recording, per sample: no window spans the step into it
   Eigen::VectorXd measured_j;                   // per window
   std::vector<int> fold_of;                     // held-out fold of each window
   double soc_capacity_j = 0.0;

@@ -104,7 +104,13 @@ struct Channel {
 
 double Recording::distance_m() const {
   double s = 0.0;
-  for (std::size_t i = 0; i + 1 < time_s.size(); ++i) s += 0.5 * (speed_mps[i] + speed_mps[i + 1]) * (time_s[i + 1] - time_s[i]);
+  for (std::size_t i = 0; i + 1 < time_s.size(); ++i) {
+    const double dt = time_s[i + 1] - time_s[i];
+    // What happened in a gap was not recorded: twenty trips two hours apart counted each trip's last speed for the
+    // two hours, 1418 km against the GPS track's 854 (session 23's outside testing). The windows skip gaps alike.
+    if (dt > kReportedGap_s) continue;
+    s += 0.5 * (speed_mps[i] + speed_mps[i + 1]) * dt;
+  }
   return s;
 }
 

@@ -30,7 +30,7 @@ struct Recording {
   std::vector<std::string> repairs;  ///< every change made to the file's values, and gaps kept, in words
 
   double duration_s() const { return time_s.empty() ? 0.0 : time_s.back() - time_s.front(); }
-  double distance_m() const;  ///< trapezoid integral of speed
+  double distance_m() const;  ///< trapezoid integral of speed, gaps (steps over kReportedGap_s) left out
 };
 
 /// How a logger's columns map to rollsim's canonical ones. Canonical names, in the file's own units:
