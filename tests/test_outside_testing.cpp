@@ -908,6 +908,15 @@ TEST_F(OutsideTesting, GapsBetweenTripsAreNotDriving) {
   EXPECT_FALSE(has(two.out + two.err, "is the speed in the unit its mapping says")) << two.out << two.err;
 }
 
+// An electric car's battery power against a petrol car was diagnosed (+217 %, road_grade named), where SOC and fuel
+// against the wrong car are refused (session 23's outside testing).
+TEST_F(OutsideTesting, BatteryPowerAgainstACarWithoutABatteryIsRefused) {
+  std::string text = "time_s,speed_kmh,battery_power_kw\n";
+  for (int t = 0; t <= 600; ++t) text += std::to_string(t) + "," + std::to_string(t % 120 < 60 ? t % 120 : 120 - t % 120) + ",5\n";
+  const std::string path = write("ev_power.csv", text);
+  expect_refused("diagnose --vehicle ice --recording '" + path + "'", path + ": battery power recorded but the vehicle has no battery");
+}
+
 // U3: a tab in the indentation gave yaml-cpp's "illegal map value" alone.
 TEST_F(OutsideTesting, ATabIndentedYamlLineIsNamed) {
   const std::string tyre = write("tab.yaml", "size: \"185/65 R15 88H\"\npressure_bar: 2.5\nmodel:\n\tcoulomb_damping_n: 170\n");

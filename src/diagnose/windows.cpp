@@ -154,6 +154,10 @@ void check_informative(const Recording& r, const std::vector<double>& measured_w
 }  // namespace
 
 std::vector<double> measured_power_w(const Vehicle& v, const Recording& r, ChannelKind& kind) {
+  // As a SOC or a fuel channel against the wrong car: an EV's battery power against ice.yaml read +217 % and named
+  // road_grade (session 23's outside testing).
+  if ((r.battery_power_w || (r.battery_voltage_v && r.battery_current_a)) && !v.battery())
+    throw InputError(r.source, "battery power recorded but the vehicle has no battery (a combustion car: give it a fuel rate channel)");
   if (r.battery_power_w) {
     kind = ChannelKind::battery_power;
     return *r.battery_power_w;
