@@ -290,6 +290,26 @@ TEST_F(DriveCycleFiles, GpsNoiseOnALevelRouteIsNoClimb) {
   EXPECT_NEAR(simulate_forward(ev, c).energy.battery_terminal_j / flat_j, 1.0, 0.02);
 }
 
+// A GPS drifting up 6 m in small steps while the car stands, and snapping back as it moves off: each snap-back was the
+// one step dropped as a glitch, so every stop booked a 6 m climb (session 23's outside testing: +11 % energy on a
+// level route with six stops). Drifting up or down, snapping back while standing or on the first moving sample.
+TEST_F(DriveCycleFiles, AnElevationDriftingWhileStandingIsNoClimb) {
+  for (const double drift_m : {6.0, -6.0, 4.0}) {
+    for (const int snap_at : {119, 120}) {  // the stop's last standing sample, or the first moving one
+      std::string text = "time_s,speed_kmh,elevation_m\n";
+      for (int t = 0; t <= 720; ++t) {
+        const int phase = t % 120;  // 0-20 s up to 50 km/h, 60 s cruise, 20 s down, 20 s standing
+        const double kmh = phase < 20 ? 2.5 * phase : phase < 80 ? 50.0 : phase < 100 ? 50.0 - 2.5 * (phase - 80) : 0.0;
+        const bool drifting = phase >= 100 && phase < snap_at;  // back at 150 m from phase snap_at (120: the next 0)
+        const double h_m = 150.0 + (drifting ? drift_m * (phase - 99) / 20.0 : 0.0);
+        text += std::to_string(t) + "," + std::to_string(kmh) + "," + std::to_string(h_m) + "\n";
+      }
+      const auto c = load_cycle(write("drift.csv", text));
+      EXPECT_NEAR(net_climb_m(c), 0.0, 0.25) << drift_m << " m, snapping back at " << snap_at;  // six stops: 36 m before
+    }
+  }
+}
+
 TEST_F(DriveCycleFiles, BadInputNamesFileLineColumnAndValue) {
   auto has = [](const std::string& msg, const std::string& part) {
     return msg.find(part) != std::string::npos ? ::testing::AssertionSuccess()
