@@ -917,6 +917,25 @@ TEST_F(OutsideTesting, BatteryPowerAgainstACarWithoutABatteryIsRefused) {
   expect_refused("diagnose --vehicle ice --recording '" + path + "'", path + ": battery power recorded but the vehicle has no battery");
 }
 
+// One file over two days: the trip again the next day at the same clock read "time goes backwards" (session 23's
+// outside testing). The date's change across the break starts the next day, in the US, ISO and European forms.
+TEST_F(OutsideTesting, ARecordingOverSeveralDaysIsRead) {
+  const std::string trip = slurp(kTwizyTrip);
+  const std::string header = trip.substr(0, trip.find('\n') + 1), body = trip.substr(trip.find('\n') + 1);
+  for (const auto& [day1, day2] : {std::pair{"7/1/2021", "7/2/2021"}, {"2021-07-01", "2021-07-02"}, {"01.07.2021", "02.07.2021"},
+                                   {"31/12/2021", "1/1/2022"}}) {
+    std::string text = header;
+    for (const char* date : {day1, day2}) {
+      std::istringstream in(body);
+      for (std::string l; std::getline(in, l);) text += date + l.substr(l.find(',')) + "\n";
+    }
+    const CmdResult r = run_rollsim("diagnose --vehicle twizy --preset rsk_twizy --recording '" + write("days.csv", text) + "'");
+    EXPECT_EQ(r.exit_code, 0) << day1 << ": " << r.err;
+    // 7/1 11:50:10 to 7/2 10:34:36: 22 h 44 min 26 s.
+    EXPECT_TRUE(has(r.out, "81866 s between lines 4536-4537")) << day1 << ": " << r.out.substr(0, 600);
+  }
+}
+
 // U3: a tab in the indentation gave yaml-cpp's "illegal map value" alone.
 TEST_F(OutsideTesting, ATabIndentedYamlLineIsNamed) {
   const std::string tyre = write("tab.yaml", "size: \"185/65 R15 88H\"\npressure_bar: 2.5\nmodel:\n\tcoulomb_damping_n: 170\n");

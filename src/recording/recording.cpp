@@ -1,6 +1,7 @@
 #include "rollsim/recording/recording.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <limits>
@@ -87,6 +88,60 @@ std::optional<double> parse_clock(const std::string& text) {
   const int h = std::stoi(hh), m = std::stoi(mm);
   if (h > 23 || m > 59 || *sec < 0.0 || *sec >= 61.0) return std::nullopt;  // 60.x: a leap second
   return h * units::kSPerHour + m * 60.0 + *sec;
+}
+
+// Days since 1970-01-01 of a civil date (Howard Hinnant's days_from_civil, proleptic Gregorian).
+long days_from_civil(long y, unsigned m, unsigned d) {
+  y -= m <= 2;
+  const long era = (y >= 0 ? y : y - 399) / 400;
+  const auto yoe = static_cast<unsigned>(y - era * 400);
+  const unsigned doy = (153 * (m > 2 ? m - 3 : m + 9) + 2) / 5 + d - 1;
+  const unsigned doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
+  return era * 146097 + static_cast<long>(doe) - 719468;
+}
+
+// The three numbers of a date cell split at '/', '-' or '.', or nothing.
+std::optional<std::array<long, 3>> date_fields(const std::string& text) {
+  std::array<long, 3> f{};
+  std::size_t k = 0, i = 0;
+  const std::string s = trim(text);
+  while (k < 3) {
+    std::size_t j = i;
+    while (j < s.size() && std::isdigit(static_cast<unsigned char>(s[j]))) ++j;
+    if (j == i || j - i > 4) return std::nullopt;
+    f[k++] = std::stol(s.substr(i, j - i));
+    if (k < 3) {
+      if (j >= s.size() || (s[j] != '/' && s[j] != '-' && s[j] != '.')) return std::nullopt;
+      i = j + 1;
+    } else if (j != s.size()) {
+      return std::nullopt;
+    }
+  }
+  return f;
+}
+
+// Day numbers of a date column, where every cell reads as one date: year first (2021-07-01), or the year last with
+// the day first if any first field exceeds 12 or the separator is '.' (01.07.2021), else the month first (7/1/2021,
+// the US loggers'). Empty when the column does not read so throughout.
+std::vector<long> date_day_numbers(const CsvTable& table, std::size_t col) {
+  std::vector<std::array<long, 3>> f;
+  bool day_first = false;
+  for (const auto& row : table.rows) {
+    const auto d = date_fields(row[col]);
+    if (!d) return {};
+    if ((*d)[2] >= 1000 && ((*d)[0] > 12 || row[col].find('.') != std::string::npos)) day_first = true;
+    f.push_back(*d);
+  }
+  std::vector<long> days;
+  for (const auto& d : f) {
+    long y = 0, m = 0, dd = 0;
+    if (d[0] >= 1000) y = d[0], m = d[1], dd = d[2];
+    else if (d[2] >= 1000) y = d[2], m = day_first ? d[1] : d[0], dd = day_first ? d[0] : d[1];
+    else return {};
+    if (m < 1 || m > 12 || dd < 1 || dd > 31) return {};
+    days.push_back(days_from_civil(y, static_cast<unsigned>(m), static_cast<unsigned>(dd)));
+  }
+  return days;
 }
 
 std::string lines_text(const CsvTable& t, std::size_t r0, std::size_t r1) {
@@ -263,6 +318,11 @@ Recording load_recording(const std::string& path, const ColumnMapping& mapping) 
   std::vector<std::size_t> date_disagrees;
   std::size_t day = 0;
   std::string current_date = col_date ? table.rows[0][*col_date] : "";
+  // A logger writing one file over several days: a date that moves on across a break in the logging starts a later
+  // day, which the clock alone cannot tell (10:34 on 7/2 after 11:50 on 7/1 was "time goes backwards": session 23's
+  // outside testing). Within continuous logging the clock rules, so a date kept in another time zone than the clock
+  // only earns a note (date_disagrees).
+  const std::vector<long> day_numbers = clock && col_date ? date_day_numbers(table, *col_date) : std::vector<long>{};
   for (std::size_t r = 0; r < n; ++r) {
     const std::string& cell = table.rows[r][col_t];
     if (is_missing(cell)) throw InputError(table.where(r, col_t), "time is missing; every row needs a time");
@@ -273,7 +333,12 @@ Recording load_recording(const std::string& path, const ColumnMapping& mapping) 
                                                           std::to_string(table.row_line[0]) + ")");
       if (r > 0) {
         const double prev_clock = rec.time_s[r - 1] - static_cast<double>(day) * kSecondsPerDay;
-        if (*c < prev_clock - kMidnightFall_s) {
+        const long days_on = day_numbers.empty() ? 0 : day_numbers[r] - day_numbers[r - 1];
+        const bool a_break = *c < prev_clock || *c - prev_clock > kReportedGap_s;
+        if (days_on > 0 && a_break) {
+          day += static_cast<std::size_t>(days_on);
+          current_date = table.rows[r][*col_date];
+        } else if (*c < prev_clock - kMidnightFall_s) {
           ++day;
           if (col_date) {
             const std::string& d = table.rows[r][*col_date];

@@ -34,7 +34,7 @@ struct Recording {
 };
 
 /// How a logger's columns map to rollsim's canonical ones. Canonical names, in the file's own units:
-/// time_s (s, or clock text HH:MM:SS[.fff]), date (text; only to confirm a clock passing midnight),
+/// time_s (s, or clock text HH:MM:SS[.fff]), date (text: confirms a clock passing midnight, and a date moving on across a break in the logging starts a later day),
 /// speed_kmh, battery_power_kw (+ discharging), battery_voltage_v, battery_current_a (+ discharging), soc_pct,
 /// fuel_rate_lph, elevation_m, grade_pct, ambient_temp_c, latitude, longitude (degrees).
 /// A canonical column without a mapping is looked up under its own name. The scale multiplies the source
