@@ -2,7 +2,9 @@
 // of every command). Each test failed before its fix.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
+#include <iomanip>
 #include <fstream>
 #include <iterator>
 #include <map>
@@ -934,6 +936,38 @@ TEST_F(OutsideTesting, ARecordingOverSeveralDaysIsRead) {
     // 7/1 11:50:10 to 7/2 10:34:36: 22 h 44 min 26 s.
     EXPECT_TRUE(has(r.out, "81866 s between lines 4536-4537")) << day1 << ": " << r.out.substr(0, 600);
   }
+}
+
+// The Camry file maps its logger's mph and cm3/s columns with their factors; a user's file already in km/h and l/h,
+// mapped with --column, got those factors too: -41 % and aux_load named, in silence (session 23's outside testing).
+TEST_F(OutsideTesting, AColumnMappedElsewhereLeavesItsScaleBehind) {
+  std::ifstream in(kCamryUdds);
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::string> head;
+  std::stringstream hs(line);
+  for (std::string c; std::getline(hs, c, ',');) head.push_back(c);
+  auto col = [&](const std::string& name) { return static_cast<std::size_t>(std::find(head.begin(), head.end(), name) - head.begin()); };
+  const std::size_t t = col("Time[s]"), v = col("Dyno_Spd[mph]"), f = col("Eng_FuelFlow_Direct_DI[ccps]");
+  ASSERT_LT(f, head.size());
+  std::ostringstream out;
+  out << std::setprecision(10) << "t,v_kmh,fuel_lph\n";
+  while (std::getline(in, line)) {
+    std::vector<std::string> x;
+    std::stringstream ss(line);
+    for (std::string c; std::getline(ss, c, ',');) x.push_back(c);
+    out << x[t] << "," << std::stod(x[v]) * 1.609344 << "," << std::stod(x[f]) * 3.6 << "\n";
+  }
+  const std::string canonical = write("canonical.csv", out.str());
+  const std::string as_logged = "diagnose --vehicle camry_2018 --recording '" + kCamryUdds + "'";
+  const std::string remapped = "diagnose --vehicle camry_2018 --recording '" + canonical +
+                               "' --column time_s=t --column speed_kmh=v_kmh --column fuel_rate_lph=fuel_lph";
+  const CmdResult a = run_rollsim(as_logged), b = run_rollsim(remapped);
+  ASSERT_EQ(b.exit_code, 0) << b.err;
+  EXPECT_EQ(line_with(b.out, "uncalibrated trip energy error"), line_with(a.out, "uncalibrated trip energy error")) << b.out;
+  // A scale given with the new column still applies.
+  const CmdResult c = run_rollsim(remapped + " --scale fuel_rate_lph=0.5");
+  EXPECT_NE(line_with(c.out, "uncalibrated trip energy error"), line_with(a.out, "uncalibrated trip energy error")) << c.out;
 }
 
 // U3: a tab in the indentation gave yaml-cpp's "illegal map value" alone.

@@ -264,7 +264,14 @@ ColumnMapping assemble_mapping(const std::string& preset, YamlMap& vehicle_file,
 }
 
 ColumnMapping merge_mapping(ColumnMapping base, const ColumnMapping& overrides) {
-  for (const auto& [k, v] : overrides.source_for_canonical) base.source_for_canonical[k] = v;
+  for (const auto& [k, v] : overrides.source_for_canonical) {
+    // A scale is the unit of its source column: one mapped to another column leaves it behind (the Camry file's mph
+    // and cm3/s factors were applied to columns mapped to km/h and l/h, -41 % in silence: session 23's outside testing).
+    const auto was = base.source_for_canonical.find(k);
+    if (was != base.source_for_canonical.end() && was->second != v && !overrides.scale_for_canonical.count(k))
+      base.scale_for_canonical.erase(k);
+    base.source_for_canonical[k] = v;
+  }
   for (const auto& [k, v] : overrides.scale_for_canonical) base.scale_for_canonical[k] = v;
   if (!overrides.how_to_map.empty()) base.how_to_map = overrides.how_to_map;
   return base;

@@ -70,7 +70,8 @@ ColumnMapping column_mapping_from_yaml(YamlMap& file);
 /// Options given after a preset override its entries (merge with merge_mapping).
 ColumnMapping preset_mapping(const std::string& name);
 std::vector<std::string> preset_mapping_names();
-/// Entries of `overrides` replace those of `base`.
+/// Entries of `overrides` replace those of `base`; a column mapped to another source drops its scale from `base`
+/// (a scale is its source column's unit) unless `overrides` gives one.
 ColumnMapping merge_mapping(ColumnMapping base, const ColumnMapping& overrides);
 /// The mapping a diagnosis uses: the preset (if named), then the vehicle file's own logger blocks, then the
 /// `--column C=S` and `--scale C=F` options, each overriding the one before.
