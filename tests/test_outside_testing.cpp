@@ -970,6 +970,16 @@ TEST_F(OutsideTesting, AColumnMappedElsewhereLeavesItsScaleBehind) {
   EXPECT_NE(line_with(c.out, "uncalibrated trip energy error"), line_with(a.out, "uncalibrated trip energy error")) << c.out;
 }
 
+// regen_limit ("brake blending") was a candidate on the petrol Camry, named on 20 copies of its UDDS and listed among
+// its detection limits: a car braking by friction alone has no regeneration to limit (session 23's outside testing).
+TEST_F(OutsideTesting, RegenLimitIsNoCandidateOnACarWithoutRegeneration) {
+  const CmdResult camry = run_rollsim("diagnose --vehicle camry_2018 --recording '" + kCamryUdds + "'");
+  ASSERT_EQ(camry.exit_code, 0) << camry.err;
+  EXPECT_FALSE(has(camry.out, "regen_limit")) << camry.out;
+  const CmdResult twizy = run_rollsim("diagnose --vehicle twizy --preset rsk_twizy --recording '" + kTwizyTrip + "'");
+  EXPECT_TRUE(has(twizy.out, "regen_limit")) << twizy.out;
+}
+
 // U3: a tab in the indentation gave yaml-cpp's "illegal map value" alone.
 TEST_F(OutsideTesting, ATabIndentedYamlLineIsNamed) {
   const std::string tyre = write("tab.yaml", "size: \"185/65 R15 88H\"\npressure_bar: 2.5\nmodel:\n\tcoulomb_damping_n: 170\n");

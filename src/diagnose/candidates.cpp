@@ -64,7 +64,7 @@ class SignatureForce final : public Effect {
 // looked more like a fast tyre warm-up than like the one slow engine shape (and a cold-start test's 3-minute one
 // like a decaying constant power until the 15 kJ/K shape was added), and a 4 kW regen cap needed a friction
 // share above 1 at the one 10 kW limit, out of bounds, so a force-squared loss took its place.
-std::vector<EffectParameters> shapes_of(const EffectInfo& info, ChannelKind channel) {
+std::vector<EffectParameters> shapes_of(const EffectInfo& info, ChannelKind channel, bool regenerates) {
   if (info.id == EffectId::tyre_warmup)
     return {{{"heat_capacity_j_per_k", 20000.0}}, {{"heat_capacity_j_per_k", 50000.0}}, {{"heat_capacity_j_per_k", 120000.0}}};
   if (info.id == EffectId::engine_warmup) {
@@ -72,6 +72,9 @@ std::vector<EffectParameters> shapes_of(const EffectInfo& info, ChannelKind chan
     return {{{"heat_capacity_j_per_k", 15000.0}}, {{"heat_capacity_j_per_k", 40000.0}}, {{"heat_capacity_j_per_k", 100000.0}},
             {{"heat_capacity_j_per_k", 250000.0}}};
   }
+  // A car that brakes by friction alone has no regeneration to limit: on the Camry the shape, a wheel loss in hard
+  // braking, moved its engine's cut-off and was named "brake blending" (session 23's outside testing).
+  if (info.id == EffectId::regen_limit && !regenerates) return {};
   if (info.id == EffectId::regen_limit)
     return {{{"regen_limit_w", 3000.0}}, {{"regen_limit_w", 6000.0}}, {{"regen_limit_w", 12000.0}}};
   if (info.id == EffectId::road_profile) return {};  // inferred from the residual (road_profile.cpp), not one shape
@@ -247,7 +250,7 @@ Signatures compute_signatures(const Replayer& rp, const Observations& o, const V
       if (headings_known(rp.cycles)) add_bearing_candidates(info, ctx, extras, s.candidates);
       continue;
     }
-    for (const auto& shape : shapes_of(info, o.channel)) {
+    for (const auto& shape : shapes_of(info, o.channel, rp.vehicle.battery() != nullptr)) {
       Candidate c;
       c.id = info.id;
       c.shape = shape;
