@@ -156,7 +156,14 @@ TEST(DiagnoseReport, WritesFiguresAndAnHtmlPageEmbeddingThem) {
   const Diagnosis d = diagnose(v, {with_concealed_speed_force(v, repeated("wltc", 2, 1.0), 80.0, 300.0, 3)});
   const std::string dir = ::testing::TempDir() + "/diag_report_test/sub";
   fs::remove_all(dir);
+  // An earlier report's road profile (this one has none) goes; a user's own files stay (session 23's outside testing).
+  fs::create_directories(dir);
+  for (const char* name : {"road_profile.svg", "road_profile_2.svg", "my_road_profile.svg", "notes.txt"}) std::ofstream(fs::path(dir) / name) << "old";
   const auto files = write_diagnosis_report(dir, d, "test");
+  EXPECT_FALSE(fs::exists(fs::path(dir) / "road_profile.svg"));
+  EXPECT_FALSE(fs::exists(fs::path(dir) / "road_profile_2.svg"));
+  EXPECT_TRUE(fs::exists(fs::path(dir) / "my_road_profile.svg"));
+  EXPECT_TRUE(fs::exists(fs::path(dir) / "notes.txt"));
   const std::vector<std::string> svgs{"regimes.svg", "energy.svg", "cumulative.svg", "residual_speed.svg", "residual_accel.svg",
                                       "residual_time.svg"};
   for (const auto& s : svgs) {

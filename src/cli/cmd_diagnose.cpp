@@ -87,7 +87,11 @@ void run_diagnose(const DiagnoseCliOptions& o) {
     files.insert(files.end(), report.begin(), report.end());
   }
   write_files_atomically(files);
-  if (!o.report.empty()) std::cout << "report written to " << o.report << " (" << report_files << " files, report.html)\n";
+  if (!o.report.empty()) {
+    const auto stale = remove_stale_report_figures(o.report, files);
+    std::cout << "report written to " << o.report << " (" << report_files << " files, report.html"
+              << (stale.empty() ? "" : "; " + std::to_string(stale.size()) + " figure(s) of an earlier report removed") << ")\n";
+  }
   if (!o.write_vehicle.empty()) std::cout << "fitted vehicle written to " << o.write_vehicle << "\n";
 }
 

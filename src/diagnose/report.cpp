@@ -6,6 +6,8 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <set>
+#include <regex>
 #include <fstream>
 #include <sstream>
 
@@ -191,9 +193,24 @@ std::vector<OutputFile> render_diagnosis_report(const std::string& dir, const Di
   return files;
 }
 
+std::vector<std::string> remove_stale_report_figures(const std::string& dir, const std::vector<OutputFile>& written) {
+  std::set<fs::path> kept;
+  for (const auto& f : written) kept.insert(fs::path(f.path).lexically_normal());
+  static const std::regex figure(R"((energy|cumulative|regimes|residual_(speed|accel|time)|road_profile(_[0-9]+)?)\.svg)");
+  std::vector<std::string> removed;
+  std::error_code ec;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const fs::path p = it->path();
+    if (!std::regex_match(p.filename().string(), figure) || kept.count(p.lexically_normal()) || !it->is_regular_file(ec)) continue;
+    if (fs::remove(p, ec)) removed.push_back(p.string());
+  }
+  return removed;
+}
+
 std::vector<std::string> write_diagnosis_report(const std::string& dir, const Diagnosis& d, const std::string& title) {
   const auto files = render_diagnosis_report(dir, d, title);
   write_files_atomically(files);
+  remove_stale_report_figures(dir, files);
   std::vector<std::string> written;
   for (const auto& f : files) written.push_back(f.path);
   return written;

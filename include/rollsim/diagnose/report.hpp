@@ -17,6 +17,11 @@ void check_report_dir(const std::string& dir);
 /// with its other outputs, so that nothing is written when any of them fails.
 std::vector<OutputFile> render_diagnosis_report(const std::string& dir, const Diagnosis& d, const std::string& title);
 
+/// Removes from DIR the figures an earlier report left there that `written` does not hold again (a road_profile.svg
+/// stayed beside a report that had none: session 23's outside testing). Only the report's own figure names are
+/// touched (energy.svg, cumulative.svg, regimes.svg, residual_*.svg, road_profile*.svg); returns the paths removed.
+std::vector<std::string> remove_stale_report_figures(const std::string& dir, const std::vector<OutputFile>& written);
+
 /// One sentence for a reader: the verdict, the main finding with its leading parameter and share of the measured
 /// energy (and what it is confounded with), and how the held-out error per window changes with the fitted effects.
 std::string diagnosis_headline(const Diagnosis& d);
