@@ -334,6 +334,48 @@ TEST(Regress, DeliberatelyBrokenBaselineFailsNamingTheCase) {
   fs::remove(file);
 }
 
+// --update wrote the file anew in its own layout, dropping a user's comments, blank lines and key order, even when
+// nothing changed, and left it 644 whatever it had been (session 23's outside testing): values change in place now.
+TEST(Regress, UpdateChangesTheValuesInPlace) {
+  const auto file = temp_dir() / "commented_baseline.yaml";
+  const std::string text =
+      "# my own header\r\ncases:\r\n  # the EV\r\n  - name: ev-nominal-nedc\r\n    tolerance_pct: 0.5     # tight\r\n"
+      "    expected: 1.6         # set by hand\r\n    vehicle: ev\r\n    tyre: nominal\r\n    cycle: nedc\r\n    unit: kwh_per_10km\r\n\r\n"
+      "  - {name: flow, vehicle: ev, tyre: nominal, cycle: udds, unit: kwh_per_10km, expected: \"1.5\", tolerance_pct: 1}\r\n";
+  std::ofstream(file, std::ios::binary) << text;
+  fs::permissions(file, fs::perms::owner_read | fs::perms::owner_write, fs::perm_options::replace);
+  const CmdResult u = run("regress '" + file.string() + "' --update");
+  ASSERT_EQ(u.exit_code, 0) << u.err;
+  EXPECT_TRUE(u.err.empty()) << u.err;  // no "written anew" warning
+  const std::string after = slurp(file);
+  const std::regex value("expected: ([0-9.]+)         # set by hand\r\n[\\s\\S]*expected: \"([0-9.]+)\", tolerance_pct: 1\\}\r\n$");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(after, m, value)) << after;
+  EXPECT_NEAR(std::stod(m[1].str()), 1.644, 0.01);  // ev.yaml on NEDC (README: 1.644 kWh/10 km)
+  // Everything but the two values is the file as it was.
+  std::string restored = after;
+  restored.replace(static_cast<std::size_t>(m.position(2)), m.length(2), "1.5");
+  restored.replace(static_cast<std::size_t>(m.position(1)), m.length(1), "1.6");
+  EXPECT_EQ(restored, text);
+  EXPECT_EQ(fs::status(file).permissions(), fs::perms::owner_read | fs::perms::owner_write);
+  EXPECT_EQ(run("regress '" + file.string() + "'").exit_code, 0);
+  fs::remove(file);
+}
+
+// Names that cannot name a case in a message (empty, blank, a line break, bytes that are no UTF-8) are refused.
+TEST(Regress, ACaseNameMustBePrintableText) {
+  const auto file = temp_dir() / "names.yaml";
+  for (const std::string name : {"\"\"", "\"   \"", "\"a\\nb\"", "\"all fine'\\nerror: x\"", "x\xff" "y"}) {
+    std::ofstream(file, std::ios::binary) << "cases:\n  - name: " << name << "\n    vehicle: ev\n    tyre: nominal\n    cycle: nedc\n"
+                                             "    unit: kwh_per_10km\n    expected: 1.6\n    tolerance_pct: 1\n";
+    const CmdResult r = run("regress '" + file.string() + "'");
+    EXPECT_EQ(r.exit_code, 2) << name;
+    EXPECT_TRUE(has(r.err, "key 'cases[0].name'")) << name << ": " << r.err;
+    EXPECT_EQ(lines(r.err).size(), 1u) << r.err;
+  }
+  fs::remove(file);
+}
+
 TEST(Regress, MissingCycleIsAClearErrorNamingTheCase) {
   const auto file = temp_dir() / "missing_cycle.yaml";
   std::ofstream(file) << "cases:\n  - name: lost-cycle\n    vehicle: ev\n    tyre: nominal\n    cycle: no-such-cycle\n"

@@ -39,7 +39,11 @@ int run_regress(const RegressOptionsText& o) {
     if (!r.trace.followed) std::cout << "WARNING: case '" << r.c.name << "': " << report::shortfall_caveat(r.trace) << "\n";
   }
   if (o.update) {
-    write_files_atomically({{o.file, "--update", selection::baseline_yaml(b, outcomes)}});
+    bool rewritten = false;
+    write_files_atomically({{o.file, "--update", selection::baseline_yaml(b, outcomes, &rewritten)}});
+    if (rewritten)
+      std::cerr << "warning: " << o.file << ": a value was not where it was read, so the file was written anew in rollsim's "
+                << "layout: its comments and key order are not kept\n";
     std::size_t changed = 0;
     for (const auto& r : outcomes) {
       // Changed as the file records it: full-precision noise below its six digits is no change.

@@ -171,6 +171,10 @@ void write_files_atomically(const std::vector<OutputFile>& files) {
     created.insert(created.end(), missing.rbegin(), missing.rend());
     temporaries[i] = temporary_for(dest[i].path);
     put(files[i], temporaries[i], false);
+    // A file replaced keeps its permissions: a baseline kept at 600 came back 644, readable by all (session 23's
+    // outside testing). The temporary is the writer's own, so this cannot fail short of the folder vanishing.
+    const fs::file_status old = fs::status(dest[i].path, ec);
+    if (!ec && fs::is_regular_file(old)) fs::permissions(temporaries[i], old.permissions(), fs::perm_options::replace, ec);
   }
   // Devices and pipes last before the renames: a failure there still leaves no regular file written.
   for (std::size_t i = 0; i < files.size(); ++i)

@@ -1,15 +1,18 @@
 // The energy regression baseline: strict reading, forward runs of every case, and the rewritten file for --update.
 #include "rollsim/selection/regress.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <optional>
 #include <regex>
 #include <sstream>
 
 #include "rollsim/common/error.hpp"
 #include "rollsim/common/input_file.hpp"
 #include "rollsim/common/json.hpp"
+#include "rollsim/common/text.hpp"
 #include "rollsim/common/yaml_reader.hpp"
 #include "rollsim/cycle/drive_cycle.hpp"
 #include "rollsim/selection/common.hpp"
@@ -19,8 +22,9 @@
 namespace rollsim::selection {
 
 Baseline load_baseline(const std::string& path) {
-  YamlMap root = YamlMap::load_file(path);
   Baseline b;
+  b.text = read_input_file(path, kMaxYamlFileBytes);
+  YamlMap root = YamlMap::load_text(b.text, path);
   b.file = path;
   if (!root.has("cases") || !root.node()["cases"].IsSequence()) {
     throw InputError(root.where("cases"), "missing: a baseline needs a list 'cases' of {name, vehicle, tyre, cycle, "
@@ -38,6 +42,13 @@ Baseline load_baseline(const std::string& path) {
     YamlMap m(list[i], path, item + ".");
     RegressCase c;
     c.name = m.string("name");
+    // A case is named in every message about it: an empty or blank name read "case '' drifted", a line break in it
+    // forged a line of its own on stderr, and a byte that is no UTF-8 became U+FFFD on --update (session 23).
+    const bool blank = c.name.find_first_not_of(" \t") == std::string::npos;
+    const bool control = std::any_of(c.name.begin(), c.name.end(), [](char ch) { return static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f; });
+    if (blank || control || valid_utf8(c.name) != c.name)
+      throw InputError(m.where("name"), "'" + display_name(valid_utf8(c.name)) + "' is not allowed: a case's name must be UTF-8 text " +
+                                            "with something besides spaces and no control characters (line breaks, tabs)");
     c.vehicle = m.string("vehicle");
     c.tyre = m.string("tyre");
     c.cycle = m.string("cycle");
@@ -46,6 +57,8 @@ Baseline load_baseline(const std::string& path) {
       throw InputError(m.where("unit"), "'" + c.unit + "' is not allowed: must be kwh_per_10km or l_per_100km");
     }
     c.expected = m.number("expected", Range::positive());
+    c.expected_line = list[i]["expected"].Mark().line;
+    c.expected_column = list[i]["expected"].Mark().column;
     // --update writes `expected` to 6 significant digits (up to 0.0005 % off): a tolerance must hold that rounding.
     c.tolerance_pct = m.number("tolerance_pct", Range::closed(0.001, 100.0));
     m.finish();
@@ -107,7 +120,41 @@ std::string yaml_scalar(const std::string& text) {
 
 }  // namespace
 
-std::string baseline_yaml(const Baseline& b, const std::vector<RegressOutcome>& outcomes) {
+namespace {
+
+// The file's text with each case's expected value replaced where it was read; nullopt where one is not found there
+// as the number it read (a BOM or a multi-byte character before it on its line can move yaml-cpp's column).
+std::optional<std::string> updated_in_place(const Baseline& b, const std::vector<RegressOutcome>& outcomes) {
+  std::vector<std::string> lines;
+  std::size_t start = 0;
+  for (std::size_t nl; (nl = b.text.find('\n', start)) != std::string::npos; start = nl + 1) lines.push_back(b.text.substr(start, nl - start + 1));
+  if (start < b.text.size()) lines.push_back(b.text.substr(start));
+  static const std::regex number(R"((["']?)([-+]?[0-9.]+(?:[eE][-+]?[0-9]+)?)\1)");
+  for (std::size_t i = 0; i < b.cases.size() && i < outcomes.size(); ++i) {
+    const RegressCase& c = b.cases[i];
+    if (c.expected_line < 0 || c.expected_line >= static_cast<int>(lines.size())) return std::nullopt;
+    std::string& line = lines[static_cast<std::size_t>(c.expected_line)];
+    const auto col = static_cast<std::size_t>(std::max(0, c.expected_column));
+    if (col >= line.size()) return std::nullopt;
+    std::smatch m;
+    const std::string rest = line.substr(col);
+    if (!std::regex_search(rest, m, number, std::regex_constants::match_continuous)) return std::nullopt;
+    char* end = nullptr;
+    const std::string digits = m[2].str();
+    if (std::strtod(digits.c_str(), &end) != c.expected) return std::nullopt;
+    line = line.substr(0, col) + m[1].str() + baseline_value_text(outcomes[i].actual) + m[1].str() + rest.substr(static_cast<std::size_t>(m.length(0)));
+  }
+  std::string out;
+  for (const auto& l : lines) out += l;
+  return out;
+}
+
+}  // namespace
+
+std::string baseline_yaml(const Baseline& b, const std::vector<RegressOutcome>& outcomes, bool* rewritten) {
+  if (rewritten) *rewritten = false;
+  if (const auto in_place = updated_in_place(b, outcomes)) return *in_place;
+  if (rewritten) *rewritten = true;
   std::ostringstream y;
   y << "# Energy regression baseline for `rollsim regress` (forward simulation). Each case: the car, the tyre fitted\n"
        "# on all four wheels, the cycle, and the expected battery energy (kwh_per_10km) or fuel (l_per_100km).\n"

@@ -16,10 +16,13 @@ struct RegressCase {
   std::string unit;           ///< "kwh_per_10km" or "l_per_100km"
   double expected = 0.0;
   double tolerance_pct = 0.5;
+  int expected_line = -1;    ///< where `expected`'s value sits in the file (0-based), for an update in place
+  int expected_column = -1;
 };
 
 struct Baseline {
   std::string file;
+  std::string text;  ///< the file as read: --update changes its values in place, keeping comments and order
   std::vector<RegressCase> cases;
 };
 
@@ -38,8 +41,10 @@ struct RegressOutcome {
 /// InputError naming the file and the case.
 std::vector<RegressOutcome> run_baseline(const Baseline& baseline);
 
-/// The baseline text with every expected value replaced by the actual one (comments: how to regenerate).
-std::string baseline_yaml(const Baseline& baseline, const std::vector<RegressOutcome>& outcomes);
+/// The baseline text with every expected value replaced by the actual one: in place in the file's own text where
+/// each value is found where it was read (comments, order, quoting and line ends kept), else the whole file written
+/// anew in rollsim's layout, `rewritten` then set true.
+std::string baseline_yaml(const Baseline& baseline, const std::vector<RegressOutcome>& outcomes, bool* rewritten = nullptr);
 
 /// A baseline value as the file writes it (six significant digits): an update changes a case only when this does.
 std::string baseline_value_text(double value);
