@@ -325,6 +325,7 @@ py::list api_compare(py::object vehicle, py::object tyre_names, py::object cycle
     py::gil_scoped_release released;
     cmp = selection::compare_tyres(v, list.tyres, c, copt);
   }
+  for (const auto& d : cmp.duplicates) warn("left out " + d);
   for (const auto& w : selection::trace_warnings(cmp)) warn(w);
   py::list out;
   for (const auto& j : selection::comparison_json(cmp)) out.append(from_json(j.str()));

@@ -98,6 +98,28 @@ TEST(CliSelection, ACandidateWithoutAModelSolutionIsUnfitWithItsReasonAndNoFigur
   EXPECT_NE(last.find("\"fits\": false"), std::string::npos) << last;
 }
 
+// The car's own tyre file, or a file named twice, was ranked again beside itself (session 23's outside testing).
+TEST(CliSelection, CompareRanksEachTyreFileOnce) {
+  const CmdResult r = run("compare --vehicle ev --replay --json --tyre nominal --tyre low-rrc --tyre tyres/low-rrc.yaml --tyre 175-65R15");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(lines(r.out).size(), 3u) << r.out;  // own, low-rrc, 175-65R15
+  EXPECT_TRUE(has(r.err, "note: left out ")) << r.err;
+  EXPECT_TRUE(has(r.err, "nominal.yaml is the car's own tyre, ranked as (own)")) << r.err;
+  EXPECT_TRUE(has(r.err, "tyres/low-rrc.yaml is already a candidate")) << r.err;
+}
+
+// A check failed by less than its message's rounding read "load 3999 N > 3999 N capacity" and "+3.0 % from 610 mm
+// (tolerance 3 %)" (session 23's outside testing): the figures carry the decimals that tell them apart.
+TEST(CliSelection, AFailedFitCheckShowsItsFiguresApart) {
+  const auto dir = rollsim::test::temp_dir();
+  std::ofstream(dir / "light.yaml") << "name: light\nouter_radius_m: 0.305\nsection_width_m: 0.195\npressure_bar: 2.5\nmax_load_kg: 407.74\n";
+  std::ofstream(dir / "large.yaml") << "name: large\nsection_width_m: 0.195\npressure_bar: 2.5\nouter_diameter_mm: 628.31\nload_index: 91\n";
+  const CmdResult r = run("compare --vehicle ev --replay --tyre '" + (dir / "light.yaml").string() + "' --tyre '" + (dir / "large.yaml").string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(has(r.out, "does not fit: load 3998.7 N > 3998.6 N capacity at 2.5 bar")) << r.out;
+  EXPECT_TRUE(has(r.out, "does not fit: diameter 628.31 mm is +3.002 % from 610 mm (tolerance 3 %)")) << r.out;
+}
+
 TEST(CliSelection, CompareCsvCarriesTheJsonsFieldsOnEveryLine) {
   const std::string args = "compare --vehicle ev --tyre low-rrc --tyre 175-65R15 --tyre tyres/catalogue/205-55R16.yaml "
                            "--cycle nedc --replay --threads 1";

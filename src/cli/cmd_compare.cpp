@@ -124,6 +124,7 @@ void run_compare(const CompareOptionsText& o, const ProcessGroup& group) {
     for (const auto& cname : cycles) {
       const DriveCycle cycle = load_cycle_noted(cname, "--cycle");
       const auto cmp = selection::compare_tyres(v, candidates, cycle, copt);
+      for (const auto& d : cmp.duplicates) std::cerr << "note: left out " << d << "\n";
       if (o.json) print_json(cmp);
       else if (o.csv) print_csv(cmp, csv_header);
       else print_table(cmp, o.replay);

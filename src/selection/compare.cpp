@@ -3,8 +3,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <set>
 
 #include "rollsim/common/error.hpp"
+#include "rollsim/common/format.hpp"
 #include "rollsim/common/units.hpp"
 #include "rollsim/report/table.hpp"
 #include "rollsim/selection/common.hpp"
@@ -30,6 +33,13 @@ double load_capacity_at_pressure_n(const TyreSpec& tyre) {
   return ratio >= 1.0 ? tyre.max_load_n : tyre.max_load_n * std::pow(ratio, 0.585);
 }
 
+// Decimals enough, from `digits` up, to show `a` and `b` apart: "load 3999 N > 3999 N capacity" and "+3.0 % (tolerance
+// 3 %)" said a tyre failed a check its own figures passed (session 23's outside testing).
+int decimals_apart(double a, double b, int digits) {
+  while (digits < 6 && fixed(a, digits) == fixed(b, digits)) ++digits;
+  return digits;
+}
+
 FitCheck check_fit(const Vehicle& vehicle, const TyreSpec& own, const TyreSpec& candidate,
                    double diameter_tolerance_pct) {
   FitCheck f;
@@ -45,13 +55,15 @@ FitCheck check_fit(const Vehicle& vehicle, const TyreSpec& own, const TyreSpec& 
                                                "load range's pressure (C 350, D 450, E 550 kPa), which the size does not give"
                                              : "load capacity unknown (no load index or max load)");
   } else if (f.wheel_load_n > f.capacity_n) {
-    reasons.push_back("load " + fixed(f.wheel_load_n, 0) + " N > " + fixed(f.capacity_n, 0) +
+    const int d = decimals_apart(f.wheel_load_n, f.capacity_n, 0);
+    reasons.push_back("load " + fixed(f.wheel_load_n, d) + " N > " + fixed(f.capacity_n, d) +
                       " N capacity at " + fixed(units::pa_to_bar(candidate.state.pressure_pa), 1) + " bar");
   }
   // A change that is the tolerance to rounding (628.3 mm against 610 mm: 3.0000000000000027 %) is within it.
   if (std::abs(f.diameter_change_pct) > diameter_tolerance_pct * (1.0 + 1e-12)) {
-    reasons.push_back("diameter " + fixed(d_new * 1e3, 0) + " mm is " +
-                      (f.diameter_change_pct > 0 ? "+" : "") + fixed(f.diameter_change_pct, 1) + " % from " +
+    const int d = decimals_apart(std::abs(f.diameter_change_pct), diameter_tolerance_pct, 1);
+    reasons.push_back("diameter " + fixed(d_new * 1e3, d > 1 ? 2 : 0) + " mm is " +
+                      (f.diameter_change_pct > 0 ? "+" : "") + fixed(f.diameter_change_pct, d) + " % from " +
                       fixed(d_own * 1e3, 0) + " mm (tolerance " + format_value(diameter_tolerance_pct) + " %)");
   }
   f.fits = reasons.empty();
@@ -108,9 +120,16 @@ CandidateResult evaluated(const Vehicle& vehicle, const TyreSpec& own, const Tyr
   return c;
 }
 
+// The file a tyre came from, as one path whatever way it was named (shipped name, relative or absolute path).
+std::string same_file_key(const std::string& source) {
+  std::error_code ec;
+  const auto p = std::filesystem::weakly_canonical(source, ec);
+  return ec ? source : p.string();
+}
+
 }  // namespace
 
-Comparison compare_tyres(const Vehicle& vehicle, const std::vector<TyreSpec>& candidates, const DriveCycle& cycle,
+Comparison compare_tyres(const Vehicle& vehicle, const std::vector<TyreSpec>& given, const DriveCycle& cycle,
                          const CompareOptions& o) {
   if (!vehicle.front_tyre) {
     throw InputError(vehicle.source, "the car has no tyres of its own (coast-down road load): nothing to compare with");
@@ -119,6 +138,18 @@ Comparison compare_tyres(const Vehicle& vehicle, const std::vector<TyreSpec>& ca
   require_one_tyre_set(vehicle, "compare");
   const TyreSpec& own = *vehicle.front_tyre;
   Comparison cmp;
+  // The car's own tyre file, or one file named twice (by name and by path), was ranked again beside itself (session
+  // 23's outside testing): each file is a candidate once, and the own tyre is the "own" row.
+  std::vector<TyreSpec> candidates;
+  std::set<std::string> seen{same_file_key(own.source)};
+  for (const auto& t : given) {
+    if (t.source.empty() || t.source == "command line" || seen.insert(same_file_key(t.source)).second) {
+      candidates.push_back(t);
+      continue;
+    }
+    cmp.duplicates.push_back(t.source + (same_file_key(t.source) == same_file_key(own.source) ? " is the car's own tyre, ranked as (own)"
+                                                                                            : " is already a candidate"));
+  }
   cmp.vehicle = vehicle.name;
   cmp.cycle = cycle.name;
   cmp.unit = energy_unit(vehicle);

@@ -60,6 +60,8 @@ struct Comparison {
   double wheel_load_n = 0.0;  ///< the heavier axle's static wheel load, at which RRC and RR power are given
   std::vector<CandidateResult> ranked;
   std::vector<CandidateResult> unfit;
+  /// Candidates left out as the car's own tyre file or a file already among them (each said once, not ranked twice).
+  std::vector<std::string> duplicates;
 };
 
 struct CompareOptions {
