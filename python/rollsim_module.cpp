@@ -321,11 +321,13 @@ py::list api_compare(py::object vehicle, py::object tyre_names, py::object cycle
   const Vehicle v = vehicle_from(vehicle);
   const DriveCycle c = cycle_from(cycle);
   selection::Comparison cmp;
+  std::vector<std::string> left_out;
+  const std::vector<TyreSpec> candidates = selection::without_duplicate_files(v, list.tyres, left_out);
+  for (const auto& d : left_out) warn("left out " + d);
   {
     py::gil_scoped_release released;
-    cmp = selection::compare_tyres(v, list.tyres, c, copt);
+    cmp = selection::compare_tyres(v, candidates, c, copt);
   }
-  for (const auto& d : cmp.duplicates) warn("left out " + d);
   for (const auto& w : selection::trace_warnings(cmp)) warn(w);
   py::list out;
   for (const auto& j : selection::comparison_json(cmp)) out.append(from_json(j.str()));

@@ -123,8 +123,9 @@ void run_compare(const CompareOptionsText& o, const ProcessGroup& group) {
     const Vehicle v = load_vehicle_file(resolve_data_file(vname, "vehicles", ".yaml", "--vehicle"));
     for (const auto& cname : cycles) {
       const DriveCycle cycle = load_cycle_noted(cname, "--cycle");
-      const auto cmp = selection::compare_tyres(v, candidates, cycle, copt);
-      for (const auto& d : cmp.duplicates) std::cerr << "note: left out " << d << "\n";
+      std::vector<std::string> left_out;
+      const auto cmp = selection::compare_tyres(v, selection::without_duplicate_files(v, candidates, left_out), cycle, copt);
+      for (const auto& d : left_out) std::cerr << "note: left out " << d << "\n";
       if (o.json) print_json(cmp);
       else if (o.csv) print_csv(cmp, csv_header);
       else print_table(cmp, o.replay);

@@ -129,7 +129,23 @@ std::string same_file_key(const std::string& source) {
 
 }  // namespace
 
-Comparison compare_tyres(const Vehicle& vehicle, const std::vector<TyreSpec>& given, const DriveCycle& cycle,
+std::vector<TyreSpec> without_duplicate_files(const Vehicle& vehicle, const std::vector<TyreSpec>& candidates,
+                                              std::vector<std::string>& left_out) {
+  std::vector<TyreSpec> kept;
+  std::set<std::string> seen;
+  const std::string own = vehicle.front_tyre ? same_file_key(vehicle.front_tyre->source) : std::string();
+  if (!own.empty()) seen.insert(own);
+  for (const auto& t : candidates) {
+    if (t.source.empty() || t.source == "command line" || seen.insert(same_file_key(t.source)).second) {
+      kept.push_back(t);
+      continue;
+    }
+    left_out.push_back(t.source + (same_file_key(t.source) == own ? " is the car's own tyre, ranked as (own)" : " is already a candidate"));
+  }
+  return kept;
+}
+
+Comparison compare_tyres(const Vehicle& vehicle, const std::vector<TyreSpec>& candidates, const DriveCycle& cycle,
                          const CompareOptions& o) {
   if (!vehicle.front_tyre) {
     throw InputError(vehicle.source, "the car has no tyres of its own (coast-down road load): nothing to compare with");
@@ -138,18 +154,6 @@ Comparison compare_tyres(const Vehicle& vehicle, const std::vector<TyreSpec>& gi
   require_one_tyre_set(vehicle, "compare");
   const TyreSpec& own = *vehicle.front_tyre;
   Comparison cmp;
-  // The car's own tyre file, or one file named twice (by name and by path), was ranked again beside itself (session
-  // 23's outside testing): each file is a candidate once, and the own tyre is the "own" row.
-  std::vector<TyreSpec> candidates;
-  std::set<std::string> seen{same_file_key(own.source)};
-  for (const auto& t : given) {
-    if (t.source.empty() || t.source == "command line" || seen.insert(same_file_key(t.source)).second) {
-      candidates.push_back(t);
-      continue;
-    }
-    cmp.duplicates.push_back(t.source + (same_file_key(t.source) == same_file_key(own.source) ? " is the car's own tyre, ranked as (own)"
-                                                                                            : " is already a candidate"));
-  }
   cmp.vehicle = vehicle.name;
   cmp.cycle = cycle.name;
   cmp.unit = energy_unit(vehicle);

@@ -60,9 +60,13 @@ struct Comparison {
   double wheel_load_n = 0.0;  ///< the heavier axle's static wheel load, at which RRC and RR power are given
   std::vector<CandidateResult> ranked;
   std::vector<CandidateResult> unfit;
-  /// Candidates left out as the car's own tyre file or a file already among them (each said once, not ranked twice).
-  std::vector<std::string> duplicates;
 };
+
+/// The candidates read from files without the car's own tyre file and without a file already among them (named by
+/// name and by path, it was ranked twice: session 23's outside testing); each one left out is said in `left_out`.
+/// Candidates that are not files (built in memory) are all kept.
+std::vector<TyreSpec> without_duplicate_files(const Vehicle& vehicle, const std::vector<TyreSpec>& candidates,
+                                              std::vector<std::string>& left_out);
 
 struct CompareOptions {
   double diameter_tolerance_pct = 3.0;
