@@ -271,8 +271,7 @@ py::object api_tyre(py::object file, py::object size, py::object outer_radius_m,
     });
     points.push_back(from_json(tyre_point_json(spec, load.load_n, v_kmh, r).str()).cast<py::dict>());
   }
-  if (spec.max_load_n > 0.0 && load.load_n > spec.max_load_n)
-    warn("load " + fixed(load.load_n, 0) + " N is above the tyre's rated maximum " + fixed(spec.max_load_n, 0) + " N");
+  if (const std::string w = requested_load_warning(spec, load); !w.empty()) warn(w);
   if (speeds.ndim() == 0) return points.front();
   if (points.empty()) throw InputError("--speed-kmh", "an empty array: give at least one speed");
   return stack(points);

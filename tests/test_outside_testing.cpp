@@ -980,6 +980,34 @@ TEST_F(OutsideTesting, RegenLimitIsNoCandidateOnACarWithoutRegeneration) {
   EXPECT_TRUE(has(twizy.out, "regen_limit")) << twizy.out;
 }
 
+// Tyre inputs in another unit (session 23's outside testing): a load in kg ran silently at 8 % of the rating, a
+// diameter in metres was blamed on load_index, and a load index far from the designation's passed where the same
+// rating as max_load_kg is refused.
+TEST_F(OutsideTesting, TyreUnitSlipsAreNamedAtTheirOwnKey) {
+  CmdResult r = run_rollsim("tyre 175-70R14 --load-n 400");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(has(r.err, "warning: load 400 N is 8 % of the tyre's rated 4903 N; is it in kg? (400 kg = 3923 N)")) << r.err;
+  r = run_rollsim("tyre 175-70R14 --load-n 4903.33");
+  EXPECT_TRUE(has(r.err, "load 4903.33 N is above the tyre's rated maximum 4903.32 N")) << r.err;
+  EXPECT_TRUE(run_rollsim("tyre 175-70R14 --load-n 4000").err.empty());
+  struct Slip {
+    const char* file;
+    const char* message;
+  };
+  for (const Slip& s : {Slip{"outer_diameter_mm: 0.61\nsection_width_m: 0.195\n", "key 'outer_diameter_mm': 0.61 mm is not allowed: no road tyre "
+                                                                                  "measures that; must be in [300, 2500] mm; is it in m? (0.61 m = 610 mm)"},
+                        Slip{"outer_radius_m: 305\nsection_width_m: 0.195\n", "key 'outer_radius_m': 305 m is not allowed: no road tyre measures "
+                                                                              "that; must be in [0.15, 1.25] m; is it in mm? (305 mm = 0.305 m)"},
+                        Slip{"outer_radius_m: 0.305\nsection_width_m: 195\n", "key 'section_width_m': 195 m is not allowed"},
+                        Slip{"size: \"195/65 R15 91H\"\nload_index: 120\n", "key 'load_index': 120 (1400 kg) is not allowed for '195/65 R15 "
+                                                                          "91H', whose load index 91 rates it 615 kg"}}) {
+    const std::string t = write("slip.yaml", std::string("name: slip\npressure_bar: 2.1\n") + s.file);
+    expect_refused("tyre '" + t + "' --load-n 4000", s.message);
+  }
+  // A load index near the designation's is a rating of its own (reinforced, or a measured set).
+  EXPECT_EQ(run_rollsim("tyre '" + write("xl.yaml", "name: xl\npressure_bar: 2.5\nsize: \"195/65 R15 91H\"\nload_index: 95\n") + "'").exit_code, 0);
+}
+
 // U3: a tab in the indentation gave yaml-cpp's "illegal map value" alone.
 TEST_F(OutsideTesting, ATabIndentedYamlLineIsNamed) {
   const std::string tyre = write("tab.yaml", "size: \"185/65 R15 88H\"\npressure_bar: 2.5\nmodel:\n\tcoulomb_damping_n: 170\n");

@@ -113,11 +113,7 @@ void run_tyre(const TyreOptions& o) {
   }
 
   // Warned only once the point is known to be solvable, so a rejected load gets one message, not two.
-  if (spec.max_load_n > 0.0 && load.load_n > spec.max_load_n) {
-    std::cerr << "warning: load " << fixed(load.load_n, 0) << " N is above the tyre's rated maximum "
-              << fixed(spec.max_load_n, 0) << " N (" << kg_text(spec.max_load_n)
-              << "); results are outside the tyre's rating\n";
-  }
+  if (const std::string w = requested_load_warning(spec, load); !w.empty()) std::cerr << "warning: " << w << "\n";
 
   const double p_bar = units::pa_to_bar(spec.state.pressure_pa);
   if (o.json) {

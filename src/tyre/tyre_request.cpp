@@ -1,5 +1,7 @@
 #include "rollsim/tyre/tyre_request.hpp"
 
+#include "rollsim/common/format.hpp"
+
 #include "rollsim/common/units.hpp"
 #include "rollsim/common/yaml_reader.hpp"
 
@@ -68,6 +70,21 @@ TyreLoadChoice choose_requested_load(const TyreRequest& o, const TyreSpec& spec)
   }
   return {pct / 100.0 * spec.max_load_n,
           pct_given ? "--load-pct " + o.load_pct : "the default load (80 % of the maximum load)"};
+}
+
+std::string requested_load_warning(const TyreSpec& spec, const TyreLoadChoice& load) {
+  const double max_n = spec.max_load_n, n = load.load_n;
+  if (!(max_n > 0.0)) return "";
+  int d = 0;
+  while (d < 3 && fixed(n, d) == fixed(max_n, d)) ++d;
+  if (n > max_n)
+    return "load " + fixed(n, d) + " N is above the tyre's rated maximum " + fixed(max_n, d) + " N (" +
+           fixed(max_n / units::kStandardGravity_mps2, 0) + " kg); results are outside the tyre's rating";
+  constexpr double kLeastShare = 0.15;  // no car loads a tyre this lightly: an empty quadricycle's is ~25 %
+  if (n < kLeastShare * max_n && load.where.rfind("--load-n", 0) == 0)
+    return "load " + format_value(n) + " N is " + fixed(100.0 * n / max_n, 0) + " % of the tyre's rated " + fixed(max_n, 0) +
+           " N; is it in kg? (" + format_value(n) + " kg = " + fixed(n * units::kStandardGravity_mps2, 0) + " N)";
+  return "";
 }
 
 double parse_requested_speed_kmh(const std::string& text) {

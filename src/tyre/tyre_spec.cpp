@@ -268,6 +268,17 @@ void check_pressure_in(double value, double per_bar, const std::string& unit, co
 }
 }  // namespace
 
+namespace {
+// A road tyre's geometry, from a quadricycle's 12-inch wheel to a lorry's 22.5-inch one: a value outside was typed in
+// another unit (outer_diameter_mm: 0.61 was blamed on load_index, as "98745 % of its section height": session 23).
+void check_geometry_plausible(double value, double lo, double hi, const std::string& unit, std::initializer_list<UnitSlip> slips,
+                              const std::string& where) {
+  if (value >= lo && value <= hi) return;
+  throw InputError(where, format_value(value) + " " + unit + " is not allowed: no road tyre measures that; must be in [" +
+                              format_value(lo) + ", " + format_value(hi) + "] " + unit + unit_slip_hint(value, Range::closed(lo, hi), unit, slips));
+}
+}  // namespace
+
 void check_pressure_plausible(double bar, const std::optional<TyreSize>& size, const std::string& where) {
   check_pressure_in(bar, 1.0, "bar", "", {{"MPa", 10.0}, {"psi", kPaPerPsi / 1e5}, {"kPa", 0.01}, {"Pa", 1e-5}}, size, where);
 }
@@ -381,11 +392,12 @@ TyreSpec load_tyre(YamlMap y) {
   spec.reference = opt_string(y, "source").value_or("");
 
   const auto size_text = opt_string(y, "size");
-  const auto radius = opt_number(y, "outer_radius_m", Range::open_low(0.0, 1.5));
-  const auto width = opt_number(y, "section_width_m", Range::open_low(0.0, 1.0));
+  // Any positive number reaches the plausibility checks below, which name the unit a value may have been typed in.
+  const auto radius = opt_number(y, "outer_radius_m", Range::positive());
+  const auto width = opt_number(y, "section_width_m", Range::positive());
   const auto rim_in = opt_number(y, "rim_diameter_in", Range::open_low(0.0, 60.0));
   const auto rim_r = opt_number(y, "rim_radius_m", Range::non_negative());
-  const auto measured_d_mm = opt_number(y, "outer_diameter_mm", Range::open_low(0.0, 3000.0));
+  const auto measured_d_mm = opt_number(y, "outer_diameter_mm", Range::positive());
   auto& g = spec.state.geometry;
 
   if (size_text) {
@@ -414,6 +426,11 @@ TyreSpec load_tyre(YamlMap y) {
     if (rim_in) g.rim_radius_m = *rim_in * units::kMPerInch / 2.0;
     if (rim_r) g.rim_radius_m = *rim_r;
   }
+  constexpr double kMmPerIn = 25.4;
+  if (radius) check_geometry_plausible(*radius, 0.15, 1.25, "m", {{"mm", 1e-3}, {"cm", 1e-2}, {"inches", kMmPerIn * 1e-3}}, y.where("outer_radius_m"));
+  if (measured_d_mm)
+    check_geometry_plausible(*measured_d_mm, 300.0, 2500.0, "mm", {{"m", 1e3}, {"cm", 10.0}, {"inches", kMmPerIn}}, y.where("outer_diameter_mm"));
+  if (width) check_geometry_plausible(*width, 0.08, 0.5, "m", {{"mm", 1e-3}, {"cm", 1e-2}, {"inches", kMmPerIn * 1e-3}}, y.where("section_width_m"));
   if (measured_d_mm) g.outer_radius_m = *measured_d_mm * units::kMPerMm / 2.0;
   if (!(g.rim_radius_m < g.outer_radius_m)) {
     const std::string key = rim_in ? "rim_diameter_in" : rim_r ? "rim_radius_m" : "outer_diameter_mm";
@@ -443,6 +460,16 @@ TyreSpec load_tyre(YamlMap y) {
   }
 
   if (max_kg && spec.size && spec.size->load_index) check_rating_against_index(*max_kg, *spec.size, y.where("max_load_kg"));
+  // The same rating as a load index: 120 on a '195/65 R15 91H' (1400 kg against 615) ran at 1.8 times the tyre's real
+  // rating, where max_load_kg: 1400 is refused (session 23's outside testing).
+  if (li && spec.size && spec.size->load_index && static_cast<int>(*li) != *spec.size->load_index) {
+    const double kg = *load_index_max_load_kg(static_cast<int>(*li)), index_kg = *load_index_max_load_kg(*spec.size->load_index);
+    if (kg < index_kg / 1.5 || kg > index_kg * 1.5)
+      throw InputError(y.where("load_index"), format_value(*li) + " (" + format_value(kg) + " kg) is not allowed for '" + spec.size->designation +
+                                                  "', whose load index " + std::to_string(*spec.size->load_index) + " rates it " +
+                                                  format_value(index_kg) + " kg: an index must rate it within [" + significant(index_kg / 1.5, 4) +
+                                                  ", " + significant(index_kg * 1.5, 4) + "] kg");
+  }
   if (y.has("model") && y.node()["model"].IsScalar()) {
     spec.state.model = model_kind(y.string("model"), y.where("model"));
     if (spec.state.model == TyreModelKind::Hysteresis) {
