@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <sstream>
 
 #include "rollsim/common/units.hpp"
@@ -288,9 +289,15 @@ void write_trace_csv(std::ostream& out, const SimulationResult& r) {
   const std::vector<TraceColumn> columns = trace_columns(r);
   for (std::size_t c = 0; c < columns.size(); ++c) out << (c ? "," : "") << columns[c].name;
   out << '\n';
-  out.precision(8);
+  // Eight significant digits, time to the millisecond whatever its origin: a logger's epoch seconds (1.7e9) at 10 Hz
+  // read 7 distinct times in 6000 rows at eight digits (session 23's outside testing).
   for (std::size_t i = 0; i < r.trace.size(); ++i) {
-    for (std::size_t c = 0; c < columns.size(); ++c) out << (c ? "," : "") << columns[c].values[i];
+    for (std::size_t c = 0; c < columns.size(); ++c) {
+      out << (c ? "," : "");
+      const double x = columns[c].values[i];
+      if (columns[c].name == "time_s" && std::abs(x) >= 1e5) out << std::setprecision(static_cast<int>(std::floor(std::log10(std::abs(x)))) + 4) << x;
+      else out << std::setprecision(8) << x;
+    }
     out << '\n';
   }
 }
