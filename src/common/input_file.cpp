@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "rollsim/common/error.hpp"
+#include "rollsim/common/format.hpp"
 
 namespace rollsim {
 
@@ -51,8 +52,9 @@ std::string read_input_file(const std::string& path, std::uintmax_t max_bytes) {
   if (st.type() != fs::file_type::regular) throw InputError(path, "is not a regular file (a device, pipe or socket?)");
   const std::uintmax_t size = fs::file_size(path, ec);
   if (!ec && size > max_bytes) {
-    throw InputError(path, "is " + std::to_string(size >> 20) + " MiB; files of this kind are limited to " +
-                               std::to_string(max_bytes >> 20) + " MiB");
+    // In bytes beside MiB: 4.77 MiB read "is 4 MiB; ... limited to 4 MiB" (session 23's outside testing).
+    throw InputError(path, "is " + std::to_string(size) + " bytes (" + fixed(static_cast<double>(size) / (1 << 20), 2) +
+                               " MiB); files of this kind are limited to " + std::to_string(max_bytes >> 20) + " MiB");
   }
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, std::string("cannot be read: ") + std::strerror(errno));

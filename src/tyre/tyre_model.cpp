@@ -108,7 +108,7 @@ void check_operating_point(const TyreState& tyre, double load_n, double speed_mp
                            (rim_known ? "reaches the rim (sidewall height "
                                       : "is over a third of the outer radius, beyond any tyre's sidewall (no rim given; ") +
                            v(limit_m * 1e3) + " mm at stiffness " + v(kz) + " N/m); the model has no solution: " +
-                           "load must be below " + v(kz * limit_m) + " N at this pressure");
+                           "load must be below " + fixed(kz * limit_m, 2) + " N at this pressure");
   }
 }
 
