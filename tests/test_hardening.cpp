@@ -214,7 +214,7 @@ TEST_F(Hardening, OversizedRecordingIsRejectedEarly) {
   fs::resize_file(big, 300u << 20);  // sparse: no disk used
   CmdResult r = run_rollsim("diagnose --vehicle ev --recording '" + big + "'");
   EXPECT_EQ(r.exit_code, 2);
-  EXPECT_TRUE(has(r.err, big + ": is 300 MiB")) << r.err;
+  EXPECT_TRUE(has(r.err, big + ": is 314572800 bytes (300.00 MiB)")) << r.err;
 
   std::string rows = "time_s,speed_kmh,battery_power_kw\n";
   rows.reserve(20u << 20);
