@@ -306,9 +306,13 @@ py::dict api_simulate(py::object vehicle, py::object tyre, py::object cycle, py:
 }
 
 py::list api_compare(py::object vehicle, py::object tyre_names, py::object cycle, py::object catalogue,
-                 py::object diameter_tolerance_pct) {
+                 py::object diameter_tolerance_pct, py::object replay, py::object threads) {
   const auto tyres = arg_as<std::vector<std::string>>(tyre_names, "tyres", "a list of tyre files or shipped names (str)");
   selection::CompareOptions copt;
+  // The command line's --replay and --threads (session 22's notes: Python had neither).
+  copt.replay = flag(replay, "replay");
+  if (const std::string n = number_text(threads, "threads"); !n.empty())
+    copt.threads = static_cast<unsigned>(parse_option_count(n, "threads", Range::closed(1, 1024)));
   copt.diameter_tolerance_pct =
       selection::parse_diameter_tolerance_pct(number_text(diameter_tolerance_pct, "diameter_tolerance_pct"));
   const std::string folder = catalogue.is_none() ? "" : arg_as<std::string>(catalogue, "catalogue", "a folder path (str)");
@@ -334,7 +338,9 @@ py::list api_compare(py::object vehicle, py::object tyre_names, py::object cycle
 }
 
 py::list api_sweep(py::object tyre, py::object axes_arg, py::object load_n, py::object speed_kmh, py::object vehicle,
-               py::object cycle, py::object threads) {
+               py::object cycle, py::object threads, py::object replay_arg) {
+  const bool replay = flag(replay_arg, "replay");
+  if (replay && vehicle.is_none()) throw InputError("replay", "needs vehicle: a tyre alone is not simulated");
   const auto axes = arg_as<std::vector<py::sequence>>(axes_arg, "axes", "a list of (param, from, to[, steps])");
   selection::SweepRequest req;
   for (const auto& a : axes) {
@@ -347,7 +353,8 @@ py::list api_sweep(py::object tyre, py::object axes_arg, py::object load_n, py::
   req.load_n = number_text(load_n, "load_n");
   req.speed_kmh = number_text(speed_kmh, "speed_kmh");
   req.threads = number_text(threads, "threads");
-  const selection::SweepOptions so = selection::sweep_options_from_request(req);
+  selection::SweepOptions so = selection::sweep_options_from_request(req);
+  so.replay = replay;
   if (!cycle.is_none() && vehicle.is_none()) throw InputError("cycle", "needs vehicle: a tyre alone drives no cycle");
   const std::optional<TyreSpec> given = tyre_from(tyre);
   // None was dereferenced: the interpreter died (session 22's outside testing).
@@ -624,23 +631,25 @@ aec_kwh_per_10km or fuel_l_per_100km, energy_breakdown_kwh, ...), 'trace': dict 
 columns: time_s, speed_kmh, rolling_force_n, battery_power_kw, ...; empty with trace=False)}.)");
 
   m.def("compare", &api_compare, "vehicle"_a, "tyres"_a = py::list(), "cycle"_a = "nedc",
-        "catalogue"_a = py::none(), "diameter_tolerance_pct"_a = 3.0,
+        "catalogue"_a = py::none(), "diameter_tolerance_pct"_a = 3.0, "replay"_a = false, "threads"_a = py::none(),
         R"(Tyre selection (`rollsim compare --json`): the car on the cycle with each tyre on all four wheels.
 
 vehicle: file, shipped name or dict; tyres: files or shipped names; catalogue: a folder of tyre files (used when
-given, or when tyres is empty: the shipped tyres/catalogue); diameter_tolerance_pct [%]. Returns a list of dicts,
+given, or when tyres is empty: the shipped tyres/catalogue); diameter_tolerance_pct [%]; replay: kinematic replay
+instead of the forward simulation; threads (default every core). Returns a list of dicts,
 the fitting tyres ranked best first (rank 1..), then the unfit ones (rank None, with the reason). Broken catalogue
 files are skipped with a warning. followed_trace is False (with max_deficit_kmh [km/h] and a warning) where the car
 could not follow the cycle on that tyre: its figure is then for a slower drive.)");
 
   m.def("sweep", &api_sweep, "tyre"_a, "axes"_a, py::kw_only(), "load_n"_a = py::none(), "speed_kmh"_a = py::none(),
-        "vehicle"_a = py::none(), "cycle"_a = py::none(), "threads"_a = py::none(),
+        "vehicle"_a = py::none(), "cycle"_a = py::none(), "threads"_a = py::none(), "replay"_a = false,
         R"(A sweep of one or two tyre parameters (`rollsim sweep --json`).
 
 tyre: file, shipped name or dict. axes: [(param, from, to[, steps])], param one of pressure [bar], diameter [mm],
 width [mm], load [N], load-pct [%], speed [km/h]; steps default 11. load_n [N] (default 80 % of the maximum
 load), speed_kmh [km/h] (default 80; not with a speed axis). With vehicle (and cycle, default 'nedc'; a cycle without a vehicle is an error) each
-point is a forward simulation of the car (on `threads` threads, default every core). Returns a list of dicts, one
+point is a forward simulation of the car, or with replay=True its kinematic replay (on `threads` threads, default
+every core). Returns a list of dicts, one
 per point: the swept values (pressure_bar, diameter_mm, width_mm, load_n, load_pct, speed_kmh), the load_n and
 speed_kmh evaluated at when not swept, rrc,
 rr_force_n, rr_power_w, deflection_m, and the car's kwh_per_10km or l_per_100km with followed_trace (False, and a

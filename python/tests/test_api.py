@@ -156,6 +156,18 @@ class SelectionApi(unittest.TestCase):
         self.assertEqual(sum("could not follow" in str(w.message) for w in caught), len(rows))
         self.assertTrue(all(r["followed_trace"] for r in rollsim.compare("ev", tyres=["175-65R15"])))
 
+    def test_replay_and_threads_are_the_clis(self):
+        # Python had no replay on compare and sweep, nor threads on compare (session 22's notes).
+        expected, _, _ = cli("compare", "--vehicle", "ev", "--tyre", "low-rrc", "--replay", "--threads", "1", "--json")
+        self.assertEqual(rollsim.compare("ev", tyres=["low-rrc"], replay=True, threads=1), expected)
+        expected, _, _ = cli("sweep", "--tyre", "175-70R14", "--param", "pressure", "--from", "2", "--to", "3", "--steps", "3",
+                             "--vehicle", "ev", "--replay", "--json")
+        self.assertEqual(rollsim.sweep("175-70R14", [("pressure", 2, 3, 3)], vehicle="ev", replay=True), expected)
+        with self.assertRaises(rollsim.InputError):
+            rollsim.sweep("175-70R14", [("pressure", 2, 3, 3)], replay=True)
+        with self.assertRaises(rollsim.InputError):
+            rollsim.compare("ev", tyres=["low-rrc"], threads=0)
+
     def test_an_empty_catalogue_path_is_refused(self):
         # It compared the shipped catalogue, as None does (session 22's notes); so did the CLI's --catalogue "".
         with self.assertRaises(rollsim.InputError) as caught:
