@@ -1025,6 +1025,15 @@ TEST_F(OutsideTesting, ATraceKeepsTheMillisecondAtAnyTimeOrigin) {
   EXPECT_TRUE(times.count("1700000000.1")) << *times.begin();
 }
 
+// An engine_on column beside an electric car was ignored in silence (session 22's notes).
+TEST_F(OutsideTesting, AnEngineOnColumnBesideACarWithoutAnEngineIsSaid) {
+  const std::string cycle = write("eo.csv", "time_s,speed_kmh,engine_on\n0,0,0\n10,0,1\n20,30,1\n30,30,1\n40,0,1\n50,0,0\n60,0,0\n");
+  const CmdResult ev = run_rollsim("simulate --vehicle ev --cycle '" + cycle + "'");
+  EXPECT_EQ(ev.exit_code, 0) << ev.err;
+  EXPECT_TRUE(has(ev.err, "its engine_on column is not used: 'Mid-size electric car (platform study)' has no engine")) << ev.err;
+  EXPECT_FALSE(has(run_rollsim("simulate --vehicle ice --cycle '" + cycle + "'").err, "engine_on"));
+}
+
 // U3: a tab in the indentation gave yaml-cpp's "illegal map value" alone.
 TEST_F(OutsideTesting, ATabIndentedYamlLineIsNamed) {
   const std::string tyre = write("tab.yaml", "size: \"185/65 R15 88H\"\npressure_bar: 2.5\nmodel:\n\tcoulomb_damping_n: 170\n");

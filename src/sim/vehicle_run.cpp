@@ -20,6 +20,11 @@ VehicleRun run_vehicle(const Vehicle& base, const std::optional<TyreSpec>& tyre,
   }
   run.warnings = base.warnings;
   for (auto& w : check_tyre_loads(run.vehicle, tyre ? "--tyre '" + tyre->source + "'" : base.source)) run.warnings.push_back(w);
+  // The column switches an engine: a car without one runs its auxiliaries on as before, which was not said (session
+  // 22's notes).
+  if (cycle.any_engine_off() && !run.vehicle.fuel())
+    run.warnings.push_back(cycle.source + ": its engine_on column is not used: '" + run.vehicle.name + "' has no engine (the "
+                           "auxiliaries run throughout; accessories_on switches them)");
   const VehicleModel model = VehicleModel::assemble(run.vehicle);
   try {
     run.result = replay ? simulate_replay(model, cycle, options) : simulate_forward(model, cycle, options);
