@@ -125,9 +125,11 @@ PowerFlow ElectricPowertrain::deliver(double wheel_force_n, double speed_mps, in
     const double limiter = speed_limit_factor(motor_speed_radps);
     regen_force_n = std::min(regen_force_n, limiter * p_.motor.max_torque_nm * ratio / (wheel_radius_m * eta));
     if (v > 0.0) {
-      // Mechanical power reaching the motor is limited by the motor rating and by what the battery accepts.
-      const double max_shaft_w = std::min(p_.motor.max_power_w, rg.max_power_w);
-      regen_force_n = std::min(regen_force_n, limiter * max_shaft_w / (v * eta));
+      // Mechanical power reaching the motor is limited by the motor rating, derated near top speed as motoring is, and
+      // by what the battery accepts, which the machine's speed does not derate (the fade scaled both: at 146 km/h ev.yaml
+      // took 5.3 kW of a 15.4 kW braking demand where its 20 kW regen limit allows all: session 23's outside testing).
+      const double max_shaft_w = std::min(limiter * p_.motor.max_power_w, rg.max_power_w);
+      regen_force_n = std::min(regen_force_n, max_shaft_w / (v * eta));
     } else {
       regen_force_n = 0.0;
     }
