@@ -1060,6 +1060,37 @@ TEST_F(OutsideTesting, RegenNearTopSpeedIsLimitedByTheDeratedMachineNotADeratedR
   EXPECT_NEAR(at_10, -11.72, 0.06);
 }
 
+// Behind the trace after its top speed while the trace fell faster than the car, the driver's integral wound up, and
+// the Twizy then ran up to 6 km/h ahead of a level 70 km/h at full power (session 23's outside testing).
+TEST_F(OutsideTesting, TheDriverDoesNotRunAheadAfterFallingBehind) {
+  std::string text = "time_s,speed_kmh\n";
+  const std::vector<std::pair<double, double>> knots{{0, 0}, {20, 60}, {30, 120}, {45, 120}, {52, 70}, {80, 70}, {95, 0}, {100, 0}};
+  for (double t = 0.0; t <= 100.0; t += 0.25) {
+    std::size_t k = 1;
+    while (knots[k].first < t) ++k;
+    const auto [t0, v0] = knots[k - 1];
+    const auto [t1, v1] = knots[k];
+    text += std::to_string(t) + "," + std::to_string(v0 + (v1 - v0) * (t - t0) / (t1 - t0)) + "\n";
+  }
+  const std::string cycle = write("behind.csv", text), trace = (dir_ / "behind_trace.csv").string();
+  const CmdResult r = run_rollsim("simulate --vehicle twizy --cycle '" + cycle + "' --trace '" + trace + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(has(r.out, "could not follow the trace")) << r.out;  // it cannot reach 120 km/h
+  std::ifstream in(trace);
+  std::string line;
+  std::getline(in, line);
+  double lead_kmh = -1e9;
+  while (std::getline(in, line)) {
+    std::stringstream ss(line);
+    std::string t, target, speed;
+    std::getline(ss, t, ',');
+    std::getline(ss, target, ',');
+    std::getline(ss, speed, ',');
+    lead_kmh = std::max(lead_kmh, std::stod(speed) - std::stod(target));
+  }
+  EXPECT_LT(lead_kmh, 1.0);
+}
+
 // U3: a tab in the indentation gave yaml-cpp's "illegal map value" alone.
 TEST_F(OutsideTesting, ATabIndentedYamlLineIsNamed) {
   const std::string tyre = write("tab.yaml", "size: \"185/65 R15 88H\"\npressure_bar: 2.5\nmodel:\n\tcoulomb_damping_n: 170\n");
