@@ -178,7 +178,8 @@ ElectricPowertrainParams read_electric(YamlMap& pt, std::vector<std::string>& wa
     p.regen.min_speed_mps = units::kmh_to_mps(m.number_or("min_speed_kmh", 0.0, Range::closed(0.0, 100.0)));
     p.regen.fade_speed_mps = units::kmh_to_mps(m.number_or("fade_speed_kmh", units::mps_to_kmh(p.regen.min_speed_mps), Range::closed(0.0, 200.0)));
     if (p.regen.fade_speed_mps < p.regen.min_speed_mps)
-      throw InputError(m.where("fade_speed_kmh"), "must be >= min_speed_kmh");
+      throw InputError(m.where("fade_speed_kmh"), format_value(units::mps_to_kmh(p.regen.fade_speed_mps)) + " km/h must be >= min_speed_kmh " +
+                                                     format_value(units::mps_to_kmh(p.regen.min_speed_mps)) + " km/h");
     m.finish();
   }
   p.aux_power_w = read_aux_power_w(pt);
