@@ -1091,6 +1091,14 @@ TEST_F(OutsideTesting, TheDriverDoesNotRunAheadAfterFallingBehind) {
   EXPECT_LT(lead_kmh, 1.0);
 }
 
+// validate refused a --plot in a missing folder only after running the whole list (5-8 s, the results lost): the
+// figure's path is checked first now, before the list is even read (session 23's outside testing).
+TEST_F(OutsideTesting, ValidateChecksItsPlotPathBeforeTheList) {
+  expect_refused("validate --epa-test-car-list '" + (dir_ / "no_list.csv").string() + "' --plot /nonexistent-folder/x.svg",
+                 "--plot /nonexistent-folder/x.svg: cannot write here");
+  expect_refused("validate --epa-test-car-list '" + (dir_ / "no_list.csv").string() + "' --plot x.txt", "--plot x.txt: must end in .svg");
+}
+
 // U3: a tab in the indentation gave yaml-cpp's "illegal map value" alone.
 TEST_F(OutsideTesting, ATabIndentedYamlLineIsNamed) {
   const std::string tyre = write("tab.yaml", "size: \"185/65 R15 88H\"\npressure_bar: 2.5\nmodel:\n\tcoulomb_damping_n: 170\n");

@@ -113,8 +113,9 @@ std::string list_title(const validate::Validation& v) {
   return "EPA Test Car List " + *years.begin() + (years.size() > 1 ? "-" + *years.rbegin() : "");
 }
 
-// Predicted against measured, one series per powertrain, with the line of perfect agreement.
-void plot(const validate::Validation& v, const std::string& file) {
+// The figure's path and gnuplot, checked before the list is run (a missing folder was refused after the whole list,
+// its results lost: session 23's outside testing); returns gnuplot.
+std::string check_plot_target(const std::string& file) {
   namespace fs = std::filesystem;
   const std::string ext = fs::path(file).extension().string();
   if (ext != ".svg") throw InputError("--plot " + file, "must end in .svg");
@@ -124,6 +125,13 @@ void plot(const validate::Validation& v, const std::string& file) {
   const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
   std::error_code ec;
   if (!fs::is_directory(dir, ec) || access(dir.c_str(), W_OK) != 0) throw InputError("--plot " + file, "cannot write here (folder missing or not writable)");
+  return gnuplot;
+}
+
+// Predicted against measured, one series per powertrain, with the line of perfect agreement.
+void plot(const validate::Validation& v, const std::string& file) {
+  namespace fs = std::filesystem;
+  const std::string gnuplot = check_plot_target(file);
   const report::ScratchDir scratch("rollsim_validate_");
   const fs::path& work = scratch.path();
   // Each series' points, in the legend's (alphabetical) order; a file is named by its place in that order, so the
@@ -170,6 +178,7 @@ void run_validate(const ValidateOptionsText& o, const ProcessGroup& group) {
   if (o.list.empty()) throw InputError("--epa-test-car-list", "missing: give the EPA Test Car List CSV");
   unsigned threads = 0;
   if (!o.threads.empty()) threads = static_cast<unsigned>(parse_option_count(o.threads, "--threads", Range::closed(1, 1024)));
+  if (!o.plot.empty()) check_plot_target(o.plot);
   const auto rows = validate::read_epa_test_car_list(o.list);
   const auto v = validate::validate_epa_list(rows, threads, group.mapper());
   if (!o.plot.empty() && group.is_root()) plot(v, o.plot);

@@ -202,7 +202,13 @@ Observations build_windows(const Vehicle& vehicle, const std::vector<Recording>&
   o.window_s = window_s;
   cut_windows(o, recordings);
   const Eigen::Index n = o.n();
-  if (n < 8) throw InputError("--recording", "too short to diagnose: " + std::to_string(n) + " windows of " + num(window_s) + " s, need 8");
+  // Named by its files: the bench's --real-trace was blamed on a --recording it does not have (session 23).
+  if (n < 8) {
+    std::string files;
+    for (std::size_t k = 0; k < recordings.size() && k < 3; ++k) files += (k ? ", " : "") + recordings[k].source;
+    throw InputError(files + (recordings.size() > 3 ? ", ..." : ""),
+                     "too short to diagnose: " + std::to_string(n) + " windows of " + num(window_s) + " s, need 8");
+  }
   // Held-out folds: whole recordings when several are given (the honest test of a model), else alternating blocks.
   o.fold_of.resize(static_cast<std::size_t>(n));
   for (Eigen::Index w = 0; w < n; ++w)
