@@ -26,6 +26,12 @@ std::string printf_finite(double value, const char* format, int precision) {
 
 std::string fixed(double value, int decimals) { return printf_finite(value, "%.*f", decimals); }
 
+int decimals_apart(double a, double b, int least, int most) {
+  int d = least;
+  while (d < most && fixed(a, d) == fixed(b, d)) ++d;
+  return d;
+}
+
 std::string significant(double value, int digits) { return printf_finite(value, "%.*g", digits); }
 
 }  // namespace rollsim

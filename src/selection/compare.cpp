@@ -33,13 +33,6 @@ double load_capacity_at_pressure_n(const TyreSpec& tyre) {
   return ratio >= 1.0 ? tyre.max_load_n : tyre.max_load_n * std::pow(ratio, 0.585);
 }
 
-// Decimals enough, from `digits` up, to show `a` and `b` apart: "load 3999 N > 3999 N capacity" and "+3.0 % (tolerance
-// 3 %)" said a tyre failed a check its own figures passed (session 23's outside testing).
-int decimals_apart(double a, double b, int digits) {
-  while (digits < 6 && fixed(a, digits) == fixed(b, digits)) ++digits;
-  return digits;
-}
-
 FitCheck check_fit(const Vehicle& vehicle, const TyreSpec& own, const TyreSpec& candidate,
                    double diameter_tolerance_pct) {
   FitCheck f;
@@ -55,13 +48,14 @@ FitCheck check_fit(const Vehicle& vehicle, const TyreSpec& own, const TyreSpec& 
                                                "load range's pressure (C 350, D 450, E 550 kPa), which the size does not give"
                                              : "load capacity unknown (no load index or max load)");
   } else if (f.wheel_load_n > f.capacity_n) {
-    const int d = decimals_apart(f.wheel_load_n, f.capacity_n, 0);
+    // "load 3999 N > 3999 N capacity" and "+3.0 % (tolerance 3 %)" said a tyre failed a check its figures passed.
+    const int d = decimals_apart(f.wheel_load_n, f.capacity_n, 0, 6);
     reasons.push_back("load " + fixed(f.wheel_load_n, d) + " N > " + fixed(f.capacity_n, d) +
                       " N capacity at " + fixed(units::pa_to_bar(candidate.state.pressure_pa), 1) + " bar");
   }
   // A change that is the tolerance to rounding (628.3 mm against 610 mm: 3.0000000000000027 %) is within it.
   if (std::abs(f.diameter_change_pct) > diameter_tolerance_pct * (1.0 + 1e-12)) {
-    const int d = decimals_apart(std::abs(f.diameter_change_pct), diameter_tolerance_pct, 1);
+    const int d = decimals_apart(std::abs(f.diameter_change_pct), diameter_tolerance_pct, 1, 6);
     reasons.push_back("diameter " + fixed(d_new * 1e3, d > 1 ? 2 : 0) + " mm is " +
                       (f.diameter_change_pct > 0 ? "+" : "") + fixed(f.diameter_change_pct, d) + " % from " +
                       fixed(d_own * 1e3, 0) + " mm (tolerance " + format_value(diameter_tolerance_pct) + " %)");

@@ -75,8 +75,7 @@ TyreLoadChoice choose_requested_load(const TyreRequest& o, const TyreSpec& spec)
 std::string requested_load_warning(const TyreSpec& spec, const TyreLoadChoice& load) {
   const double max_n = spec.max_load_n, n = load.load_n;
   if (!(max_n > 0.0)) return "";
-  int d = 0;
-  while (d < 3 && fixed(n, d) == fixed(max_n, d)) ++d;
+  const int d = decimals_apart(n, max_n, 0, 3);
   if (n > max_n)
     return "load " + fixed(n, d) + " N is above the tyre's rated maximum " + fixed(max_n, d) + " N (" +
            fixed(max_n / units::kStandardGravity_mps2, 0) + " kg); results are outside the tyre's rating";
