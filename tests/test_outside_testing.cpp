@@ -856,6 +856,20 @@ TEST_F(OutsideTesting, OptionsThatWouldDoNothingAreRefused) {
 
 const std::string kTwizyTrip = std::string(ROLLSIM_SHARED_DIR) + "/data/recordings/rsk_renault_twizy/T1_07_01_2021.csv";
 
+// The comma-separated fields of one CSV line (the files these tests write and read quote nothing).
+std::vector<std::string> csv_fields(const std::string& line) {
+  std::vector<std::string> f;
+  std::stringstream ss(line);
+  for (std::string c; std::getline(ss, c, ',');) f.push_back(c);
+  return f;
+}
+
+// The column `name` of a CSV header line, or the header's size when absent.
+std::size_t csv_column(const std::string& header, const std::string& name) {
+  const auto head = csv_fields(header);
+  return static_cast<std::size_t>(std::find(head.begin(), head.end(), name) - head.begin());
+}
+
 std::string line_with(const std::string& text, const std::string& head) {
   std::istringstream in(text);
   for (std::string l; std::getline(in, l);)
@@ -890,9 +904,7 @@ TEST_F(OutsideTesting, GapsBetweenTripsAreNotDriving) {
   std::string second;
   std::istringstream in(body);
   for (std::string l; std::getline(in, l);) {
-    std::vector<std::string> f;
-    std::stringstream ss(l);
-    for (std::string c; std::getline(ss, c, ',');) f.push_back(c);
+    auto f = csv_fields(l);
     int h = 0, m = 0, sec = 0;
     ASSERT_EQ(std::sscanf(f[1].c_str(), "%d:%d:%d", &h, &m, &sec), 3) << f[1];
     const int t = h * 3600 + m * 60 + sec + 4 * 3600;  // the trip ends before 12:00: 4 h later it is the same day
@@ -945,18 +957,13 @@ TEST_F(OutsideTesting, AColumnMappedElsewhereLeavesItsScaleBehind) {
   std::ifstream in(kCamryUdds);
   std::string line;
   std::getline(in, line);
-  std::vector<std::string> head;
-  std::stringstream hs(line);
-  for (std::string c; std::getline(hs, c, ',');) head.push_back(c);
-  auto col = [&](const std::string& name) { return static_cast<std::size_t>(std::find(head.begin(), head.end(), name) - head.begin()); };
-  const std::size_t t = col("Time[s]"), v = col("Dyno_Spd[mph]"), f = col("Eng_FuelFlow_Direct_DI[ccps]");
-  ASSERT_LT(f, head.size());
+  const std::size_t t = csv_column(line, "Time[s]"), v = csv_column(line, "Dyno_Spd[mph]"),
+                    f = csv_column(line, "Eng_FuelFlow_Direct_DI[ccps]");
+  ASSERT_LT(f, csv_fields(line).size());
   std::ostringstream out;
   out << std::setprecision(10) << "t,v_kmh,fuel_lph\n";
   while (std::getline(in, line)) {
-    std::vector<std::string> x;
-    std::stringstream ss(line);
-    for (std::string c; std::getline(ss, c, ',');) x.push_back(c);
+    const auto x = csv_fields(line);
     out << x[t] << "," << std::stod(x[v]) * 1.609344 << "," << std::stod(x[f]) * 3.6 << "\n";
   }
   const std::string canonical = write("canonical.csv", out.str());
@@ -1045,16 +1052,11 @@ TEST_F(OutsideTesting, RegenNearTopSpeedIsLimitedByTheDeratedMachineNotADeratedR
   std::ifstream in(trace);
   std::string line;
   std::getline(in, line);
-  std::vector<std::string> head;
-  std::stringstream hs(line);
-  for (std::string c; std::getline(hs, c, ',');) head.push_back(c);
-  const auto col = static_cast<std::size_t>(std::find(head.begin(), head.end(), "battery_power_kw") - head.begin());
-  ASSERT_LT(col, head.size());
+  const std::size_t col = csv_column(line, "battery_power_kw");
+  ASSERT_LT(col, csv_fields(line).size());
   double at_10 = std::nan("");
   while (std::getline(in, line)) {
-    std::vector<std::string> f;
-    std::stringstream ss(line);
-    for (std::string c; std::getline(ss, c, ',');) f.push_back(c);
+    const auto f = csv_fields(line);
     if (f[0] == "10") at_10 = std::stod(f[col]);
   }
   EXPECT_NEAR(at_10, -11.72, 0.06);
@@ -1081,12 +1083,8 @@ TEST_F(OutsideTesting, TheDriverDoesNotRunAheadAfterFallingBehind) {
   std::getline(in, line);
   double lead_kmh = -1e9;
   while (std::getline(in, line)) {
-    std::stringstream ss(line);
-    std::string t, target, speed;
-    std::getline(ss, t, ',');
-    std::getline(ss, target, ',');
-    std::getline(ss, speed, ',');
-    lead_kmh = std::max(lead_kmh, std::stod(speed) - std::stod(target));
+    const auto f = csv_fields(line);  // time_s, target_speed_kmh, speed_kmh, ...
+    lead_kmh = std::max(lead_kmh, std::stod(f[2]) - std::stod(f[1]));
   }
   EXPECT_LT(lead_kmh, 1.0);
 }
