@@ -441,6 +441,13 @@ std::string unit_slip_hint(double v, Range fits, const std::string& unit, std::i
   return "";
 }
 
+void check_physical(double v, Range physical, const std::string& unit, const std::string& why,
+                    std::initializer_list<UnitSlip> slips, const std::string& where) {
+  if (physical.contains(v)) return;
+  throw InputError(where, format_value(v) + " " + unit + " is not allowed: " + why + "; " + physical.describe() + " " + unit +
+                              unit_slip_hint(v, physical, unit, slips));
+}
+
 double checked_number(double v, const std::string& where, Range range) {
   if (!range.contains(v)) throw InputError(where, format_value(v) + " is not allowed: " + range.describe_for(v));
   return v;

@@ -268,17 +268,6 @@ void check_pressure_in(double value, double per_bar, const std::string& unit, co
 }
 }  // namespace
 
-namespace {
-// A road tyre's geometry, from a quadricycle's 12-inch wheel to a lorry's 22.5-inch one: a value outside was typed in
-// another unit (outer_diameter_mm: 0.61 was blamed on load_index, as "98745 % of its section height": session 23).
-void check_geometry_plausible(double value, double lo, double hi, const std::string& unit, std::initializer_list<UnitSlip> slips,
-                              const std::string& where) {
-  if (value >= lo && value <= hi) return;
-  throw InputError(where, format_value(value) + " " + unit + " is not allowed: no road tyre measures that; must be in [" +
-                              format_value(lo) + ", " + format_value(hi) + "] " + unit + unit_slip_hint(value, Range::closed(lo, hi), unit, slips));
-}
-}  // namespace
-
 void check_pressure_plausible(double bar, const std::optional<TyreSize>& size, const std::string& where) {
   check_pressure_in(bar, 1.0, "bar", "", {{"MPa", 10.0}, {"psi", kPaPerPsi / 1e5}, {"kPa", 0.01}, {"Pa", 1e-5}}, size, where);
 }
@@ -426,11 +415,14 @@ TyreSpec load_tyre(YamlMap y) {
     if (rim_in) g.rim_radius_m = *rim_in * units::kMPerInch / 2.0;
     if (rim_r) g.rim_radius_m = *rim_r;
   }
+  // A road tyre's geometry, from a quadricycle's 12-inch wheel to a lorry's 22.5-inch one: a value outside was typed in
+  // another unit (outer_diameter_mm: 0.61 was blamed on load_index, as "98745 % of its section height": session 23).
   constexpr double kMmPerIn = 25.4;
-  if (radius) check_geometry_plausible(*radius, 0.15, 1.25, "m", {{"mm", 1e-3}, {"cm", 1e-2}, {"inches", kMmPerIn * 1e-3}}, y.where("outer_radius_m"));
+  const std::string no_tyre = "no road tyre measures that";
+  if (radius) check_physical(*radius, Range::closed(0.15, 1.25), "m", no_tyre, {{"mm", 1e-3}, {"cm", 1e-2}, {"inches", kMmPerIn * 1e-3}}, y.where("outer_radius_m"));
   if (measured_d_mm)
-    check_geometry_plausible(*measured_d_mm, 300.0, 2500.0, "mm", {{"m", 1e3}, {"cm", 10.0}, {"inches", kMmPerIn}}, y.where("outer_diameter_mm"));
-  if (width) check_geometry_plausible(*width, 0.08, 0.5, "m", {{"mm", 1e-3}, {"cm", 1e-2}, {"inches", kMmPerIn * 1e-3}}, y.where("section_width_m"));
+    check_physical(*measured_d_mm, Range::closed(300.0, 2500.0), "mm", no_tyre, {{"m", 1e3}, {"cm", 10.0}, {"inches", kMmPerIn}}, y.where("outer_diameter_mm"));
+  if (width) check_physical(*width, Range::closed(0.08, 0.5), "m", no_tyre, {{"mm", 1e-3}, {"cm", 1e-2}, {"inches", kMmPerIn * 1e-3}}, y.where("section_width_m"));
   if (measured_d_mm) g.outer_radius_m = *measured_d_mm * units::kMPerMm / 2.0;
   if (!(g.rim_radius_m < g.outer_radius_m)) {
     const std::string key = rim_in ? "rim_diameter_in" : rim_r ? "rim_radius_m" : "outer_diameter_mm";

@@ -43,7 +43,6 @@ EngineMapParams read_engine_block(YamlMap m) {
   e.idle_torque_reserve_nm = m.number_or("idle_torque_reserve_nm", 0.0, Range::closed(0.0, 100.0));
   e.inertia_kg_m2 = m.number_or("inertia_kg_m2", 0.0, Range::closed(0.0, 5.0));
   // With their values: "must exceed idle_speed_rpm" alone left the reader to look them up (session 23's outside testing).
-  auto rpm_text = [](double radps) { return format_value(std::round(radps / kRadpsPerRpm)); };
   if (e.rated_speed_radps <= e.idle_speed_radps)
     throw InputError(m.where("rated_speed_rpm"), rpm_text(e.rated_speed_radps) + " must exceed idle_speed_rpm " + rpm_text(e.idle_speed_radps));
   if (e.max_speed_radps < e.rated_speed_radps)
@@ -88,10 +87,7 @@ TransmissionParams read_transmission(YamlMap m, double max_torque_nm) {
   const double final_drive = m.number("final_drive_ratio", Range::closed(0.1, 30.0));
   if (t.kind == TransmissionKind::cvt && gears.size() != 2)
     throw InputError(m.where("ratios"), "a CVT gives exactly two ratios, its lowest gear and its overdrive");
-  for (std::size_t i = 1; i < gears.size(); ++i)
-    if (gears[i] >= gears[i - 1])
-      throw InputError(m.where("ratios"), "gear " + std::to_string(i + 1) + "'s " + format_value(gears[i]) + " is not below gear " +
-                                              std::to_string(i) + "'s " + format_value(gears[i - 1]) + ": must fall from first gear to top gear");
+  check_ratios_fall(gears, m.where("ratios"));
   for (double g : gears) t.ratios.push_back(g * final_drive);
   t.efficiency = m.number("efficiency", Range::efficiency());
   t.spin_loss_nm = m.number_or("spin_loss_nm", 0.0, Range::closed(0.0, 200.0));

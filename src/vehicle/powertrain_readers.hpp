@@ -12,6 +12,13 @@ FuelParams read_fuel(YamlMap m);
 /// `aux_power_w` of a powertrain block [W]: 0 (left out) or a road vehicle's electrical load, at least 10 W.
 double read_aux_power_w(YamlMap& pt);
 
+/// Refuses at `where` the first gear ratio that is not below the one before it, naming both (a swapped pair ran
+/// silently); one rule for the Willans gearbox and the engine map's transmission.
+void check_ratios_fall(const std::vector<double>& ratios, const std::string& where);
+
+/// An engine speed [rad/s] as an error message says it: whole rpm.
+std::string rpm_text(double radps);
+
 /// Refuses an engine whose `max_power_kw` (at `where`) cannot carry the accessories' shaft power, aux_power_w over the
 /// alternator's efficiency: the power left for the wheels would be negative.
 void check_engine_carries_accessories(double max_power_w, double aux_power_w, double alternator_efficiency, const std::string& where);

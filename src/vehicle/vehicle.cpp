@@ -29,9 +29,8 @@ TyreSpec load_tyre_named(const std::string& name, const YamlMap& m, const std::s
 // (rotating mass, the tyres' domain, the battery's power) would blame that key instead.
 double for_road_vehicle(const YamlMap& m, const std::string& key, double v, Range physical, const std::string& unit,
                         const std::string& why, std::initializer_list<UnitSlip> slips) {
-  if (physical.contains(v)) return v;
-  throw InputError(m.where(key), format_value(v) + " " + unit + " is not allowed: " + why + "; " + physical.describe() +
-                                     " " + unit + unit_slip_hint(v, physical, unit, slips));
+  check_physical(v, physical, unit, why, slips, m.where(key));
+  return v;
 }
 
 BodyParams read_body(YamlMap m) {
@@ -219,8 +218,7 @@ CombustionPowertrainParams read_combustion(YamlMap& pt, double driven_radius_m, 
     e.fuel_cut_min_speed_radps = m.number_or("fuel_cut_min_speed_rpm", 1.2 * e.idle_speed_radps / kRadPerSPerRpm,
                                              Range::closed(0.0, 1e5)) * kRadPerSPerRpm;
     if (e.max_speed_radps <= e.idle_speed_radps)
-      throw InputError(m.where("max_speed_rpm"), format_value(std::round(e.max_speed_radps / kRadPerSPerRpm)) + " must exceed idle_speed_rpm " +
-                                                     format_value(std::round(e.idle_speed_radps / kRadPerSPerRpm)));
+      throw InputError(m.where("max_speed_rpm"), rpm_text(e.max_speed_radps) + " must exceed idle_speed_rpm " + rpm_text(e.idle_speed_radps));
     m.finish();
   }
   {
@@ -228,11 +226,7 @@ CombustionPowertrainParams read_combustion(YamlMap& pt, double driven_radius_m, 
     auto& g = p.gearbox;
     g.ratios = m.numbers("ratios", Range::closed(0.1, 100.0));
     // As the engine-map reader refuses it: [3.73, 1.32, 2.05, ...] ran silently (session 22's outside testing).
-    for (std::size_t i = 1; i < g.ratios.size(); ++i) {
-      if (g.ratios[i] >= g.ratios[i - 1])
-        throw InputError(m.where("ratios"), "gear " + std::to_string(i + 1) + "'s " + format_value(g.ratios[i]) + " is not below gear " +
-                                                std::to_string(i) + "'s " + format_value(g.ratios[i - 1]) + ": must fall from first gear to top gear");
-    }
+    check_ratios_fall(g.ratios, m.where("ratios"));
     g.final_drive_ratio = m.number("final_drive_ratio", Range::closed(0.1, 100.0));
     g.efficiency = m.number("efficiency", Range::efficiency());
     const std::size_t shifts = g.ratios.size() - 1;
@@ -271,6 +265,16 @@ CombustionPowertrainParams read_combustion(YamlMap& pt, double driven_radius_m, 
 }
 
 }  // namespace
+
+void check_ratios_fall(const std::vector<double>& ratios, const std::string& where) {
+  for (std::size_t i = 1; i < ratios.size(); ++i) {
+    if (ratios[i] >= ratios[i - 1])
+      throw InputError(where, "gear " + std::to_string(i + 1) + "'s " + format_value(ratios[i]) + " is not below gear " + std::to_string(i) +
+                                  "'s " + format_value(ratios[i - 1]) + ": must fall from first gear to top gear");
+  }
+}
+
+std::string rpm_text(double radps) { return format_value(std::round(radps / kRadPerSPerRpm)); }
 
 // 0.2 kW against ice.yaml's 500 W of accessory shaft power left a negative force, -1e11 N near standstill, and CVODE
 // failed at the first launch (session 22's outside testing).

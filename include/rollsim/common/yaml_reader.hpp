@@ -44,6 +44,11 @@ struct UnitSlip {
 /// else "": the end of a message refusing `v` as implausible.
 std::string unit_slip_hint(double v, Range fits, const std::string& unit, std::initializer_list<UnitSlip> slips);
 
+/// Refuses at `where` a value outside what is `physical` for its kind: "V unit is not allowed: why; must be in
+/// [..] unit", with the unit it would fit in (unit_slip_hint). A vehicle's and a tyre's unit slips alike.
+void check_physical(double v, Range physical, const std::string& unit, const std::string& why,
+                    std::initializer_list<UnitSlip> slips, const std::string& where);
+
 /// A number given as text on the command line or by the Python API: parsed whole and checked against `range`;
 /// throws InputError naming `option`, the text or value, and what is allowed (strtod alone would accept "nan").
 double parse_option_number(const std::string& text, const std::string& option, Range range);
