@@ -184,13 +184,10 @@ Vehicle vehicle_from(py::handle v) {
   if (py::isinstance<py::dict>(v)) return load_vehicle_text(dict_json(v, "vehicle dict"), "vehicle dict");
   return load_vehicle_file(vehicle_path(v));
 }
-std::string tyre_path(py::handle t) {
-  return resolve_data_file(arg_as<std::string>(t, "tyre", kNameOrDict), "tyres", ".yaml", "--tyre");
-}
 std::optional<TyreSpec> tyre_from(py::handle t) {
   if (t.is_none()) return std::nullopt;
   if (py::isinstance<py::dict>(t)) return load_tyre_text(dict_json(t, "tyre dict"), "tyre dict");
-  return load_tyre_file(tyre_path(t));
+  return load_tyre_file(resolve_data_file(arg_as<std::string>(t, "tyre", kNameOrDict), "tyres", ".yaml", "--tyre"));
 }
 
 // A shipped name or CSV path; a dict of arrays named like the CSV columns (time_s, speed_kmh or speed_mps,
@@ -295,7 +292,7 @@ py::dict api_simulate(py::object vehicle, py::object tyre, py::object cycle, py:
   JsonObject summary = report::to_json(run.result, run.tyre_label);
   // As simulate --json: the files read, null for a dict, arrays or the vehicle's own tyres.
   report::add_input_files(summary, {py::isinstance<py::dict>(vehicle) ? "" : base.source,
-                                    tyre.is_none() || py::isinstance<py::dict>(tyre) ? "" : tyre_path(tyre),
+                                    tyre_set && !py::isinstance<py::dict>(tyre) ? tyre_set->source : "",
                                     py::isinstance<py::str>(fspath_or_self(cycle)) ? c.source : ""});
   out["summary"] = from_json(summary.str());
   py::dict columns;

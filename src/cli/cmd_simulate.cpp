@@ -43,13 +43,10 @@ void run_simulate(const SimulateOptions& o) {
   const Vehicle base = load_vehicle_file(resolve_data_file(o.vehicle, "vehicles", ".yaml", "--vehicle"));
   std::vector<std::string> inputs = vehicle_input_files(base);
   std::vector<std::optional<TyreSpec>> tyre_sets;
-  std::vector<std::string> tyre_files;
   for (const auto& t : o.tyres) {
     inputs.push_back(resolve_data_file(t, "tyres", ".yaml", "--tyre"));
-    tyre_files.push_back(inputs.back());
     tyre_sets.emplace_back(load_tyre_file(inputs.back()));
   }
-  if (tyre_files.empty()) tyre_files.emplace_back();
 
   if (tyre_sets.empty()) tyre_sets.emplace_back(std::nullopt);
   std::vector<DriveCycle> cycles;
@@ -63,8 +60,7 @@ void run_simulate(const SimulateOptions& o) {
   sim_opt.record_trace = !o.trace_path.empty();
   std::vector<Run> runs;
   for (const auto& cycle : cycles) {
-    for (std::size_t k = 0; k < tyre_sets.size(); ++k) {
-      const auto& tyre = tyre_sets[k];
+    for (const auto& tyre : tyre_sets) {
       VehicleRun run = run_vehicle(base, tyre, cycle, o.replay, sim_opt);
       // Once per tyre set (the first cycle): an overloaded tyre is allowed but said.
       if (&cycle == &cycles.front()) {
@@ -78,7 +74,7 @@ void run_simulate(const SimulateOptions& o) {
                   << fixed(v.coastdown->a_n, 1) << " N (" << fixed(100.0 * tyre_a_n / v.coastdown->a_n, 1)
                   << " %)\n";
       }
-      runs.push_back({run.tyre_label, std::move(run.result), tyre_files[k], cycle.source});
+      runs.push_back({run.tyre_label, std::move(run.result), tyre ? tyre->source : "", cycle.source});
     }
   }
 
