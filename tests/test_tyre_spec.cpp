@@ -225,7 +225,7 @@ TEST(TyreFile, BadFilesNameFileKeyValueAndWhatIsAllowed) {
   const Case cases[] = {
       {"misspelt", "size: \"175/70 R14 84T\"\npresure_bar: 2.1\n", "presure_bar"},
       {"nopressure", "size: \"175/70 R14 84T\"\n", "pressure_bar"},
-      {"zeropressure", "size: \"175/70 R14 84T\"\npressure_bar: 0\n", "must be > 0"},
+      {"zeropressure", "size: \"175/70 R14 84T\"\npressure_bar: 0\n", "must be in [1, 5] bar"},
       {"negpressure", "size: \"175/70 R14 84T\"\npressure_bar: -2\n", "-2"},
       {"nanpressure", "size: \"175/70 R14 84T\"\npressure_bar: .nan\n", "NaN"},
       {"badsize", "size: \"175/70 X14\"\npressure_bar: 2\n", "175/70 X14"},

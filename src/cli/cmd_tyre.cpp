@@ -1,4 +1,5 @@
 // `rollsim tyre`: one tyre at one load and one or more speeds, as a table, JSON lines, or an explanation.
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <iostream>
@@ -114,6 +115,9 @@ void run_tyre(const TyreOptions& o) {
 
   // Warned only once the point is known to be solvable, so a rejected load gets one message, not two.
   if (const std::string w = requested_load_warning(spec, load); !w.empty()) std::cerr << "warning: " << w << "\n";
+  const double top_kmh = *std::max_element(speeds_kmh.begin(), speeds_kmh.end());
+  if (const std::string w = speed_rating_warning(spec, units::kmh_to_mps(top_kmh), "--speed-kmh"); !w.empty())
+    std::cerr << "warning: " << w << "\n";
 
   const double p_bar = units::pa_to_bar(spec.state.pressure_pa);
   if (o.json) {

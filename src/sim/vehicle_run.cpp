@@ -1,5 +1,6 @@
 #include "rollsim/sim/vehicle_run.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace rollsim {
@@ -20,6 +21,13 @@ VehicleRun run_vehicle(const Vehicle& base, const std::optional<TyreSpec>& tyre,
   }
   run.warnings = base.warnings;
   for (auto& w : check_tyre_loads(run.vehicle, tyre ? "--tyre '" + tyre->source + "'" : base.source)) run.warnings.push_back(w);
+  if (run.vehicle.front_tyre && !cycle.speed_mps.empty()) {
+    const double top_mps = *std::max_element(cycle.speed_mps.begin(), cycle.speed_mps.end());
+    const bool same = run.vehicle.front_tyre->name == run.vehicle.rear_tyre->name;
+    for (const TyreSpec* t : {&*run.vehicle.front_tyre, same ? nullptr : &*run.vehicle.rear_tyre})
+      if (t)
+        if (std::string w = speed_rating_warning(*t, top_mps, cycle.name); !w.empty()) run.warnings.push_back(std::move(w));
+  }
   // The column switches an engine: a car without one runs its auxiliaries on as before, which was not said (session
   // 22's notes).
   if (cycle.any_engine_off() && !run.vehicle.fuel())

@@ -44,7 +44,7 @@ TyreSpec build_requested_tyre(const TyreRequest& o) {
     spec.state.geometry.section_width_m = parse_option_number(o.width_m, "--width-m", Range::open_low(0.0, 1.0));
   }
   if (!o.pressure_bar.empty()) {
-    const double bar = parse_option_number(o.pressure_bar, "--pressure-bar", Range::positive());  // units: below
+    const double bar = parse_option_number(o.pressure_bar, "--pressure-bar", Range::finite());  // range and units: below
     check_pressure_plausible(bar, spec.size, "--pressure-bar");
     spec.state.pressure_pa = units::bar_to_pa(bar);
   } else if (o.file.empty() && o.file_text.empty()) {

@@ -283,6 +283,27 @@ std::optional<double> load_index_max_load_kg(int load_index) {
   return kLoadIndexKg[static_cast<std::size_t>(load_index - kFirstLoadIndex)];
 }
 
+std::optional<double> speed_symbol_max_mps(const std::string& symbol) {
+  static const std::pair<const char*, double> kRatedKmh[] = {
+      {"A1", 5},  {"A2", 10}, {"A3", 15}, {"A4", 20},  {"A5", 25},  {"A6", 30},  {"A7", 35},  {"A8", 40},
+      {"B", 50},  {"C", 60},  {"D", 65},  {"E", 70},   {"F", 80},   {"G", 90},   {"J", 100},  {"K", 110},
+      {"L", 120}, {"M", 130}, {"N", 140}, {"P", 150},  {"Q", 160},  {"R", 170},  {"S", 180},  {"T", 190},
+      {"U", 200}, {"H", 210}, {"V", 240}, {"W", 270},  {"Y", 300}};
+  const std::string s = upper(symbol);
+  for (const auto& [name, kmh] : kRatedKmh)
+    if (s == name) return units::kmh_to_mps(kmh);
+  return std::nullopt;
+}
+
+std::string speed_rating_warning(const TyreSpec& tyre, double speed_mps, const std::string& what) {
+  if (!tyre.size || !tyre.size->speed_symbol) return "";
+  const auto rated_mps = speed_symbol_max_mps(*tyre.size->speed_symbol);
+  if (!rated_mps || speed_mps <= *rated_mps * (1.0 + 1e-9)) return "";
+  return what + " reaches " + fixed(units::mps_to_kmh(speed_mps), 1) + " km/h, above tyre '" + tyre.name + "''s speed rating " +
+         *tyre.size->speed_symbol + " (" + format_value(std::round(units::mps_to_kmh(*rated_mps))) +
+         " km/h): the model runs there, but the tyre is not built for it";
+}
+
 TyreSize parse_tyre_size(const std::string& designation, const std::string& where) {
   const std::string text = upper(designation);
   const std::string quoted = "'" + designation + "'";
@@ -432,7 +453,7 @@ TyreSpec load_tyre(YamlMap y) {
 
   // Any positive number reaches the plausibility check, which knows the tyre's class and the units a value may
   // have been typed in: 210 (kPa) met a bare "(0, 20]" before (session 20).
-  const double pressure_bar = y.number("pressure_bar", Range::positive());
+  const double pressure_bar = y.number("pressure_bar", Range::finite());  // the tyre class's range: below
   check_pressure_plausible(pressure_bar, spec.size, y.where("pressure_bar"));
   spec.state.pressure_pa = units::bar_to_pa(pressure_bar);
 

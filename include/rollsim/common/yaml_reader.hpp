@@ -19,6 +19,7 @@ struct Range {
   bool max_open = false;  ///< true: value must be strictly less than max
 
   static Range positive() { return {0.0, 1e300, true, false}; }
+  static Range finite() { return {-1e300, 1e300, false, false}; }  ///< for a check of its own that follows
   static Range non_negative() { return {0.0, 1e300, false, false}; }
   static Range fraction() { return {0.0, 1.0, false, false}; }            ///< [0, 1]
   static Range efficiency() { return {0.0, 1.0, true, false}; }          ///< (0, 1]

@@ -36,6 +36,10 @@ double iso28580_passenger_pressure_pa(const TyreSize& size);
 /// Maximum load [kg] of an ETRTO/ISO load index; std::nullopt outside the table (indices 60..125 at least).
 std::optional<double> load_index_max_load_kg(int load_index);
 
+/// The speed [m/s] a speed symbol rates the tyre for (ISO 4000-1 / ETRTO: Q 160 km/h, H 210, V 240, Y 300);
+/// std::nullopt for Z ("above 240 km/h", no upper figure) and for what is not a symbol.
+std::optional<double> speed_symbol_max_mps(const std::string& symbol);
+
 /// A tyre ready for the model: geometry, inflation, model constants, and what is known of its rating.
 struct TyreSpec {
   std::string name;                 ///< file stem or a label, for tables
@@ -46,6 +50,10 @@ struct TyreSpec {
   TyreState state;                  ///< geometry, pressure_pa, constants
   double max_load_n = 0.0;          ///< rated maximum load at reference pressure; 0 when unknown
 };
+
+/// A warning when `speed_mps` exceeds the tyre's speed rating, naming `what` runs that fast; empty otherwise (and for
+/// a tyre without a speed symbol). The model still runs there, but no tyre is built or tested for it.
+std::string speed_rating_warning(const TyreSpec& tyre, double speed_mps, const std::string& what);
 
 /// Refuses an inflation pressure [bar] outside what a road tyre of this kind runs at (passenger 1-5 bar, light
 /// truck 1-8, truck rims 1-10), naming `where` and the likely unit slip (MPa, psi). One rule for a tyre file's
