@@ -232,6 +232,34 @@ TEST(TyreFit, ChoosesOnlyWhatThePointsDetermine) {
   EXPECT_EQ(pressures.size(), 2u);  // level and deflection exponent; no speed or load information
 }
 
+// A dense sweep is as many conditions as it spans, however close its neighbours: grouped by each value's neighbour,
+// 180-300 kPa in 0.1 kPa steps chained into one pressure and the deflection exponent was held at the shared 0.54
+// (2.98 % RMS against a truth of 0.8; session 24's outside testing). Likewise loads in 2 N steps.
+TEST(TyreFit, ADenseSweepIsManyConditionsAndFreesItsExponent) {
+  TyreState truth = hysteresis_tyre();
+  truth.hysteresis.deflection_exponent = 0.8, truth.hysteresis.load_exponent = -0.3;
+  FitRequest pressures, loads;
+  for (int k = 0; k <= 1200; ++k) {
+    TyreState at = truth;
+    at.pressure_pa = 180e3 + 100.0 * k;
+    pressures.points.push_back({at.pressure_pa, 4000.0, 80 / 3.6, evaluate_rolling_resistance(at, 4000.0, 80 / 3.6).rrc, "p"});
+  }
+  for (int k = 0; k <= 1500; ++k) {
+    const double z = 3000.0 + 2.0 * k;
+    loads.points.push_back({truth.pressure_pa, z, 80 / 3.6, evaluate_rolling_resistance(truth, z, 80 / 3.6).rrc, "z"});
+  }
+  EXPECT_GE(identifiable_params(pressures.points).size(), 2u);
+  TyreState start = truth;
+  start.hysteresis = HysteresisConstants{};
+  const TyreFit fp = fit_hysteresis(start, pressures);
+  EXPECT_LT(fp.rms_relative_error, 1e-6);
+  // A load sweep alone tells the load and deflection exponents' sum, not each (both scale with the load).
+  EXPECT_LT(fit_hysteresis(start, loads).rms_relative_error, 1e-6);
+  // Neighbours within 0.1 % of a group's first value are still one condition (a repeated measurement).
+  auto pt = [](double kpa) { return RrcPoint{kpa * 1e3, 4000.0, 80 / 3.6, 0.009, "p"}; };
+  EXPECT_EQ(identifiable_params({pt(210.0), pt(210.1), pt(210.2)}).size(), 1u);
+}
+
 // Points that have RRC rise with pressure contradict the model's law (loss grows with deflection) and every measured
 // set: the deflection exponent is held at its bound 0 and the contradiction stays in the residuals, as a negative
 // frequency slope does. Before session 13 two such points wrote a tyre with a deflection exponent of -2.9.
