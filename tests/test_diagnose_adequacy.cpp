@@ -60,18 +60,25 @@ class RisingRrc final : public Effect {
 // WLTC twice at 10 Hz; the truth replayed there; the recording at `hz`, its power the truth's `lag_s` earlier (the
 // 10 Hz trace read at a shifted sample: no interpolation shared with the diagnosis), times `scale`, plus white noise.
 // `instantaneous`: a logger that reads the power at the sample's instant instead of integrating over its interval.
+// `smooth`: the truth's speed a Catmull-Rom cubic through the cycle's points (a car's speed has no corners; the
+// logged samples are the same), so its acceleration is continuous, not held per second.
 Recording recording(const Vehicle& v, std::shared_ptr<const Effect> truth, double hz, double lag_s, double scale, unsigned seed,
-                    bool instantaneous = false) {
+                    bool instantaneous = false, bool smooth = false) {
   const DriveCycle one = load_cycle("wltc");
   DriveCycle c;
   c.name = "wltc x2 at 10 Hz";
   const double period = one.time_s.back() - one.time_s.front() + 1.0;
+  const std::size_t n = one.time_s.size();
   for (int rep = 0; rep < 2; ++rep)
-    for (std::size_t i = 0; i + 1 < one.time_s.size(); ++i)
+    for (std::size_t i = 0; i + 1 < n; ++i)
       for (int k = 0; k < 10; ++k) {
         const double f = k / 10.0;
         c.time_s.push_back(rep * period + one.time_s[i] + f * (one.time_s[i + 1] - one.time_s[i]));
-        c.speed_mps.push_back((1.0 - f) * one.speed_mps[i] + f * one.speed_mps[i + 1]);
+        const double v0 = one.speed_mps[i > 0 ? i - 1 : i], v1 = one.speed_mps[i], v2 = one.speed_mps[i + 1],
+                     v3 = one.speed_mps[i + 2 < n ? i + 2 : i + 1];
+        const double cubic = 0.5 * (2.0 * v1 + (v2 - v0) * f + (2.0 * v0 - 5.0 * v1 + 4.0 * v2 - v3) * f * f +
+                                    (3.0 * v1 - v0 - 3.0 * v2 + v3) * f * f * f);
+        c.speed_mps.push_back(smooth ? std::max(0.0, cubic) : (1.0 - f) * v1 + f * v2);
         c.grade.push_back(0.0);
       }
   VehicleModel m = VehicleModel::assemble(v);
@@ -214,6 +221,34 @@ TEST(DiagnoseAdequacy, AnInstantaneousLoggerIsReadAsOne) {
   EXPECT_EQ(d.verdict, "nothing_missing") << diagnosis_text(d);
   // And an integrating logger is read as the interval means it holds.
   EXPECT_EQ(run(v, recording(v, nullptr, 1.0, 0.0, 1.0, 8), 60.0).channel_sampling, "interval_mean");
+}
+
+TEST(DiagnoseAdequacy, ASmoothlyDrivenCarLoggedEitherWayThroughAScaleErrorIsNothingMissing) {
+  // A real car's acceleration has no corners. Its instants then sit close to interval means half a sample later, so
+  // either reading may fit (the replay holds each second's acceleration); what must hold is the verdict, through a
+  // 3 % scale error and a fractional lag, whichever the logger is.
+  const Vehicle v = ev();
+  for (double lag_s : {0.0, 0.4})
+    for (bool instantaneous : {true, false}) {
+      const Diagnosis d = run(v, recording(v, nullptr, 1.0, lag_s, 1.03, 9, instantaneous, true), 60.0);
+      EXPECT_EQ(d.verdict, "nothing_missing") << lag_s << (instantaneous ? " s, instants\n" : " s, means\n") << diagnosis_text(d);
+      EXPECT_NEAR(d.channel_scale, 1.03, 0.01) << diagnosis_text(d);
+    }
+}
+
+TEST(DiagnoseAdequacy, TheSamplingIsReadAlikeThroughAChannelScaleError) {
+  // A logger 3 % off in scale adds the same misfit to both readings and had hidden the instant's better fit: a 1 Hz
+  // instantaneous logger 3 % high was read as interval means and its ramps' residual named (session 23's outside
+  // testing). The choice is made with each reading's own best scale.
+  const Vehicle v = ev();
+  for (double scale : {0.97, 1.03}) {
+    const Diagnosis point = run(v, recording(v, nullptr, 1.0, 0.0, scale, 8, true), 60.0);
+    EXPECT_EQ(point.channel_sampling, "instantaneous") << scale << "\n" << diagnosis_text(point);
+    EXPECT_EQ(point.verdict, "nothing_missing") << scale << "\n" << diagnosis_text(point);
+    const Diagnosis mean = run(v, recording(v, nullptr, 1.0, 0.0, scale, 8), 60.0);
+    EXPECT_EQ(mean.channel_sampling, "interval_mean") << scale << "\n" << diagnosis_text(mean);
+    EXPECT_EQ(mean.verdict, "nothing_missing") << scale << "\n" << diagnosis_text(mean);
+  }
 }
 
 TEST(DiagnoseAdequacy, CalibrationPriorsAreReadFromTheVehicleFileStrictly) {

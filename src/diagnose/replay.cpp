@@ -32,7 +32,9 @@ double sim_end_power_w(const TracePoint& t, bool electric, double fuel_j_per_m3,
 // lagged interval overlaps two samples' intervals, so linear between samples is exact. Instants (`end` given): the
 // instant lies a fraction f into segment k, so between its start and its end at its own acceleration; linear between
 // two samples' point values mixed the next segment's acceleration in, and on a 1 Hz instantaneous logger with a
-// fractional lag that residual named effects on nulls (13 of 20 on session 20's outside check).
+// fractional lag that residual named effects on nulls (13 of 20 on session 20's outside check). Linear from start to
+// end misses a kink inside the segment (the regen fade or the motor's limit crossed within a second), which a mean
+// integrates but an instant may fall on: session 24's outside check of Twizy copies with speed glitches of 10 m/s^2.
 double shifted(const std::vector<double>& p, const std::vector<double>* end, std::size_t i, double lag) {
   const double pos = static_cast<double>(i) - lag;
   if (pos <= 0.0) return p.front();
@@ -55,6 +57,20 @@ double lag_sse(const std::vector<std::vector<double>>& sim_w, const std::vector<
       sse += e * e;
     }
   return sse;
+}
+
+// The residual left when the measured channel is fitted as s x sim, s least squares within [1 - bound, 1 + bound]
+// (the calibration's box), over the samples lag_sse uses.
+double scaled_sse(const std::vector<std::vector<double>>& sim_w, const std::vector<std::vector<double>>* end_w,
+                  const Observations& o, double lag, std::size_t first, double scale_bound) {
+  double mm = 0.0, mp = 0.0, pp = 0.0;
+  for (std::size_t ri = 0; ri < sim_w.size(); ++ri)
+    for (std::size_t i = first; i < sim_w[ri].size(); ++i) {
+      const double p = shifted(sim_w[ri], ends_of(end_w, ri), i, lag), m = o.measured_w[ri][i];
+      mm += m * m, mp += m * p, pp += p * p;
+    }
+  const double s = pp > 0.0 ? std::clamp(mp / pp, 1.0 - scale_bound, 1.0 + scale_bound) : 1.0;
+  return std::max(0.0, mm - 2.0 * s * mp + s * s * pp);
 }
 
 struct ChannelReading {
@@ -151,7 +167,7 @@ Eigen::VectorXd window_energies(const Variant& v, const Observations& o, double 
 // Whole samples first, then 0.05-sample steps about the best; the interval is where the per-sample criterion
 // n_eff ln(SSE / SSE_min) stays under 3.84, n_eff from the residual's lag-1 autocorrelation (AR(1)).
 LagEstimate estimate_lag(const std::vector<std::vector<double>>& sim_w, const Observations& o,
-                         const std::vector<std::vector<double>>* end_w) {
+                         const std::vector<std::vector<double>>* end_w, double scale_bound) {
   LagEstimate l;
   if (o.channel == ChannelKind::soc) return l;
   l.estimated = true;
@@ -174,6 +190,7 @@ LagEstimate estimate_lag(const std::vector<std::vector<double>>& sim_w, const Ob
   const std::size_t k = static_cast<std::size_t>(std::min_element(sse.begin(), sse.end()) - sse.begin());
   l.samples = grid[k];
   l.sse_w2 = sse[k];
+  l.scaled_sse_w2 = scaled_sse(sim_w, end_w, o, l.samples, static_cast<std::size_t>(max_lag), scale_bound);
   // The residual's autocorrelation at the best lag sets how much independent information the samples carry.
   double num = 0.0, den = 0.0, count = 0.0;
   for (std::size_t ri = 0; ri < sim_w.size(); ++ri) {
