@@ -663,6 +663,29 @@ TEST(TyreLabel, Iso28580ConditionsFollowTheLoadIndexAndLoadVersion) {
   EXPECT_THROW(iso28580_point(parse_tyre_size("205/55 R16", "s"), 0.008, "w"), InputError);
 }
 
+// Van and truck sizes (EU classes C2 and C3) are marked by a dual load index, a "C" after the rim or a truck rim, not
+// only by "LT": their ISO 28580 point is not a passenger tyre's, so a label or test-report point is refused as for LT.
+// A truck tyre had been placed at 210 kPa and 24.7 kN with the C1 bands (session 24's outside testing).
+TEST(TyreLabel, VanAndTruckSizesAreNotGivenThePassengerPoint) {
+  for (const char* size : {"275/70 R22.5 148/145M", "195/75 R16 107/105R", "215/65 R16C 109/107T", "245/70 R19.5 136M",
+                           "LT245/75 R16 120/116S"}) {
+    const TyreSize s = parse_tyre_size(size, "s");
+    EXPECT_TRUE(s.commercial) << size;
+    try {
+      iso28580_point(s, 0.006, "--label B");
+      ADD_FAILURE() << size << " given a passenger point";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("EU class C2 or C3"), std::string::npos) << e.what();
+    }
+  }
+  // "R16C" is the van marker, not a second speed symbol; its own speed symbol and load index are still read.
+  const TyreSize van = parse_tyre_size("215/65 R16C 109/107T", "s");
+  EXPECT_EQ(van.load_index, 109);
+  EXPECT_EQ(van.speed_symbol, "T");
+  for (const char* size : {"205/55 R16 91V", "205/55 R16 94V XL", "175/65 R14 82T"})
+    EXPECT_FALSE(parse_tyre_size(size, "s").commercial) << size;
+}
+
 // --- the command ---
 
 TEST(CliTyreFit, OnePointFileIsANormalTyreFileThatReproducesThePoint) {

@@ -21,9 +21,10 @@ double reference_pressure_pa(const TyreSpec& tyre) {
 }
 
 namespace {
-// A light-truck tyre's load index holds at its load range's inflation (TRA: C 350, D 450, E 550 kPa), which the size
-// designation does not carry; the passenger reference overstated its capacity at car pressures by ~60 % (session 20).
-bool light_truck(const TyreSpec& tyre) { return tyre.size && tyre.size->prefix == SizePrefix::light_truck; }
+// A light-truck (or van or truck) tyre's load index holds at its load range's inflation (TRA: C 350, D 450, E 550 kPa),
+// which the size designation does not carry; the passenger reference overstated its capacity at car pressures by ~60 %
+// (session 20).
+bool light_truck(const TyreSpec& tyre) { return tyre.size && tyre.size->commercial; }
 }  // namespace
 
 double load_capacity_at_pressure_n(const TyreSpec& tyre) {

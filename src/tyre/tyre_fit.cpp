@@ -452,12 +452,13 @@ RrcPoint iso28580_point(const TyreSize& size, double drum_rrc, const std::string
     throw InputError(where, "the size '" + size.designation + "' has no load index, so the ISO 28580 load (80 % of "
                             "the load index's load) is unknown; give the size with its load index, e.g. '205/55 R16 91V'");
   }
-  if (size.prefix == SizePrefix::light_truck) {
-    // ISO 28580 tests a C2 tyre at 85 % of its load at the pressure of its load-inflation table, and its EU label
-    // has bands of its own: neither is built, and the passenger point would be a silently wrong one.
-    throw InputError(where, "'" + size.designation + "' is a light-truck size (EU class C2): its ISO 28580 point "
-                            "(85 % of the load index's load, at its load-inflation table's pressure) and its label "
-                            "bands are not built; give its measured point(s) as KPA,LOAD_N,KMH,RRC");
+  if (size.commercial) {
+    // ISO 28580 tests a C2 or C3 tyre at 85 % of its load at the pressure of its load-inflation table, and its EU
+    // label has bands of its own: neither is built, and the passenger point would be a silently wrong one (a
+    // 275/70 R22.5 148/145M truck tyre was placed at 210 kPa and 24.7 kN with C1 bands: session 24's outside testing).
+    throw InputError(where, "'" + size.designation + "' is a light-truck, van or truck size (EU class C2 or C3): its "
+                            "ISO 28580 point (85 % of the load index's load, at its load-inflation table's pressure) "
+                            "and its label bands are not built; give its measured point(s) as KPA,LOAD_N,KMH,RRC");
   }
   check_rrc_range(drum_rrc, where);
   RrcPoint p;

@@ -91,9 +91,9 @@ std::vector<HysteresisParam> free_params_from_keys(const std::vector<std::string
 }
 
 double fitted_file_pressure_pa(const TyreSize& size, std::optional<double> pressure_bar, const std::string& where) {
-  if (!pressure_bar && size.prefix == SizePrefix::light_truck) {
-    throw InputError(where, "missing: a light-truck tyre ('" + size.designation + "') runs at the pressure of its "
-                            "load-inflation table, not a passenger tyre's 2.1 bar; give the pressure to write in bar");
+  if (!pressure_bar && size.commercial) {
+    throw InputError(where, "missing: a light-truck, van or truck tyre ('" + size.designation + "') runs at the pressure "
+                            "of its load-inflation table, not a passenger tyre's 2.1 bar; give the pressure to write in bar");
   }
   if (!pressure_bar) return iso28580_passenger_pressure_pa(size);
   // The tyre file's own check, so that every file written here is one the other commands read (0.5-6 bar was taken

@@ -208,6 +208,7 @@ PressureClass pressure_class(const std::optional<TyreSize>& size) {
   const bool half_inch_rim = size && std::fmod(std::round(size->rim_diameter_m / units::kMPerInch * 10.0), 10.0) == 5.0;
   if (size && size->prefix == SizePrefix::light_truck) return {"a light-truck (LT) tyre", 8.0, "about 3-6.5 bar"};
   if (half_inch_rim) return {"a tyre on a truck rim (17.5, 19.5, 22.5 in)", 10.0, "about 6-9 bar"};
+  if (size && size->commercial) return {"a van tyre (C2)", 8.0, "about 3.5-5.5 bar"};
   if (size) return {"a passenger tyre", 5.0, "about 1.5-3.5 bar, a temporary spare 4.2"};
   return {"a road vehicle's tyre", 10.0, "passenger 1.5-3.5 bar, light truck up to 6.5, truck up to 9-10"};
 }
@@ -334,6 +335,10 @@ TyreSize parse_tyre_size(const std::string& designation, const std::string& wher
   const std::string rim = c.number();
   if (rim.empty()) return fail("missing rim diameter in inches");
   if (rim.size() > 5) return fail("rim diameter " + rim.substr(0, 8) + "... in is outside 8..30 in");
+  // "R16C": a commercial (van) tyre. Read as a speed symbol it had been refused as "more than one speed symbol".
+  if (c.i + 1 <= text.size() && text.compare(c.i, 1, "C") == 0 &&
+      (c.i + 1 == text.size() || text[c.i + 1] == ' ' || text[c.i + 1] == '\t' || text[c.i + 1] == '('))
+    ++c.i, out.commercial = true;
 
   out.section_width_m = std::stod(width) * units::kMPerMm;
   out.aspect_ratio = std::stod(aspect) / 100.0;
@@ -344,6 +349,8 @@ TyreSize parse_tyre_size(const std::string& designation, const std::string& wher
     return fail("aspect ratio " + aspect + " is outside 20..95 %");
   if (std::stod(rim) < 8.0 || std::stod(rim) > 30.0) return fail("rim diameter " + rim + " in is outside 8..30 in");
   out.outer_radius_m = out.rim_diameter_m / 2.0 + out.section_width_m * out.aspect_ratio;
+  out.commercial = out.commercial || out.prefix == SizePrefix::light_truck ||
+                   std::fmod(std::round(std::stod(rim) * 10.0), 10.0) == 5.0;  // truck rims: 17.5, 19.5, 22.5 in
 
   // Service description and suffixes, in any spacing: "91V", "(94Y)", "121/118S", "V", "XL", "Reinforced".
   while (true) {
@@ -365,8 +372,9 @@ TyreSize parse_tyre_size(const std::string& designation, const std::string& wher
       if (out.load_index) return fail("more than one load index");
       if (li.size() > 3) return fail("load index '" + li + "' has too many digits");
       const int index = std::stoi(li);
-      if (t.eat("/")) {  // LT dual rating "121/118": single-wheel first, dual-wheel second; we use single
+      if (t.eat("/")) {  // dual rating "121/118" (LT, van, truck): single-wheel first, dual-wheel second; we use single
         if (t.digits().empty()) return fail("a load pair must look like 121/118");
+        out.commercial = true;
       }
       if (!load_index_max_load_kg(index)) {
         throw InputError(where, quoted + ": load index " + li + " is outside the ETRTO/ISO table; allowed: " +

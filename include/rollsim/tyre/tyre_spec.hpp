@@ -24,6 +24,10 @@ struct TyreSize {
   std::optional<int> load_index;    ///< 91
   std::optional<std::string> speed_symbol;  ///< "V"
   bool extra_load = false;          ///< "XL" / "Reinforced"
+  /// A light-truck, van or truck tyre (EU class C2 or C3): "LT", a "C" after the rim ("R16C"), a dual load index
+  /// ("107/105") or a truck rim (17.5, 19.5, 22.5 in). Its load index holds at its own load-inflation pressure, and
+  /// its ISO 28580 point and label bands are not a passenger tyre's.
+  bool commercial = false;
 };
 
 /// Parses a designation; throws InputError(where, ...) naming `where` (file key or option) if it does not parse
