@@ -216,6 +216,16 @@ void check_options(const TyreSpec& tyre, const SweepOptions& o) {
       check_pressure_plausible(o.axes[i].from, tyre.size, "--param pressure --from");
       check_pressure_plausible(o.axes[i].to, tyre.size, "--param pressure --to");
     }
+    // In mm, the tyre file's ranges for a road tyre: a width of 0.165 (metres) ran a 0.165 mm tyre, +17 % energy,
+    // where the pressure's unit slips were already refused (session 24's outside testing).
+    if (p == SweepParam::Width || p == SweepParam::Diameter) {
+      const bool width = p == SweepParam::Width;
+      const Range road_tyre_mm = width ? Range::closed(80.0, 500.0) : Range::closed(300.0, 2500.0);
+      const std::string key = "--param " + sweep_param_key(p);
+      for (const auto& [v, end] : {std::pair{o.axes[i].from, " --from"}, std::pair{o.axes[i].to, " --to"}})
+        check_physical(v, road_tyre_mm, "mm", "no road tyre measures that", {{"m", 1e3}, {"cm", 10.0}, {"inches", 25.4}},
+                       key + end);
+    }
     if (p == SweepParam::LoadPct && !(tyre.max_load_n > 0.0)) {
       throw InputError("--param load-pct", "the tyre's maximum load is unknown (no load index): sweep 'load' in N");
     }
