@@ -153,28 +153,44 @@ TyreState j2452_tyre(const J2452Set& set) {
   return t;
 }
 
+// The shared constants as a single tyre's fit holds them: one that must not be negative and fits below 0 is held at 0
+// and the rest refitted (and a held speed loss takes its load exponent with it). Left free, a set with a small speed
+// term (c = 1e-5) drove the others' speed loss to -2.5e-6 and the evaluation ended in a domain error naming no set
+// (session 24's outside testing).
 HysteresisConstants fit_shared_constants(const std::vector<J2452Set>& training, double drum_radius_m) {
   const OperatingGrid grid = j2452_grid();
   std::vector<std::vector<RrcPoint>> truth;
   for (const auto& s : training) truth.push_back(sample_j2452(s, grid, drum_radius_m, s.name));
-  const HysteresisConstants start;
-  auto constants = [&](const Eigen::VectorXd& x) {
-    HysteresisConstants c = start;
-    for (int k = 0; k < x.size(); ++k) set_hysteresis_param(c, kShared[k], x[k]);
-    return c;
-  };
+  HysteresisConstants held;
+  std::vector<HysteresisParam> free(std::begin(kShared), std::end(kShared));
   const int m = static_cast<int>(training.size() * grid.pressures_pa.size() * grid.loads_n.size() * grid.speeds_mps.size());
-  const ResidualFunction residuals = [&](const Eigen::VectorXd& x, Eigen::VectorXd& r) {
-    const HysteresisConstants c = constants(x);
-    int i = 0;
-    for (std::size_t k = 0; k < training.size(); ++k) {
-      const Surface model = hysteresis_surface(one_point_tyre(training[k], c, drum_radius_m));
-      for (const auto& pt : truth[k]) r[i++] = model(pt.pressure_pa, pt.load_n, pt.speed_mps) / pt.rrc - 1.0;
+  while (true) {
+    auto constants = [&](const Eigen::VectorXd& x) {
+      HysteresisConstants c = held;
+      for (std::size_t k = 0; k < free.size(); ++k) set_hysteresis_param(c, free[k], x[static_cast<Eigen::Index>(k)]);
+      return c;
+    };
+    const ResidualFunction residuals = [&](const Eigen::VectorXd& x, Eigen::VectorXd& r) {
+      const HysteresisConstants c = constants(x);
+      int i = 0;
+      for (std::size_t k = 0; k < training.size(); ++k) {
+        const Surface model = hysteresis_surface(one_point_tyre(training[k], c, drum_radius_m));
+        for (const auto& pt : truth[k]) r[i++] = model(pt.pressure_pa, pt.load_n, pt.speed_mps) / pt.rrc - 1.0;
+      }
+    };
+    Eigen::VectorXd x0(static_cast<Eigen::Index>(free.size()));
+    for (std::size_t k = 0; k < free.size(); ++k) x0[static_cast<Eigen::Index>(k)] = hysteresis_param_value(held, free[k]);
+    const HysteresisConstants fitted = constants(least_squares(residuals, m, x0).x);
+    std::vector<HysteresisParam> below;
+    for (auto p : free)
+      if (hysteresis_param_non_negative(p) && hysteresis_param_value(fitted, p) < 0.0) below.push_back(p);
+    if (below.empty()) return fitted;
+    for (auto p : below) {
+      set_hysteresis_param(held, p, 0.0);
+      free.erase(std::find(free.begin(), free.end(), p));
+      if (p == HysteresisParam::SpeedLoss) free.erase(std::remove(free.begin(), free.end(), HysteresisParam::SpeedLossLoadExponent), free.end());
     }
-  };
-  Eigen::VectorXd x0(5);
-  for (int k = 0; k < 5; ++k) x0[k] = hysteresis_param_value(start, kShared[k]);
-  return constants(least_squares(residuals, m, x0).x);
+  }
 }
 
 Eigen::VectorXd minimise_on_simplex(const Eigen::MatrixXd& q, const Eigen::VectorXd& c) {

@@ -300,6 +300,10 @@ void check_rrc_point(const TyreState& tyre, const RrcPoint& p) {
   }
 }
 
+bool hysteresis_param_non_negative(HysteresisParam p) {
+  return p == HysteresisParam::FrequencySlope || p == HysteresisParam::SpeedLoss || p == HysteresisParam::DeflectionExponent;
+}
+
 std::vector<HysteresisParam> identifiable_params(const std::vector<RrcPoint>& points) {
   const Spread s = spread(points);
   const std::size_t conditions = distinct_conditions(points);
@@ -346,17 +350,13 @@ TyreFit fit_hysteresis(const TyreState& start_in, const FitRequest& r) {
   start.hysteresis.rrc_ref = 0.01;
   start.hysteresis.rrc_ref *= r.points.front().rrc / model_rrc(start, r.points.front());
 
-  // A slope or speed loss cannot be negative (RRC would reach 0 at some speed), nor the deflection exponent (a
-  // tyre losing less the more it deflects would lose more when pumped up; every measured set loses less, J2452
-  // pressure exponents -0.26 to -0.59): one that fits below 0 is held at 0 and the rest refitted.
+  // A constant that must not be negative and fits below 0 is held at 0 and the rest refitted.
   std::vector<HysteresisParam> at_bound, undetermined, flat;
   while (true) {
     TyreFit fit = fit_once(start, r, free, flat);
     bool changed = false;
     for (const auto& e : fit.params) {
-      const bool nonneg = e.param == HysteresisParam::FrequencySlope || e.param == HysteresisParam::SpeedLoss ||
-                          e.param == HysteresisParam::DeflectionExponent;
-      if (nonneg && e.value < 0.0) {
+      if (hysteresis_param_non_negative(e.param) && e.value < 0.0) {
         set_hysteresis_param(start.hysteresis, e.param, 0.0);
         free.erase(std::find(free.begin(), free.end(), e.param));
         at_bound.push_back(e.param);

@@ -33,6 +33,10 @@ std::vector<HysteresisParam> all_hysteresis_params();
 std::optional<HysteresisParam> hysteresis_param_from_key(const std::string& key);
 double hysteresis_param_value(const HysteresisConstants& c, HysteresisParam p);
 void set_hysteresis_param(HysteresisConstants& c, HysteresisParam p, double value);
+/// A slope or speed loss cannot be negative (RRC would reach 0 at some speed), nor the deflection exponent (a tyre
+/// losing less the more it deflects would lose more when pumped up; every measured set loses less, J2452 pressure
+/// exponents -0.26 to -0.59): a fit that puts one below 0 holds it at 0 and refits the rest.
+bool hysteresis_param_non_negative(HysteresisParam p);
 
 /// Checks a point is physically a passenger/light-truck tyre measurement and solvable for `tyre`: pressure in
 /// [50, 600] kPa, speed in (0, 300] km/h, RRC in [0.001, 0.05], a load the tyre carries without its deflection
