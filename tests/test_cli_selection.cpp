@@ -219,6 +219,22 @@ TEST(CliSelection, SweepWidthOrDiameterInAnotherUnitIsRefused) {
   EXPECT_EQ(run("sweep --tyre 175-70R14 --param width --from 165 --to 185 --steps 2").exit_code, 0);
 }
 
+// A load typed in kg is said wherever a load is given, not only by `rollsim tyre` (session 24's outside testing).
+TEST(CliSelection, ALoadInKgIsSaidBySweepSensitivityAndFit) {
+  const std::string hint = "load 400 N is 8 % of the tyre's rated 4903 N; is it in kg? (400 kg = 3923 N)";
+  const CmdResult sweep = run("sweep --tyre 175-70R14 --param pressure --from 2 --to 2.4 --steps 2 --load-n 400");
+  EXPECT_EQ(sweep.exit_code, 0) << sweep.err;
+  EXPECT_TRUE(has(sweep.err, "warning: " + hint)) << sweep.err;
+  const CmdResult sens = run("sensitivity --tyre 175-70R14 --load-n 400");
+  EXPECT_EQ(sens.exit_code, 0) << sens.err;
+  EXPECT_TRUE(has(sens.out, hint)) << sens.out;
+  const auto out = rollsim::test::temp_dir() / "kg.yaml";
+  const CmdResult fit = run("tyre fit --size '175/70 R14 84T' --point 210,400,80,0.0085 --output '" + out.string() + "'");
+  EXPECT_EQ(fit.exit_code, 0) << fit.err;
+  EXPECT_TRUE(has(fit.err, "--point 210,400,80,0.0085: " + hint)) << fit.err;
+  EXPECT_FALSE(has(run("sweep --tyre 175-70R14 --param pressure --from 2 --to 2.4 --steps 2 --load-n 3000").err, "in kg"));
+}
+
 TEST(CliSelection, SweepOutOfDomainSaysHowManyPointsAndTheFirst) {
   const CmdResult r = run("sweep --tyre 175-70R14 --param load --from 1000 --to 40000 --steps 40");
   EXPECT_NE(r.exit_code, 0);

@@ -9,6 +9,7 @@
 #include "rollsim/common/input_file.hpp"
 #include "rollsim/common/units.hpp"
 #include "rollsim/common/yaml_reader.hpp"
+#include "rollsim/tyre/tyre_request.hpp"
 #include "rollsim/report/simulation_report.hpp"
 #include "rollsim/selection/common.hpp"
 
@@ -152,6 +153,7 @@ std::vector<std::string> sensitivity_warnings(const Sensitivity& s) {
     out.push_back("load " + fixed(s.load_n, 0) + " N is above the tyre's rated maximum " + fixed(s.max_load_n, 0) +
                   " N; the RR power elasticities are outside the tyre's rating");
   }
+  if (std::string kg = load_in_kg_hint(s.load_n, s.max_load_n); !kg.empty()) out.push_back(std::move(kg));
   for (const auto& w : s.vehicle_warnings) out.push_back(w);
   if (!s.energy_unit.empty() && !s.followed_trace) {
     out.push_back("the car could not follow the cycle in the base run or a perturbed one: the energy elasticities mix "

@@ -17,6 +17,7 @@
 #include "rollsim/report/simulation_report.hpp"
 #include "rollsim/report/table.hpp"
 #include "rollsim/selection/common.hpp"
+#include "rollsim/tyre/tyre_request.hpp"
 
 namespace rollsim::selection {
 
@@ -389,6 +390,10 @@ std::vector<std::string> sweep_warnings(const SweepResult& r) {
   }
   const std::string of = " of " + std::to_string(r.points.size()) + " points ";
   std::vector<std::string> out;
+  // A load typed in kg (session 24's outside testing: `--load-n 400` swept an RRC of 0.032 without a word).
+  double lightest_n = heaviest_n;
+  for (const auto& p : r.points) lightest_n = std::min(lightest_n, p.load_n);
+  if (std::string kg = load_in_kg_hint(lightest_n, r.max_load_n); !kg.empty()) out.push_back(std::move(kg));
   if (over > 0) {
     out.push_back("at " + std::to_string(over) + of + "the load (up to " + fixed(heaviest_n, 0) +
                   " N) is above the tyre's rated maximum " + fixed(r.max_load_n, 0) +

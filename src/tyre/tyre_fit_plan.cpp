@@ -9,6 +9,7 @@
 #include "rollsim/common/json.hpp"
 #include "rollsim/common/units.hpp"
 #include "rollsim/common/yaml_reader.hpp"
+#include "rollsim/tyre/tyre_request.hpp"
 #include "rollsim/tyre/tyre_spec.hpp"
 
 namespace rollsim {
@@ -57,6 +58,7 @@ TyreFitPlan plan_tyre_fit(const TyreFitInputs& in) {
                                 fixed(rated_n, 0) + " N (load index " + std::to_string(*in.size.load_index) +
                                 "); the fit there is outside the tyre's rating");
       }
+      if (std::string kg = load_in_kg_hint(p.load_n, rated_n); !kg.empty()) plan.warnings.push_back(p.where + ": " + kg);
     }
   }
   return plan;

@@ -79,11 +79,15 @@ std::string requested_load_warning(const TyreSpec& spec, const TyreLoadChoice& l
   if (n > max_n)
     return "load " + fixed(n, d) + " N is above the tyre's rated maximum " + fixed(max_n, d) + " N (" +
            fixed(max_n / units::kStandardGravity_mps2, 0) + " kg); results are outside the tyre's rating";
-  constexpr double kLeastShare = 0.15;  // no car loads a tyre this lightly: an empty quadricycle's is ~25 %
-  if (n < kLeastShare * max_n && load.where.rfind("--load-n", 0) == 0)
-    return "load " + format_value(n) + " N is " + fixed(100.0 * n / max_n, 0) + " % of the tyre's rated " + fixed(max_n, 0) +
-           " N; is it in kg? (" + format_value(n) + " kg = " + fixed(n * units::kStandardGravity_mps2, 0) + " N)";
-  return "";
+  return load.where.rfind("--load-n", 0) == 0 ? load_in_kg_hint(n, max_n) : "";
+}
+
+std::string load_in_kg_hint(double load_n, double max_load_n) {
+  constexpr double kLeastShare = 0.15;
+  if (!(max_load_n > 0.0) || !(load_n < kLeastShare * max_load_n)) return "";
+  return "load " + format_value(load_n) + " N is " + fixed(100.0 * load_n / max_load_n, 0) + " % of the tyre's rated " +
+         fixed(max_load_n, 0) + " N; is it in kg? (" + format_value(load_n) + " kg = " +
+         fixed(load_n * units::kStandardGravity_mps2, 0) + " N)";
 }
 
 double parse_requested_speed_kmh(const std::string& text) {

@@ -32,6 +32,10 @@ TyreSpec build_requested_tyre(const TyreRequest& request);
 /// load_n, or load_pct of the tyre's maximum load (default 80 %).
 TyreLoadChoice choose_requested_load(const TyreRequest& request, const TyreSpec& spec);
 
+/// "load N is P % of the tyre's rated M N; is it in kg?" for a load under 15 % of the rating (no car loads a tyre
+/// this lightly: an empty quadricycle's is ~25 %); empty otherwise or when the rating is unknown.
+std::string load_in_kg_hint(double load_n, double max_load_n);
+
 /// What a user should hear of the load asked for, or "": above the tyre's rating (outside it), or under 15 % of it
 /// (a load typed in kg: --load-n 400 ran at 8 % of a 4903 N rating and read an RRC 3.6 times too high, unwarned:
 /// session 23's outside testing). The figures carry the decimals that tell them apart.
