@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <tuple>
 #include <numbers>
 #include <string>
 #include <vector>
@@ -690,6 +691,17 @@ TEST(TyreLabel, ClassBandsOfRegulation2020_740ForC1) {
   EXPECT_NEAR(eu_label_band_c1("E", "x").rrc_max, 10.55e-3 + (10.5e-3 - 9.1e-3), 1e-12);
   EXPECT_THROW(eu_label_band_c1("F", "--label F"), InputError);
   EXPECT_THROW(eu_label_band_c1("AB", "--label AB"), InputError);
+  // Each edge is in one class, the one above it (a declared 6.55 rounds to 6.6, class B), also when computed onto it.
+  for (const auto& [edge, below, above] : {std::tuple{6.55e-3, "A", "B"}, {7.75e-3, "B", "C"}, {9.05e-3, "C", "D"},
+                                           {10.55e-3, "D", "E"}}) {
+    for (double rrc : {edge, std::nextafter(edge, 0.0)}) {
+      EXPECT_FALSE(eu_label_band_c1(below, "x").contains(rrc)) << rrc;
+      EXPECT_TRUE(eu_label_band_c1(above, "x").contains(rrc)) << rrc;
+    }
+    EXPECT_TRUE(eu_label_band_c1(below, "x").contains(edge - 0.01e-3)) << edge;
+  }
+  EXPECT_TRUE(eu_label_band_c1("A", "x").contains(4.0e-3));  // open below
+  EXPECT_TRUE(eu_label_band_c1("E", "x").contains(13.0e-3));  // open above
 }
 
 TEST(TyreLabel, Iso28580ConditionsFollowTheLoadIndexAndLoadVersion) {
@@ -973,18 +985,22 @@ TEST(TyreFit, IntervalsFromFewResidualsUseStudentsT) {
 }
 
 // The label check: A and E are open-ended classes (5.0 kg/t is an A, 13.0 an E), and a value computed onto an edge is
-// on it (6.549999999999998 against 6.550000000000001 read OUTSIDE); session 21's outside testing.
+// on it (6.549999999999998 against 6.550000000000001 read OUTSIDE); session 21's outside testing. An edge is the class
+// above's (6.55 is a B, not also an A: session 24's).
 TEST(CliTyreFit, TheLabelCheckKeepsOpenEndsOpenAndEdgesOnTheEdge) {
   const auto out = temp_dir() / "label_check.yaml";
-  for (const auto& [point, label] : {std::pair<std::string, std::string>{"0.0050", "A"}, {"0.0130", "E"}, {"0.00655", "B"},
-                                     {"0.00655", "A"}, {"0.00775", "C"}}) {
+  for (const auto& [point, label, inside] : {std::tuple<std::string, std::string, bool>{"0.0050", "A", true}, {"0.0130", "E", true},
+                                             {"0.00655", "B", true}, {"0.00655", "A", false}, {"0.00775", "C", true}}) {
     const CmdResult r = fit("--size '205/55 R16 91V' --point " + point + " --label " + label + " --output '" + out.string() + "'");
     ASSERT_EQ(r.exit_code, 0) << r.err;
-    EXPECT_TRUE(has(r.out, "inside the band")) << point << " " << label << ": " << r.out;
+    EXPECT_EQ(has(r.out, "inside the band"), inside) << point << " " << label << ": " << r.out;
   }
   const CmdResult outside = fit("--size '205/55 R16 91V' --point 0.0050 --label B --output '" + out.string() + "' --json");
   EXPECT_TRUE(has(outside.out, "\"inside_label_band\": false")) << outside.out;
   EXPECT_TRUE(has(outside.out, "\"label_rrc_min_kg_per_t\": 6.55,")) << outside.out;
+  EXPECT_TRUE(has(outside.out, "\"label_open_below\": false, \"label_open_above\": false")) << outside.out;
+  const CmdResult e = fit("--size '205/55 R16 91V' --point 0.0130 --label E --output '" + out.string() + "' --json");
+  EXPECT_TRUE(has(e.out, "\"label_open_below\": false, \"label_open_above\": true")) << e.out;
 }
 
 // A measured pressure of 1e308 kPa overflowed to Pa and was named "pressure inf kPa" (session 21).

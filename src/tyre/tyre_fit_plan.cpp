@@ -135,6 +135,8 @@ void write_tyre_fit_json(std::ostream& out, const TyreFit& fit, const TyreFitPla
     head.add("label_class", std::string(1, plan.band->label_class))
         .add("label_rrc_min_kg_per_t", kg_per_t(plan.band->rrc_min))
         .add("label_rrc_max_kg_per_t", kg_per_t(plan.band->rrc_max))
+        .add("label_open_below", plan.band->open_below)  // A and E: the edge given there is our closing one
+        .add("label_open_above", plan.band->open_above)
         .add("iso_rrc_kg_per_t", 1e3 * c->drum_rrc)
         .add("iso_flat_rrc_kg_per_t", 1e3 * c->flat_rrc)
         .add("iso_drum_to_flat", c->drum_to_flat)

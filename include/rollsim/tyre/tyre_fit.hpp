@@ -101,10 +101,12 @@ struct LabelBand {
   bool open_below = false;  ///< class A has no lower edge in the regulation; rrc_min is our assumption
   bool open_above = false;  ///< class E has no upper edge; rrc_max is our assumption
   /// Whether an RRC is of this class: an open end has no edge (A holds 5.0 kg/t, E 13.0; our closing edges are for
-  /// the label-alone uncertainty only), and an edge holds a value computed onto it (6.549999999999998 is 6.55).
+  /// the label-alone uncertainty only). An edge belongs to the class above it, as a value declared to 0.1 kg/t rounds
+  /// (6.55 is 6.6, class B; it had been inside both A and B: session 24's outside testing), and holds a value computed
+  /// onto it (6.549999999999998 is 6.55).
   bool contains(double rrc) const {
     constexpr double kEdge = 1e-12;  // RRC; far below the 0.1 kg/t of a declared value
-    return (open_below || rrc >= rrc_min - kEdge) && (open_above || rrc <= rrc_max + kEdge);
+    return (open_below || rrc >= rrc_min - kEdge) && (open_above || rrc < rrc_max - kEdge);
   }
 };
 
