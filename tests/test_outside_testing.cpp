@@ -189,6 +189,8 @@ TEST_F(OutsideTesting, TyreFitChecksItsOutputFirstAndMakesNoFolders) {
 TEST_F(OutsideTesting, OptionsAreCheckedWholly) {
   expect_refused("tyre fit --evaluate-j2452 ../shared/data/tyres/j2452_michelin_part.csv --label B",
                  "--label: not allowed with --evaluate-j2452");
+  expect_refused("tyre fit --evaluate-j2452 ../shared/data/tyres/j2452_michelin_part.csv --rrc-uncertainty-pct 3",
+                 "--rrc-uncertainty-pct: not allowed with --evaluate-j2452");  // was ignored (session 24)
   expect_refused("validate --epa-test-car-list ../shared/data/vehicles/epa_test_car_list_2022_part.csv --threads 2.5",
                  "--threads: '2.5' is not a whole number");
   expect_refused("diagnose --vehicle camry_2018 --preset anl_d3 --recording '" + kCamryUdds + "' --window-s nan",

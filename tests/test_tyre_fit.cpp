@@ -828,6 +828,7 @@ TEST(CliTyreFit, BadInputGetsOneNamedErrorAndNoFile) {
       {"--size '205/55 R16 91V' --point 0.008,", {"--point 0.008,", "expected KPA,LOAD_N,KMH,RRC"}},
       {"--size '205/55 R16 91V' --point 0.008 --drum-radius-m 2", {"--drum-radius-m", "J2452 set only"}},
       {"--size '205/55 R16 91V' --point 210,4500,1000,0.008", {"speed 1000 km/h is not allowed"}},
+      {"--size '205/55 R16 91V' --point 210,4500,1e300,0.008", {"speed 1e+300 km/h is not allowed"}},  // was "inf"
       // Three points at two conditions determine two constants, not three.
       {"--size '205/55 R16 91V' --point 210,4500,40,0.0075 --point 250,4500,80,0.0078 --point 210,4500,40,0.0076 "
        "--free rrc_ref,frequency_slope_per_hz,deflection_exponent", {"--free", "2 distinct condition(s)"}},

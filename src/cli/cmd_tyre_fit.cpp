@@ -250,7 +250,7 @@ void run_fit(const FitOptions& o) {
                                         {!o.measured.empty(), "--measured"}, {!o.j2452.empty(), "--j2452"},
                                         {!o.label.empty(), "--label"}, {!o.output.empty(), "--output"},
                                         {!o.free.empty(), "--free"}, {!o.pressure_bar.empty(), "--pressure-bar"},
-                                        {!o.name.empty(), "--name"}}) {
+                                        {!o.name.empty(), "--name"}, {!o.uncertainty_pct.empty(), "--rrc-uncertainty-pct"}}) {
       if (given) throw InputError(option, "not allowed with --evaluate-j2452, which judges the model on the file's sets and "
                                           "fits no tyre of its own");
     }

@@ -287,7 +287,7 @@ void check_rrc_point(const TyreState& tyre, const RrcPoint& p) {
   check_pressure_plausible_kpa(p.pressure_pa / 1e3, std::nullopt, p.where);  // the size's class: plan_tyre_fit
   const double kmh = units::mps_to_kmh(p.speed_mps);
   if (!(kmh > 0.0 && kmh <= 300.0)) {
-    throw InputError(p.where, "speed " + format_value(std::round(kmh * 1e9) / 1e9) + " km/h is not allowed: must be in (0, 300] km/h (a "
+    throw InputError(p.where, "speed " + format_value(std::abs(kmh) < 1e9 ? std::round(kmh * 1e9) / 1e9 : kmh) + " km/h is not allowed: must be in (0, 300] km/h (a "
                                                              "rolling tyre; RRC is not defined at standstill)");
   }
   check_rrc_range(p.rrc, p.where);
