@@ -92,6 +92,19 @@ TEST(EffectCatalogue, BatteryResistanceDrainsTheCellsNotTheTerminals) {
               source_j(run(ice, nullptr)), 1e-9 * source_j(run(ice, nullptr)));
 }
 
+// The current is the power over the car's own battery voltage unless the effect names one: a fixed 360 V read the
+// Twizy's (58 V) 0.04 ohm as 1.6 ohm (session 24's outside testing).
+TEST(EffectCatalogue, BatteryResistanceTakesTheBatterysVoltage) {
+  const EffectInputs in{};
+  for (const auto& [file, volts] : {std::pair{"twizy.yaml", 58.0}, {"ev.yaml", 360.0}}) {
+    const Vehicle v = vehicle(file);
+    const auto own = make_effect("battery_resistance", {{"extra_resistance_ohm", 0.1}}, effect_context(v));
+    EXPECT_NEAR(own->battery_loss_w(in, 5800.0, nullptr), 0.1 * (5800.0 / volts) * (5800.0 / volts), 1e-9) << file;
+    const auto named = make_effect("battery_resistance", {{"extra_resistance_ohm", 0.1}, {"pack_voltage_v", 400}}, effect_context(v));
+    EXPECT_NEAR(named->battery_loss_w(in, 5800.0, nullptr), 0.1 * (5800.0 / 400) * (5800.0 / 400), 1e-9) << file;
+  }
+}
+
 TEST(EffectCatalogue, RegenLimitCostsOnlyAnElectricCarAndOnlyWhenBraking) {
   const Vehicle ev = vehicle("ev.yaml");
   const SimulationResult base = run(ev, nullptr);

@@ -411,6 +411,7 @@ EffectContext effect_context(const Vehicle& vehicle) {
   // A coast-down C is half of rho CdA (F = C v^2 = rho CdA v^2 / 2).
   ctx.rho_cda_kg_per_m = vehicle.coastdown ? 2.0 * vehicle.coastdown->c_n_s2_per_m2
                                            : b.air_density_kg_per_m3 * b.drag_coefficient * b.frontal_area_m2;
+  if (const BatteryParams* battery = vehicle.battery()) ctx.pack_voltage_v = battery->open_circuit_voltage_v;
   return ctx;
 }
 

@@ -35,6 +35,7 @@ enum class EffectId {
 struct EffectContext {
   double mass_kg = 0.0;            ///< test mass (the mass effect's rolling share is scaled from it)
   double rho_cda_kg_per_m = 0.0;   ///< air density x drag area (2 x coast-down C for coast-down vehicles)
+  double pack_voltage_v = 0.0;     ///< the traction battery's open-circuit voltage; 0 without a battery
 };
 
 /// One parameter of a catalogue effect, with its unit, neutral value and allowed (physical) bounds.
