@@ -260,6 +260,10 @@ py::object api_tyre(py::object file, py::object size, py::object outer_radius_m,
   const TyreLoadChoice load = choose_requested_load(req, spec);
   const auto speeds = number_array(speed_kmh, "--speed-kmh");
   if (speeds.ndim() > 1) throw InputError("--speed-kmh", "must be a number or a 1-D array of numbers");
+  // As sweep's bound: 10^7 speeds took the interpreter down by memory, without a word (session 24's outside testing).
+  if (static_cast<std::size_t>(speeds.size()) > selection::kMaxTyreSweepPoints)
+    throw InputError("--speed-kmh", std::to_string(speeds.size()) + " speeds is more than the " +
+                                        std::to_string(selection::kMaxTyreSweepPoints) + " allowed in one call; split the array");
   std::vector<py::dict> points;
   for (py::ssize_t i = 0; i < speeds.size(); ++i) {
     const double v_kmh = parse_requested_speed_kmh(format_value(speeds.data()[i]));
@@ -269,6 +273,10 @@ py::object api_tyre(py::object file, py::object size, py::object outer_radius_m,
     points.push_back(from_json(tyre_point_json(spec, load.load_n, v_kmh, r).str()).cast<py::dict>());
   }
   if (const std::string w = requested_load_warning(spec, load); !w.empty()) warn(w);
+  if (speeds.size() > 0) {  // as `rollsim tyre` says it
+    const double top_kmh = *std::max_element(speeds.data(), speeds.data() + speeds.size());
+    if (const std::string w = speed_rating_warning(spec, units::kmh_to_mps(top_kmh), "speed_kmh"); !w.empty()) warn(w);
+  }
   if (speeds.ndim() == 0) return points.front();
   if (points.empty()) throw InputError("--speed-kmh", "an empty array: give at least one speed");
   return stack(points);

@@ -74,6 +74,17 @@ class TyreApi(unittest.TestCase):
             self.assertAlmostEqual(got["rr_power_w"] / float(row["rr_power_w"]), 1.0, delta=1e-3, msg=str(row))
 
 
+    def test_speed_arrays_are_bounded_and_the_speed_rating_is_said(self):
+        # 10^7 speeds took the interpreter down by memory without a word (session 24): bounded as sweep is.
+        with self.assertRaisesRegex(rollsim.InputError, "1000001 speeds is more than the 1000000 allowed"):
+            rollsim.tyre("175-70R14", speed_kmh=np.full(1000001, 80.0))
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            rollsim.tyre("155-70R19", speed_kmh=np.array([100.0, 170.0]))
+        self.assertTrue(any("above tyre '155-70R19''s speed rating Q (160 km/h)" in str(w.message) for w in caught),
+                        [str(w.message) for w in caught])
+
+
 class SimulateApi(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
