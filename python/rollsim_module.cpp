@@ -394,6 +394,9 @@ py::object api_diagnose(py::object vehicle, py::object recording_paths, py::obje
   // A str is a sequence too: recordings='trip.csv' would have been read letter by letter.
   if (py::isinstance<py::str>(recording_paths)) throw InputError("recordings", "expected a list of CSV paths (str), not one str");
   const auto recordings = arg_as<std::vector<std::string>>(recording_paths, "recordings", "a list of CSV paths (str)");
+  for (std::size_t k = 0; k < recordings.size(); ++k)
+    if (recordings[k].empty())
+      throw InputError("recordings[" + std::to_string(k) + "]", "an empty path is not allowed: give a recording's CSV path");
   const auto columns = arg_as<py::dict>(columns_arg, "columns", "a dict of canonical name (str) to source column (str)");
   const auto scales = arg_as<py::dict>(scales_arg, "scales", "a dict of canonical name (str) to factor (number)");
   const auto preset = arg_as<std::string>(preset_arg, "preset", "a preset name (str): 'anl_d3' or 'rsk_twizy'");
@@ -578,6 +581,7 @@ py::dict api_sensitivity(py::object tyre, py::object vehicle, py::object cycle, 
 
 py::dict api_validate(py::object list_arg, py::object threads) {
   const auto list = arg_as<std::string>(list_arg, "epa_test_car_list", "a CSV path (str)");
+  if (list.empty()) throw InputError("epa_test_car_list", "an empty path is not allowed: give the list's CSV path");
   const unsigned n = threads.is_none() ? 0u
                                        : static_cast<unsigned>(parse_option_count(number_text(threads, "threads"), "threads",
                                                                                    Range::closed(1, 1024)));
@@ -590,6 +594,7 @@ py::dict api_validate(py::object list_arg, py::object threads) {
   py::list summary, out_rows;
   for (const auto& s : validate::summarise(v)) summary.append(from_json(validate::summary_line_json(s).str()));
   for (const auto& r : v.rows) out_rows.append(from_json(validate::row_json(r).str()));
+  for (const auto& w : validate::validation_warnings(v)) warn(w);
   py::dict out;
   out["fitted"] = from_json(validate::fitted_json(v.fitted).str());
   out["maker_calibration"] = from_json(validate::maker_calibration_json(v.maker_calibration).str());

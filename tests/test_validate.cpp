@@ -485,13 +485,22 @@ TEST(EpaList, FtpWeightingReproducesThePublishedCompositeFromTheBags) {
   for (const auto& r : rows) {
     if (r.cycle != validate::EpaCycle::ftp75 || r.fuel != validate::EpaFuel::petrol || !r.measured || *r.measured <= 0.0) continue;
     if (!r.bag_mpg[0] || !r.bag_mpg[1] || !r.bag_mpg[2] || *r.bag_mpg[0] <= 0.0 || *r.bag_mpg[1] <= 0.0 || *r.bag_mpg[2] <= 0.0) continue;
+    if (r.bag4_mpg && *r.bag4_mpg > 0.0) continue;  // a four-bag (hybrid) FTP is weighted otherwise
     const double mpg = validate::ftp75_weighted_mpg(d1 / *r.bag_mpg[0], d2 / *r.bag_mpg[1], d1 / *r.bag_mpg[2], d1, d2);
-    dev.push_back(std::abs(mpg / *r.measured - 1.0));
+    dev.push_back(mpg / *r.measured - 1.0);
   }
   ASSERT_GT(dev.size(), 500u);
-  std::sort(dev.begin(), dev.end());
-  EXPECT_LT(dev[dev.size() / 2], 0.003);
-  EXPECT_LT(dev[dev.size() * 9 / 10], 0.01);
+  std::vector<double> abs_dev;
+  for (double d : dev) abs_dev.push_back(std::abs(d));
+  std::sort(abs_dev.begin(), abs_dev.end());
+  const double within_1pct = static_cast<double>(std::upper_bound(abs_dev.begin(), abs_dev.end(), 0.01) - abs_dev.begin()) /
+                             static_cast<double>(abs_dev.size());
+  std::nth_element(dev.begin(), dev.begin() + static_cast<std::ptrdiff_t>(dev.size() / 2), dev.end());
+  // The README's figures (session 24's outside testing recomputed them on the three-bag FTPs alone).
+  std::printf("three-bag petrol FTPs: %zu, median deviation %+.3f %%, %.1f %% within 1 %%\n", dev.size(),
+              100.0 * dev[dev.size() / 2], 100.0 * within_1pct);
+  EXPECT_LT(std::abs(dev[dev.size() / 2]), 0.001);
+  EXPECT_GT(within_1pct, 0.95);
 }
 
 // Pearson's correlation of two equally long samples.
@@ -1072,9 +1081,30 @@ TEST(CliValidate, AnUnusableExhaustOrFourthBagIsANamedSkipNotASilentRow) {
         {"CO2 (g/mi)", "abc", "CO2 (g/mi) 'abc' is not a number, so the result cannot"},
         {"THC (g/mi)", "-0.04", "THC (g/mi) '-0.04' is negative"},
         {"CO (g/mi)", "n/a", "CO (g/mi) 'n/a' is not a number"},
-        {"FE Bag 4", "-5", "its FTP's FE Bag 4 '-5' is negative, so whether it was run with four bags (a hybrid) is unknown"}}) {
+        {"FE Bag 4", "-5", "its FTP's FE Bag 4 '-5' is negative, so whether it was run with four bags (a hybrid) is unknown"},
+        // A zero CO2 had switched the check off as a blank does (session 24's outside testing).
+        {"CO2 (g/mi)", "0", "CO2 (g/mi) 0 (an engine that burns fuel emits CO2), so the result cannot be checked"}}) {
     expect_line_2_skipped(lines, column, value, "field outside its physical range: " + said);
   }
+}
+
+// A list too small to fit a fuel's constant predicts it with the nominal one: said on stderr and in each row's JSON,
+// where a one-maker list had read the Vantage V8 21 % low with nothing to say why. A header repeated inside the file
+// (two lists joined) is an error naming its line, not a row skipped for its procedure (session 24's outside testing).
+TEST(CliValidate, NominalConstantsAreSaidAndARepeatedHeaderIsNamed) {
+  const auto lines = list_head(6);  // line 6: the Vantage V8's FTP, of the held-out half
+  const auto r = validate_lines(lines, {lines[5]});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("\"constants\": \"nominal\""), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("warning: 1 simulated row(s) are predicted with nominal constants"), std::string::npos) << r.err;
+  const auto summary = validate_lines(lines, {lines[5]}, "--threads 1");
+  EXPECT_NE(summary.out.find("skipped: none"), std::string::npos) << summary.out;
+  const auto joined = validate_lines(lines, {lines[5], lines[0]});
+  EXPECT_EQ(joined.exit_code, 2) << joined.out;
+  EXPECT_NE(joined.err.find("edited_list.csv: line 3: repeats the header (two lists joined?)"), std::string::npos) << joined.err;
+  // The whole list fits every constant it predicts with.
+  EXPECT_EQ(test::run_rollsim("validate --json --threads 2 --epa-test-car-list " + kList).out.find("\"constants\""),
+            std::string::npos);
 }
 
 // An electric row whose FE_UNIT says MPGe was refused with a message saying MPGe is allowed, and filed under "field

@@ -299,6 +299,11 @@ class ValidateApi(unittest.TestCase):
         self.assertGreater(fitted["petrol_rows"], 0)
         with self.assertRaises(rollsim.InputError):
             rollsim.validate(str(SHARED / "no_such_list.csv"))
+        # An empty path names its argument (it said ": file not found"; session 24).
+        with self.assertRaisesRegex(rollsim.InputError, "epa_test_car_list: an empty path is not allowed"):
+            rollsim.validate("")
+        with self.assertRaisesRegex(rollsim.InputError, r"recordings\[0\]: an empty path is not allowed"):
+            rollsim.diagnose(vehicle="twizy", recordings=[""], preset="rsk_twizy")
 
 
 class GilRelease(unittest.TestCase):

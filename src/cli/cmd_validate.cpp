@@ -97,7 +97,7 @@ void print_summary(const validate::Validation& v) {
   for (const auto& o : v.rows) {
     if (o.skip != validate::SkipReason::none) ++skipped[validate::to_string(o.skip)];
   }
-  std::cout << "skipped:\n";
+  std::cout << "skipped:" << (skipped.empty() ? " none" : "") << "\n";
   for (const auto& [why, n] : skipped) std::cout << "  " << n << "  " << why << "\n";
 }
 
@@ -184,9 +184,10 @@ void run_validate(const ValidateOptionsText& o, const ProcessGroup& group) {
   if (!o.plot.empty() && group.is_root()) plot(v, o.plot);
   if (o.json) {
     for (const auto& r : v.rows) std::cout << validate::row_json(r).str() << "\n";
-    return;
+  } else {
+    print_summary(v);
   }
-  print_summary(v);
+  for (const auto& w : validate::validation_warnings(v)) std::cerr << "warning: " << w << "\n";
 }
 
 }  // namespace

@@ -167,6 +167,11 @@ std::vector<EpaTestRow> read_epa_test_car_list(const std::string& path) {
   rows.reserve(t.rows.size());
   for (std::size_t i = 0; i < t.rows.size(); ++i) {
     const auto& cells = t.rows[i];
+    // Two lists joined with `cat` carry the second's header as a row, which was read as a test skipped for its
+    // procedure 'Test Procedure Description' (session 24's outside testing).
+    if (trim(cells[c_test]) == "Test Number" && trim(cells[c_proc]) == "Test Procedure Description")
+      throw InputError(path + ": line " + std::to_string(t.row_line[i]),
+                       "repeats the header (two lists joined?): remove the line, or give the lists one by one");
     EpaTestRow r;
     // A cell that is not a finite number leaves its field empty, and its text is kept for the skip to quote (a
     // weight of '4,500' was "empty or not a number" without the text: session 22's outside testing).

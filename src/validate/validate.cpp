@@ -147,6 +147,10 @@ std::string unusable_exhaust(const EpaTestRow& r) {
   for (const char* column : kExhaustColumns) {
     if (r.unusable.count(column)) return field_problem(r, column);
   }
+  // A blank CO2 is "not given"; a zero had been read so too (session 24's outside testing), but no engine burns fuel
+  // without it.
+  if (r.co2_g_per_mi && *r.co2_g_per_mi <= 0.0)
+    return std::string(kExhaustColumns[2]) + " " + format_value(*r.co2_g_per_mi) + " (an engine that burns fuel emits CO2)";
   return "";
 }
 
@@ -547,6 +551,8 @@ Validation validate_epa_list(const std::vector<EpaTestRow>& rows, unsigned threa
     const EpaFuel fuel = rows[i].fuel;
     const double scale = fuel == EpaFuel::electricity ? electric_scale : fuel == EpaFuel::diesel ? diesel_scale : petrol_scale;
     v.rows[i].predicted = nominal_prediction(i) * scale;
+    const std::size_t fitted_by = fuel == EpaFuel::electricity ? f.electric_rows : fuel == EpaFuel::diesel ? f.diesel_rows : f.petrol_rows;
+    v.rows[i].nominal_constants = fitted_by == 0 || (rows[i].cycle == EpaCycle::ftp75 && f.cold_start_rows == 0);
     if (rows[i].cycle != EpaCycle::ftp75) continue;
     const Raw& w = raw[i];
     v.rows[i].predicted_bag_mpg[0] = scale * miles(w.bag1_m) / gallons(bag1_cold_m3(w, f.defaults.cold_fuel_excess));

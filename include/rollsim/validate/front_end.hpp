@@ -11,6 +11,10 @@ namespace rollsim::validate {
 /// maker_calibrated_error_pct (and an FTP-75's predicted bags, the physics').
 JsonObject row_json(const RowOutcome& outcome);
 
+/// What the results rest on that a reader must know, one line each without "warning:": rows predicted with nominal
+/// constants.
+std::vector<std::string> validation_warnings(const Validation& v);
+
 /// The constants fitted on the fitting half and how many rows set each (a constant with none keeps its nominal
 /// value: its count is 0).
 JsonObject fitted_json(const FittedConstants& fitted);

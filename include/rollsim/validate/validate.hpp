@@ -35,6 +35,9 @@ struct RowOutcome {
   /// The maker calibration's factor on `predicted` (maker_calibration.hpp): learned on the fitting half, and for a
   /// fitting-half row without its own model's rows; 1 where the fitting half has no other car of its make and cycle.
   double maker_factor = 1.0;
+  /// Its fuel's constant (or an FTP's cold-start excess) had no fitting-half row to fit it: predicted with the
+  /// nominal value, so its error judges no fitted model.
+  bool nominal_constants = false;
   double error_pct() const { return 100.0 * (predicted / measured - 1.0); }
   double maker_calibrated_error_pct() const { return 100.0 * (maker_factor * predicted / measured - 1.0); }
 };
