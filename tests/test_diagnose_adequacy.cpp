@@ -145,6 +145,13 @@ TEST(DiagnoseAdequacy, DutyCycledCompressorIsAnAuxLoadNotAScale) {
   EXPECT_EQ(d.findings.front().effect, "aux_load") << diagnosis_text(d);
   EXPECT_NEAR(d.findings.front().parameters.front().value, 1500.0, 300.0) << diagnosis_text(d);
   EXPECT_LE(d.channel_scale, 1.05 + 1e-9);
+  // The calibration beside the finding is the truth's (scale 1, RRC and C unchanged), and nothing says that no
+  // catalogue effect explains what the finding explains (session 24's outside testing: said beside aux_load 302 W).
+  EXPECT_NEAR(d.channel_scale_with_findings, 1.0, 0.02) << diagnosis_text(d);
+  EXPECT_NEAR(d.rrc_level_change_with_findings, 0.0, 0.05) << diagnosis_text(d);
+  const std::string text = diagnosis_text(d);
+  EXPECT_EQ(text.find("No catalogue effect alone explains"), std::string::npos) << text;
+  EXPECT_NE(text.find("; beside them: channel scale"), std::string::npos) << text;
 }
 
 TEST(DiagnoseAdequacy, RisingRrcIsNeverCalledTyreWarmupNorANegativeEffect) {

@@ -99,7 +99,8 @@ Calibration calibrate(const Observations& o, const Variant& base, const Variant&
 
 // What the boxes leave, and which catalogue effects could take a level error of that size: an effect whose
 // signature alone explains at least 80 % of it with an amplitude inside its bounds.
-std::string calibration_outside_prior_text(const Calibration& c, const Observations& o, const std::vector<Candidate>& cands) {
+std::string calibration_outside_prior_text(const Calibration& c, const Observations& o, const std::vector<Candidate>& cands,
+                                           bool with_explanations) {
   const Eigen::VectorXd left = c.model.x * (c.free_coef - c.model.fit.coef);
   const double s = c.model.fit.coef[0];
   std::string could;
@@ -119,8 +120,10 @@ std::string calibration_outside_prior_text(const Calibration& c, const Observati
          fixed(100.0 * 0.1 * f[1] / f[0], 0) + " % and aero C " + fixed(100.0 * 0.1 * f[2] / f[0], 0) + " %" +
          (beyond.empty() ? std::string() : ", beyond the box: " + beyond) + " (Delta BIC " + fixed(c.dbic_leave, 1) + " for leaving its prior: " +
          (c.sure ? "this data is sure of it" : "this data alone cannot tell") + "); it would have absorbed " +
-         fixed(100.0 * c.absorbed_j / std::max(1e-9, std::abs(o.measured_j.sum())), 1) + " % of the measured energy. " +
-         (could.empty() ? std::string("No catalogue effect alone explains that energy: a drive efficiency, usable capacity "
+         fixed(100.0 * c.absorbed_j / std::max(1e-9, std::abs(o.measured_j.sum())), 1) + " % of the measured energy" +
+         (!with_explanations ? std::string() : ". ") +
+         (!with_explanations ? std::string()
+          : could.empty() ? std::string("No catalogue effect alone explains that energy: a drive efficiency, usable capacity "
                                       "or consumer the model lacks")
                         : "Effects that could explain it, not separable from each other on this data: " + could +
                               " (to separate: log a long standstill, steady-speed runs at two speeds and the route both ways)");

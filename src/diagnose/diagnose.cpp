@@ -371,10 +371,20 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
     out.findings.push_back(std::move(f));
   } else if (cal.at_bound) {
     // Beyond the bound with findings, they take what the calibration would have absorbed (the note said "not
-    // significantly beyond it" beside a Delta BIC the data was sure of).
-    out.notes.push_back((cal.outside_prior ? "calibration beyond its prior's bound, beside the findings: "
+    // significantly beyond it" beside a Delta BIC the data was sure of). With findings, the calibration is said as
+    // it reads beside them: the note had said "no catalogue effect alone explains that energy" beside an aux_load
+    // found at its true 300 W (session 24's outside testing).
+    const bool found = !out.findings.empty();
+    out.notes.push_back((cal.outside_prior ? "calibration beyond its prior's bound before the findings: "
                                            : "calibration at its prior's bound, not significantly beyond it: ") +
-                        calibration_outside_prior_text(cal, obs, sig.candidates));
+                        calibration_outside_prior_text(cal, obs, sig.candidates, !found) +
+                        (found ? "; beside the findings it is as the calibration line says" : ""));
+  }
+  if (!out.findings.empty()) {
+    const Eigen::VectorXd& k = m.fit.coef;
+    out.channel_scale_with_findings = k[0];
+    out.rrc_level_change_with_findings = 0.1 * k[1] / k[0];
+    out.drag_change_with_findings = 0.1 * k[2] / k[0];
   }
   out.verdict = out.findings.empty() ? "nothing_missing"
                 : out.findings.front().confounded_with.empty() ? "missing_physics" : "confounded";

@@ -375,7 +375,8 @@ Finding adequacy_finding(const Adequacy& a, const NoiseFloor& nf, const Observat
 namespace rollsim::diag {
 NoiseFloor calibrated_noise_floor(const Observations& o, const std::vector<Recording>& recs, const Signatures& s,
                                   const Calibration& cal, double lag_samples, const DiagnoseOptions& opt);
-std::string calibration_outside_prior_text(const Calibration& c, const Observations& o, const std::vector<Candidate>& cands);
+std::string calibration_outside_prior_text(const Calibration& c, const Observations& o, const std::vector<Candidate>& cands,
+                                           bool with_explanations = true);
 }  // namespace rollsim::diag
 namespace rollsim::diag {
 Eigen::VectorXd per_recording_residual(const Model& m, const Observations& o, std::size_t recordings);

@@ -141,7 +141,8 @@ void limits_table(std::ostream& os, const Diagnosis& d) {
     return;
   }
   os << "<p>For each catalogue effect not found: the smallest size of its catalogue shape this data would have shown "
-        "(a lower bound: a real effect's shape differs, and the discovery benchmark measures 1-3 times these).</p>\n"
+        "(an estimate, not a bound: real shapes differ, and the discovery benchmark needs 1-3 times these; a smaller one "
+        "may still be found).</p>\n"
         "<div class=\"scroll\"><table>\n<thead><tr><th>Effect</th><th>Parameter</th><th>Smallest detectable</th><th>Unit</th>"
         "<th>Within its physical bounds</th></tr></thead>\n<tbody>\n";
   for (const auto& l : d.detection_limits)

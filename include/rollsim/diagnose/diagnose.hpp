@@ -3,6 +3,7 @@
 
 #include <limits>
 #include <optional>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -212,6 +213,10 @@ struct Diagnosis {
   /// the energy it would have absorbed is left for the effects (and reported in a finding).
   double channel_scale_prior_low = 0.0, channel_scale_prior_high = 0.0;
   double channel_scale_free = 1.0, rrc_level_change_free = 0.0, drag_change_free = 0.0;  ///< without the boxes
+  /// The calibration refitted beside the findings (NaN without findings): what the channel scale, RRC level and aero C
+  /// read once the findings take their share, where the fields above are the calibration before them.
+  double channel_scale_with_findings = std::nan(""), rrc_level_change_with_findings = std::nan(""),
+         drag_change_with_findings = std::nan("");
   double calibration_delta_bic_leaving_prior = 0.0;  ///< free against boxed calibration
   /// A box is active and the data significantly want out of it; `calibration_beyond_prior` names which of
   /// "channel_scale", "rrc_level" and "drag" the free calibration puts beyond its box.
