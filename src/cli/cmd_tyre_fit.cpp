@@ -226,7 +226,7 @@ void run_evaluate(const std::string& path, const std::string& held_out_path, con
   // Judged on a tyre it was fitted on, the table's "none of the tyres below" would be false.
   for (const auto& h : judged)
     for (const auto& s : sets)
-      if (h.name == s.name || (h.alpha == s.alpha && h.beta == s.beta && h.a == s.a && h.b == s.b && h.c == s.c))
+      if (same_j2452_tyre(h, s))
         throw InputError("--held-out-j2452 " + held_out_path, "the set " + h.name + " is also in " + path + " (" + s.name +
                                                                   "): a held-out tyre must not be one the constants are fitted on");
   const J2452Evaluation ev = held_out ? evaluate_j2452_held_out(sets, judged, drum) : evaluate_j2452(sets, drum);

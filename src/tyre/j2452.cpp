@@ -88,6 +88,10 @@ J2452Set parse_j2452_text(const std::string& text, const std::string& where) {
   return s;
 }
 
+bool same_j2452_tyre(const J2452Set& a, const J2452Set& b) {
+  return a.name == b.name || (a.alpha == b.alpha && a.beta == b.beta && a.a == b.a && a.b == b.b && a.c == b.c);
+}
+
 std::vector<J2452Set> load_j2452_csv(const std::string& path) {
   const CsvTable t = read_csv(path);
   auto col = [&](const char* name) {
@@ -117,8 +121,7 @@ std::vector<J2452Set> load_j2452_csv(const std::string& path) {
     // repeated row read 2.15 % where its leave-one-out figure is 2.35 %).
     for (std::size_t j = 0; j < out.size(); ++j) {
       const J2452Set& o = out[j];
-      const bool same_coefficients = o.alpha == s.alpha && o.beta == s.beta && o.a == s.a && o.b == s.b && o.c == s.c;
-      if (o.name == s.name || same_coefficients)
+      if (same_j2452_tyre(o, s))
         throw InputError(t.file + ": line " + std::to_string(t.row_line[i]),
                          "the set " + s.name + (o.name == s.name ? " is" : "'s coefficients are") + " also on line " +
                              std::to_string(t.row_line[j]) + " (" + o.name + "): give each tyre once");

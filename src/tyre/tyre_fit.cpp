@@ -3,8 +3,8 @@
 #include "rollsim/common/json.hpp"
 #include "rollsim/tyre/j2452.hpp"
 
-#include <array>
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <cstdio>

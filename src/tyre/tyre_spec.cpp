@@ -336,7 +336,7 @@ TyreSize parse_tyre_size(const std::string& designation, const std::string& wher
   if (rim.empty()) return fail("missing rim diameter in inches");
   if (rim.size() > 5) return fail("rim diameter " + rim.substr(0, 8) + "... in is outside 8..30 in");
   // "R16C": a commercial (van) tyre. Read as a speed symbol it had been refused as "more than one speed symbol".
-  if (c.i + 1 <= text.size() && text.compare(c.i, 1, "C") == 0 &&
+  if (c.i < text.size() && text[c.i] == 'C' &&
       (c.i + 1 == text.size() || text[c.i + 1] == ' ' || text[c.i + 1] == '\t' || text[c.i + 1] == '('))
     ++c.i, out.commercial = true;
 

@@ -1,9 +1,9 @@
 // Diagnosis of a recording against the model: locate the mismatch, name the missing catalogue effect, fit it.
 #pragma once
 
+#include <cmath>
 #include <limits>
 #include <optional>
-#include <cmath>
 #include <string>
 #include <vector>
 

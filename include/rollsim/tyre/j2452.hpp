@@ -33,6 +33,9 @@ double drum_to_flat_factor(double drum_radius_m, double tyre_radius_m);
 /// Flat-road RRC of the set at a point (SI in, kPa and km/h inside the law).
 double j2452_flat_rrc(const J2452Set& set, double pressure_pa, double load_n, double speed_mps, double drum_radius_m);
 
+/// One tyre given twice: the same name (size and class) or the same five coefficients.
+bool same_j2452_tyre(const J2452Set& a, const J2452Set& b);
+
 /// Parses "ALPHA,BETA,A,B,C" (--j2452); throws InputError(where, ...) naming the field.
 J2452Set parse_j2452_text(const std::string& text, const std::string& where);
 
