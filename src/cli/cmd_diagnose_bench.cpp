@@ -61,6 +61,7 @@ void register_diagnose_bench_command(CLI::App& app, const ProcessGroup& group) {
     for (const auto& path : o->real_traces) b.real_traces.push_back(cycle_of_recording(load_recording(path, mapping)));
     b.progress = group.is_root() && isatty(STDERR_FILENO) != 0;
     b.map_cases = group.mapper();
+    b.ranks = group.size();
     std::cout << bench_text(run_discovery_bench(v, b));
   });
 }

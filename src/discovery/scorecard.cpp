@@ -398,6 +398,7 @@ BenchResult run_discovery_bench(const Vehicle& vehicle, const BenchOptions& opt)
 
   BenchResult res;
   res.threads = threads;
+  res.ranks = opt.ranks;
   const std::size_t nt = sparse_thresholds().size();
   for (const auto& c : cases) {
     BenchRow row;
@@ -574,7 +575,9 @@ std::string bench_text(const BenchResult& r) {
       line(num(r.sparse_summary[t].threshold) + (static_cast<int>(t) == r.sparse_best ? " (best)" : ""), r.sparse_summary[t]);
     line("BIC per recording", r.sparse_bic_summary);
   }
-  os << "\n" << std::fixed << std::setprecision(1) << r.seconds << " s on " << r.threads << (r.threads == 1 ? " thread\n" : " threads\n") << std::defaultfloat;
+  // Under mpirun the threads are each rank's: "on 2 threads" hid the other ranks (session 23's notes).
+  os << "\n" << std::fixed << std::setprecision(1) << r.seconds << " s on " << r.threads << (r.threads == 1 ? " thread" : " threads")
+     << (r.ranks > 1 ? " on each of " + std::to_string(r.ranks) + " MPI ranks\n" : std::string("\n")) << std::defaultfloat;
   return os.str();
 }
 

@@ -23,7 +23,7 @@ same() {  # same NAME ARGS...: serial and two-rank stdout identical, both exit 0
     echo "FAIL $name: exit serial $s, mpirun $m"; cat "$work/serial.err" "$work/mpi.err"; failed=1; return
   fi
   # diagnose-bench's last line is its own wall time, which no two runs share.
-  if [ "$name" = diagnose-bench ]; then sed -i '$d' "$work/serial.out" "$work/mpi.out"; fi
+  if [ "$name" = diagnose-bench ]; then tail -1 "$work/mpi.out" > "$work/mpi.last"; sed -i '$d' "$work/serial.out" "$work/mpi.out"; fi
   if cmp -s "$work/serial.out" "$work/mpi.out" && [ -s "$work/serial.out" ]; then
     echo "ok   $name ($(wc -l < "$work/serial.out") lines identical)"
   else
@@ -39,6 +39,9 @@ same compare-replay compare --vehicle ev --catalogue --replay --csv
 same validate validate --epa-test-car-list "$work/epa100.csv" --json
 same fleet diagnose --fleet "$work/fleet.csv"
 same diagnose-bench diagnose-bench --quick --seeds 1 --null-seeds 1
+# ... and that line counts the ranks beside each one's threads ("on 2 threads" hid them: session 23's notes).
+if grep -q "threads* on each of 2 MPI ranks$" "$work/mpi.last"; then echo "ok   diagnose-bench names its ranks"
+else echo "FAIL diagnose-bench's time line: $(cat "$work/mpi.last")"; failed=1; fi
 # The forward sweep, written to a file by rank 0 alone: the serial stdout's bytes.
 args=(sweep --tyre nominal --vehicle ev --cycle nedc --param pressure --from 2 --to 3 --steps 4)
 "$rollsim" "${args[@]}" > "$work/s.csv"

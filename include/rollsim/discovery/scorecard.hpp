@@ -27,6 +27,7 @@ struct BenchOptions {
   bool infer_road_profile = true;  ///< diagnose with the road_profile stage (DiagnoseOptions), on every row
   /// How the recordings are spread (over MPI ranks by the CLI); empty = this process's threads.
   CaseMap map_cases;
+  int ranks = 1;           ///< how many processes map_cases spreads over (said beside the threads)
 };
 
 /// How one method fared on one case, over its seeds.
@@ -107,7 +108,8 @@ struct BenchResult {
   std::vector<SparseThresholdSummary> sparse_summary;  ///< per sparse_thresholds() entry
   SparseThresholdSummary sparse_bic_summary;
   double seconds = 0.0;
-  unsigned threads = 1;
+  unsigned threads = 1;  ///< per rank
+  int ranks = 1;
 };
 
 /// Runs the cases on `vehicle` (electric: battery power and SOC channels) and, for the fuel-channel cases, on
