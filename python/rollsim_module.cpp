@@ -513,7 +513,7 @@ py::dict api_tyre_fit(py::object size_arg, py::object points, py::object label, 
   }
   // The command line's --measured: the same loader, so the same columns and the same errors naming file and line.
   if (!measured_path.empty()) {
-    for (auto& p : load_measured_rrc_csv(measured_path)) in.points.push_back(p);
+    for (auto& p : load_measured_rrc_csv(measured_path, &in.notes)) in.points.push_back(p);
   }
   if (!label.is_none()) in.label_class = arg_as<std::string>(label, "label", "a class 'A'..'E'");
   if (!j2452.is_none()) {

@@ -790,6 +790,13 @@ TEST(CliTyreFit, MeasuredCsvFitsAndTooFewPointsIsNamed) {
   EXPECT_EQ(few.exit_code, 2);
   EXPECT_TRUE(has(few.err, "too few points")) << few.err;
   EXPECT_TRUE(has(few.err, "2 or more loads")) << few.err;
+  EXPECT_FALSE(has(r.err, "not read")) << r.err;
+  // A column the fit does not read is said (a temperature_c changed nothing without a word: session 24).
+  const auto extra = temp_dir() / "measured_extra.csv";
+  std::ofstream(extra) << "pressure_kpa,load_n,speed_kmh,rrc,temperature_c\n210,4000,50,0.0090,25\n210,4000,80,0.0095,25\n";
+  const CmdResult t = fit("--size '205/55 R16 91V' --measured '" + extra.string() + "' --output '" + out.string() + "'");
+  ASSERT_EQ(t.exit_code, 0) << t.err;
+  EXPECT_TRUE(has(t.err, "measured_extra.csv: column(s) 'temperature_c' not read")) << t.err;
 }
 
 TEST(CliTyreFit, BadInputGetsOneNamedErrorAndNoFile) {

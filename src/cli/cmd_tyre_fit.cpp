@@ -264,7 +264,7 @@ void run_fit(const FitOptions& o) {
   const TyreSize& size = in.size;
   for (const auto& p : o.points) in.points.push_back(parse_point(p, size));
   if (!o.measured.empty()) {
-    for (auto& p : load_measured_rrc_csv(o.measured)) in.points.push_back(p);
+    for (auto& p : load_measured_rrc_csv(o.measured, &in.notes)) in.points.push_back(p);
   }
   if (!o.label.empty()) {
     in.label_class = o.label;

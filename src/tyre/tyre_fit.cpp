@@ -421,7 +421,7 @@ RrcPoint rrc_point_from_file_units(double pressure_kpa, double load_n, double sp
   return {pressure_kpa * 1e3, load_n, units::kmh_to_mps(speed_kmh), rrc, std::move(where)};
 }
 
-std::vector<RrcPoint> load_measured_rrc_csv(const std::string& path) {
+std::vector<RrcPoint> load_measured_rrc_csv(const std::string& path, std::vector<std::string>* unread) {
   const CsvTable t = read_csv(path);
   const char* kCols[] = {"pressure_kpa", "load_n", "speed_kmh", "rrc"};
   std::size_t col[4];
@@ -433,6 +433,11 @@ std::vector<RrcPoint> load_measured_rrc_csv(const std::string& path) {
     }
     col[k] = *c;
   }
+  std::string others;
+  for (std::size_t c = 0; c < t.header.size(); ++c)
+    if (std::find(std::begin(col), std::end(col), c) == std::end(col)) others += (others.empty() ? "'" : ", '") + t.header[c] + "'";
+  if (unread && !others.empty())
+    unread->push_back(path + ": column(s) " + others + " not read: the fit reads pressure_kpa, load_n, speed_kmh and rrc");
   std::vector<RrcPoint> out;
   for (std::size_t i = 0; i < t.rows.size(); ++i) {
     double v[4];

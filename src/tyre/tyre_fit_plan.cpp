@@ -49,6 +49,7 @@ TyreFitPlan plan_tyre_fit(const TyreFitInputs& in) {
   // The tyre file's own rule for the size's class, so that the file reproduces its points (50-600 kPa for any tyre
   // took 50 kPa for a passenger tyre, whose file then refused it, and refused a light-truck tyre's 655 kPa).
   for (const auto& p : plan.request.points) check_pressure_plausible_kpa(p.pressure_pa / 1e3, in.size, p.where);
+  for (const auto& n : in.notes) plan.warnings.push_back(n);
   // A point loaded past the size's rating is allowed but said, as `rollsim tyre` says it (session 22).
   if (in.size.load_index) {
     const double rated_n = *load_index_max_load_kg(*in.size.load_index) * units::kStandardGravity_mps2;

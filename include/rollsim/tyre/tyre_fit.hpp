@@ -125,8 +125,10 @@ RrcPoint rrc_point_from_file_units(double pressure_kpa, double load_n, double sp
 
 /// Measured points from a CSV with columns pressure_kpa, load_n, speed_kmh, rrc (`rollsim tyre fit --measured`),
 /// each named by its file and line for the fit's errors. Throws InputError naming the file, line and column of a
-/// cell that is not a number, a missing column, or a file without data rows; ranges are the fit's to check.
-std::vector<RrcPoint> load_measured_rrc_csv(const std::string& path);
+/// cell that is not a number, a missing column, or a file without data rows; ranges are the fit's to check. Other
+/// columns are not read, and `unread`, when given, receives a line saying so (a temperature_c column changed nothing
+/// without a word: session 24's outside testing).
+std::vector<RrcPoint> load_measured_rrc_csv(const std::string& path, std::vector<std::string>* unread = nullptr);
 
 }  // namespace rollsim
 

@@ -24,6 +24,7 @@ struct TyreFitInputs {
   std::optional<double> uncertainty_pct;       ///< a point's relative scatter when no degrees of freedom remain
   std::string uncertainty_where = "rrc_uncertainty_pct";
   std::vector<HysteresisParam> free;           ///< empty: what the points determine
+  std::vector<std::string> notes;              ///< what reading the inputs left to say; the plan's warnings carry it
 };
 
 /// The fit to run and what a report needs beside it.
