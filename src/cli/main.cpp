@@ -15,7 +15,7 @@
 
 namespace {
 
-// Under mpirun every rank runs the same command on the same input; only rank 0 prints. Errors that every rank
+// Under mpirun every rank runs a distributed command (distributes_over_ranks) on the same input; only rank 0 prints. Errors that every rank
 // meets alike (bad input, a failed case: agreed collectively) are printed once, by rank 0; any other error may be
 // one rank's alone, so that rank names itself.
 // A message quotes what the user gave (a key, a column header, a value); a control character in it is shown as
@@ -74,6 +74,19 @@ std::string empty_option_value(int argc, char** argv) {
   return "";
 }
 
+// The commands that split their cases over MPI ranks (README, "Running on a cluster"). Every other command is one
+// computation: under mpirun it ran on every rank, each writing the same files (and a report's clean-up racing the
+// other rank's figures: session 23's notes), so it runs on rank 0 alone.
+bool distributes_over_ranks(int argc, char** argv) {
+  if (argc < 2) return false;
+  const std::string command = argv[1];
+  if (command == "sweep" || command == "compare" || command == "validate" || command == "diagnose-bench") return true;
+  if (command != "diagnose") return false;
+  for (int i = 2; i < argc; ++i)
+    if (std::string(argv[i]) == "--fleet" || std::string(argv[i]).rfind("--fleet=", 0) == 0) return true;
+  return false;
+}
+
 // Most commands' output is stdout: a write that failed there (a full disk, a closed stream) left a table or CSV cut
 // off mid-row with exit 0 (session 21's outside testing: `sweep > /dev/full`). Flushed and checked before exiting.
 int checked_stdout(const rollsim::ProcessGroup& group, int code) {
@@ -98,6 +111,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   const rollsim::ProcessGroup& group = *started;
+  if (!group.is_root() && !distributes_over_ranks(argc, argv)) return 0;
   if (!group.is_root()) {
     std::cout.rdbuf(nullptr);
     std::cerr.rdbuf(nullptr);

@@ -42,6 +42,16 @@ same diagnose-bench diagnose-bench --quick --seeds 1 --null-seeds 1
 # ... and that line counts the ranks beside each one's threads ("on 2 threads" hid them: session 23's notes).
 if grep -q "threads* on each of 2 MPI ranks$" "$work/mpi.last"; then echo "ok   diagnose-bench names its ranks"
 else echo "FAIL diagnose-bench's time line: $(cat "$work/mpi.last")"; failed=1; fi
+# A command that does not split its cases runs on rank 0 alone: its output as one process prints it, and a report
+# written once (two ranks each cleaning up the other's figures could leave it incomplete; session 23's notes).
+same simulate simulate --vehicle ev --tyre 155-70R19
+rm -rf "$work/report" "$work/report1"
+diag=(diagnose --vehicle camry_2018 --preset anl_d3 --recording "$camry/61811012_test_data.csv" --report)
+"$rollsim" "${diag[@]}" "$work/report1" > /dev/null 2>&1
+if "${mpirun[@]}" "$rollsim" "${diag[@]}" "$work/report" > "$work/diag.out" 2>&1 && [ -s "$work/report/report.html" ] &&
+   [ "$(ls "$work/report")" = "$(ls "$work/report1")" ]; then
+  echo "ok   diagnose --report under mpirun: $(ls "$work/report" | wc -l) files, as one process writes them"
+else echo "FAIL diagnose --report under mpirun"; tail -5 "$work/diag.out"; ls "$work/report" "$work/report1"; failed=1; fi
 # The forward sweep, written to a file by rank 0 alone: the serial stdout's bytes.
 args=(sweep --tyre nominal --vehicle ev --cycle nedc --param pressure --from 2 --to 3 --steps 4)
 "$rollsim" "${args[@]}" > "$work/s.csv"
