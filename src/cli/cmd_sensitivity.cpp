@@ -1,4 +1,5 @@
 // `rollsim sensitivity`: elasticities of RR power and of a car's energy or fuel per tyre parameter.
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <memory>
@@ -69,6 +70,12 @@ void run_sensitivity(const SensitivityOptionsText& o) {
   std::cout << "\n";
   if (vehicle) {
     std::cout << "(car: load = test mass, all wheel loads scaled together; diameter also changes the gearing)\n";
+    // The car runs at its own wheel loads whatever --load-n says, which the load row did not tell (session 24).
+    const AxleWheelLoads w = wheel_loads(vehicle->body, 0.0);
+    const double car_n = std::max(w.front_n, w.rear_n);
+    if (std::abs(s.load_n / car_n - 1.0) > 0.005)
+      std::cout << "(the car column is at the car's own wheel loads, heaviest " << fixed(car_n, 0) << " N; the tyre columns at "
+                << fixed(s.load_n, 0) << " N)\n";
   }
   for (const auto& w : selection::sensitivity_warnings(s)) std::cout << "WARNING: " << w << "\n";
 }
