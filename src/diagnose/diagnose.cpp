@@ -134,20 +134,25 @@ void set_engine_starts(std::vector<DriveCycle>& cycles, const std::vector<Record
 void choose_channel_sampling(diag::Replayer& rp, const diag::Observations& o, double scale_bound, diag::Variant& base,
                              diag::LagEstimate& lag, Diagnosis& out) {
   diag::ChannelPowers both = rp.both_samplings({});
-  lag = diag::estimate_lag(both.interval_mean, o, nullptr, scale_bound);
-  base.power_w = std::move(both.interval_mean);
-  if (o.channel == ChannelKind::soc) return;
+  lag = diag::estimate_lag(both.interval_mean, o);
+  if (o.channel == ChannelKind::soc) {
+    base.power_w = std::move(both.interval_mean);
+    return;
+  }
   // The choice is made as it was tuned (200 interval-mean nulls): each reading's lag by linear interpolation. Read
   // within their segments here, instants fitted interval-mean recordings with a concealed regen cap 1.06-1.10 x better.
-  const diag::LagEstimate point_lag = diag::estimate_lag(both.instantaneous, o, nullptr, scale_bound);
+  const diag::LagEstimate point_lag = diag::estimate_lag(both.instantaneous, o);
   constexpr double kDecisiveSseRatio = 1.05;
   // Compared at each reading's best scale within the calibration's box: a logger 3 % off in scale adds the same misfit
   // to both and had hidden a 1 Hz instantaneous logger's better fit (ratio 0.996 unscaled; session 23's outside
   // testing). Not a free scale, nor an offset: a concealed effect then let the wrong reading fit better.
-  const bool instantaneous = point_lag.scaled_sse_w2 * kDecisiveSseRatio < lag.scaled_sse_w2;
+  const double mean_sse = diag::scaled_lag_sse(both.interval_mean, nullptr, o, lag.samples, scale_bound);
+  const double point_sse = diag::scaled_lag_sse(both.instantaneous, nullptr, o, point_lag.samples, scale_bound);
+  base.power_w = std::move(both.interval_mean);
+  const bool instantaneous = point_sse * kDecisiveSseRatio < mean_sse;
   out.channel_sampling = instantaneous ? "instantaneous" : "interval_mean";
   // Interval-mean SSE over the instant's: above 1 the instant fits better (chosen only beyond the decisive 1.05).
-  out.channel_sampling_sse_ratio = lag.scaled_sse_w2 / std::max(point_lag.scaled_sse_w2, 1e-300);
+  out.channel_sampling_sse_ratio = mean_sse / std::max(point_sse, 1e-300);
   if (!instantaneous) return;
   rp.point_values = true;
   // Chosen instants are then read within their segments: a fractional lag puts an instant between a segment's start
@@ -155,7 +160,7 @@ void choose_channel_sampling(diag::Replayer& rp, const diag::Observations& o, do
   // instantaneous logger with a 0.3-0.9 s lag had its lag read as whole samples and effects named on 13 of 20 nulls).
   // The ends are replayed only now that they are needed (point_values set: the replay records them).
   rp.sample({}, base);
-  lag = diag::estimate_lag(base.power_w, o, &base.end_w, scale_bound);
+  lag = diag::estimate_lag(base.power_w, o, &base.end_w);
 }
 
 void report_calibration(const diag::Calibration& c, const diag::Observations& o, const diag::LagEstimate& lag, Diagnosis& out) {

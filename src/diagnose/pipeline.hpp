@@ -95,12 +95,14 @@ struct LagEstimate {
   double samples = 0.0, low = 0.0, high = 0.0;
   double seconds = 0.0, low_s = 0.0, high_s = 0.0;
   double sse_w2 = 0.0;  ///< sum of squared sample residuals at the best lag
-  /// The same at the channel's best scale within the calibration's box (`scale_bound`): what tells two channel
-  /// samplings apart whatever a logger's scale error adds to both alike.
-  double scaled_sse_w2 = 0.0;
 };
 LagEstimate estimate_lag(const std::vector<std::vector<double>>& sim_w, const Observations& o,
-                         const std::vector<std::vector<double>>* end_w = nullptr, double scale_bound = 0.0);
+                         const std::vector<std::vector<double>>* end_w = nullptr);
+/// The squared sample residuals at `lag_samples` over estimate_lag's samples, with the channel at its best scale within
+/// [1 - scale_bound, 1 + scale_bound]: what tells two channel samplings apart whatever a logger's scale error adds to
+/// both alike.
+double scaled_lag_sse(const std::vector<std::vector<double>>& sim_w, const std::vector<std::vector<double>>* end_w,
+                      const Observations& o, double lag_samples, double scale_bound);
 
 // ---- engine start (engine_start.cpp) ---------------------------------------------------------------------------
 

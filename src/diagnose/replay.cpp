@@ -164,18 +164,31 @@ Eigen::VectorXd window_energies(const Variant& v, const Observations& o, double 
   return window_energies(v.power_w, o, lag_samples, v.end_w.empty() ? nullptr : &v.end_w);
 }
 
+namespace {
+double median_dt_s(const Observations& o) {
+  std::vector<double> dts(o.dt_s.front());
+  std::nth_element(dts.begin(), dts.begin() + static_cast<std::ptrdiff_t>(dts.size() / 2), dts.end());
+  return dts.empty() ? 1.0 : dts[dts.size() / 2];
+}
+// The longest lag searched, up to 10 samples or 3 s, whichever is longer (loggers lag by 0.3-1.7 s; at 10 Hz that is
+// 17 samples); every lag is scored on the samples from there on.
+int max_lag_samples(double dt_s) { return std::max(10, static_cast<int>(std::ceil(3.0 / dt_s))); }
+}  // namespace
+
+double scaled_lag_sse(const std::vector<std::vector<double>>& sim_w, const std::vector<std::vector<double>>* end_w,
+                      const Observations& o, double lag_samples, double scale_bound) {
+  return scaled_sse(sim_w, end_w, o, lag_samples, static_cast<std::size_t>(max_lag_samples(median_dt_s(o))), scale_bound);
+}
+
 // Whole samples first, then 0.05-sample steps about the best; the interval is where the per-sample criterion
 // n_eff ln(SSE / SSE_min) stays under 3.84, n_eff from the residual's lag-1 autocorrelation (AR(1)).
 LagEstimate estimate_lag(const std::vector<std::vector<double>>& sim_w, const Observations& o,
-                         const std::vector<std::vector<double>>* end_w, double scale_bound) {
+                         const std::vector<std::vector<double>>* end_w) {
   LagEstimate l;
   if (o.channel == ChannelKind::soc) return l;
   l.estimated = true;
-  std::vector<double> dts(o.dt_s.front());
-  std::nth_element(dts.begin(), dts.begin() + static_cast<std::ptrdiff_t>(dts.size() / 2), dts.end());
-  const double dt = dts.empty() ? 1.0 : dts[dts.size() / 2];
-  // Up to 10 samples or 3 s, whichever is longer (loggers lag by 0.3-1.7 s; at 10 Hz that is 17 samples).
-  const int max_lag = std::max(10, static_cast<int>(std::ceil(3.0 / dt)));
+  const double dt = median_dt_s(o);
+  const int max_lag = max_lag_samples(dt);
   int best_whole = 0;
   double best = 1e300;
   for (int lag = 0; lag <= max_lag; ++lag) {
@@ -190,7 +203,6 @@ LagEstimate estimate_lag(const std::vector<std::vector<double>>& sim_w, const Ob
   const std::size_t k = static_cast<std::size_t>(std::min_element(sse.begin(), sse.end()) - sse.begin());
   l.samples = grid[k];
   l.sse_w2 = sse[k];
-  l.scaled_sse_w2 = scaled_sse(sim_w, end_w, o, l.samples, static_cast<std::size_t>(max_lag), scale_bound);
   // The residual's autocorrelation at the best lag sets how much independent information the samples carry.
   double num = 0.0, den = 0.0, count = 0.0;
   for (std::size_t ri = 0; ri < sim_w.size(); ++ri) {
