@@ -221,7 +221,8 @@ void check_options(const TyreSpec& tyre, const SweepOptions& o) {
     // where the pressure's unit slips were already refused (session 24's outside testing).
     if (p == SweepParam::Width || p == SweepParam::Diameter) {
       const bool width = p == SweepParam::Width;
-      const Range road_tyre_mm = width ? Range::closed(80.0, 500.0) : Range::closed(300.0, 2500.0);
+      const Range road_tyre_mm = width ? Range::closed(kRoadTyreWidthMin_m * 1e3, kRoadTyreWidthMax_m * 1e3)
+                                       : Range::closed(kRoadTyreDiameterMin_m * 1e3, kRoadTyreDiameterMax_m * 1e3);
       const std::string key = "--param " + sweep_param_key(p);
       for (const auto& [v, end] : {std::pair{o.axes[i].from, " --from"}, std::pair{o.axes[i].to, " --to"}})
         check_physical(v, road_tyre_mm, "mm", "no road tyre measures that", {{"m", 1e3}, {"cm", 10.0}, {"inches", 25.4}},

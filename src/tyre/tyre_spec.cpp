@@ -41,12 +41,21 @@ constexpr std::array<double, 151> kLoadIndexKg = {
     3350};                                                       // 150
 constexpr int kLastLoadIndex = kFirstLoadIndex + static_cast<int>(kLoadIndexKg.size()) - 1;
 
-// Speed symbols of ISO 4000-1 / ETRTO (A1..A8 are for special vehicles and accepted too).
-bool is_speed_symbol(const std::string& s) {
-  static const std::string kLetters = "BCDEFGJKLMNPQRSTUHVWYZ";
-  if (s.size() == 1) return kLetters.find(s[0]) != std::string::npos;
-  return s.size() == 2 && s[0] == 'A' && s[1] >= '1' && s[1] <= '8';
+// Speed symbols of ISO 4000-1 / ETRTO and the speed each rates a tyre for (A1..A8 are for special vehicles and accepted
+// too); Z ("above 240 km/h") has no figure of its own.
+constexpr std::pair<const char*, double> kRatedKmh[] = {
+    {"A1", 5},  {"A2", 10}, {"A3", 15}, {"A4", 20}, {"A5", 25}, {"A6", 30}, {"A7", 35}, {"A8", 40},
+    {"B", 50},  {"C", 60},  {"D", 65},  {"E", 70},  {"F", 80},  {"G", 90},  {"J", 100}, {"K", 110},
+    {"L", 120}, {"M", 130}, {"N", 140}, {"P", 150}, {"Q", 160}, {"R", 170}, {"S", 180}, {"T", 190},
+    {"U", 200}, {"H", 210}, {"V", 240}, {"W", 270}, {"Y", 300}};
+
+std::optional<double> rated_kmh(const std::string& upper_symbol) {
+  for (const auto& [name, kmh] : kRatedKmh)
+    if (upper_symbol == name) return kmh;
+  return std::nullopt;
 }
+
+bool is_speed_symbol(const std::string& s) { return s == "Z" || rated_kmh(s).has_value(); }
 
 std::string upper(std::string s) {
   for (auto& c : s) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
@@ -285,15 +294,8 @@ std::optional<double> load_index_max_load_kg(int load_index) {
 }
 
 std::optional<double> speed_symbol_max_mps(const std::string& symbol) {
-  static const std::pair<const char*, double> kRatedKmh[] = {
-      {"A1", 5},  {"A2", 10}, {"A3", 15}, {"A4", 20},  {"A5", 25},  {"A6", 30},  {"A7", 35},  {"A8", 40},
-      {"B", 50},  {"C", 60},  {"D", 65},  {"E", 70},   {"F", 80},   {"G", 90},   {"J", 100},  {"K", 110},
-      {"L", 120}, {"M", 130}, {"N", 140}, {"P", 150},  {"Q", 160},  {"R", 170},  {"S", 180},  {"T", 190},
-      {"U", 200}, {"H", 210}, {"V", 240}, {"W", 270},  {"Y", 300}};
-  const std::string s = upper(symbol);
-  for (const auto& [name, kmh] : kRatedKmh)
-    if (s == name) return units::kmh_to_mps(kmh);
-  return std::nullopt;
+  const auto kmh = rated_kmh(upper(symbol));
+  return kmh ? std::optional(units::kmh_to_mps(*kmh)) : std::nullopt;
 }
 
 std::string speed_rating_warning(const TyreSpec& tyre, double speed_mps, const std::string& what) {
@@ -448,10 +450,15 @@ TyreSpec load_tyre(YamlMap y) {
   // another unit (outer_diameter_mm: 0.61 was blamed on load_index, as "98745 % of its section height": session 23).
   constexpr double kMmPerIn = 25.4;
   const std::string no_tyre = "no road tyre measures that";
-  if (radius) check_physical(*radius, Range::closed(0.15, 1.25), "m", no_tyre, {{"mm", 1e-3}, {"cm", 1e-2}, {"inches", kMmPerIn * 1e-3}}, y.where("outer_radius_m"));
+  if (radius)
+    check_physical(*radius, Range::closed(kRoadTyreDiameterMin_m / 2.0, kRoadTyreDiameterMax_m / 2.0), "m", no_tyre,
+                   {{"mm", 1e-3}, {"cm", 1e-2}, {"inches", kMmPerIn * 1e-3}}, y.where("outer_radius_m"));
   if (measured_d_mm)
-    check_physical(*measured_d_mm, Range::closed(300.0, 2500.0), "mm", no_tyre, {{"m", 1e3}, {"cm", 10.0}, {"inches", kMmPerIn}}, y.where("outer_diameter_mm"));
-  if (width) check_physical(*width, Range::closed(0.08, 0.5), "m", no_tyre, {{"mm", 1e-3}, {"cm", 1e-2}, {"inches", kMmPerIn * 1e-3}}, y.where("section_width_m"));
+    check_physical(*measured_d_mm, Range::closed(kRoadTyreDiameterMin_m * 1e3, kRoadTyreDiameterMax_m * 1e3), "mm", no_tyre,
+                   {{"m", 1e3}, {"cm", 10.0}, {"inches", kMmPerIn}}, y.where("outer_diameter_mm"));
+  if (width)
+    check_physical(*width, Range::closed(kRoadTyreWidthMin_m, kRoadTyreWidthMax_m), "m", no_tyre,
+                   {{"mm", 1e-3}, {"cm", 1e-2}, {"inches", kMmPerIn * 1e-3}}, y.where("section_width_m"));
   if (measured_d_mm) g.outer_radius_m = *measured_d_mm * units::kMPerMm / 2.0;
   if (!(g.rim_radius_m < g.outer_radius_m)) {
     const std::string key = rim_in ? "rim_diameter_in" : rim_r ? "rim_radius_m" : "outer_diameter_mm";

@@ -40,6 +40,11 @@ double iso28580_passenger_pressure_pa(const TyreSize& size);
 /// Maximum load [kg] of an ETRTO/ISO load index; std::nullopt outside the table (indices 60..125 at least).
 std::optional<double> load_index_max_load_kg(int load_index);
 
+/// What a road tyre measures, from a quadricycle's 12-inch wheel to a lorry's 22.5-inch one: a value outside was typed
+/// in another unit. One range for a tyre file's geometry and a sweep's width and diameter.
+inline constexpr double kRoadTyreWidthMin_m = 0.08, kRoadTyreWidthMax_m = 0.5;
+inline constexpr double kRoadTyreDiameterMin_m = 0.3, kRoadTyreDiameterMax_m = 2.5;
+
 /// The speed [m/s] a speed symbol rates the tyre for (ISO 4000-1 / ETRTO: Q 160 km/h, H 210, V 240, Y 300);
 /// std::nullopt for Z ("above 240 km/h", no upper figure) and for what is not a symbol.
 std::optional<double> speed_symbol_max_mps(const std::string& symbol);
