@@ -1,14 +1,22 @@
 // Hostile and careless input (issue 11): shell text in names, duplicate keys, misleading or unnamed errors,
 // outputs left behind on failure. Each test failed before its fix.
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <tuple>
 
+#include "rollsim/common/atomic_file.hpp"
 #include "rollsim/common/text.hpp"
 #include "test_support.hpp"
 
@@ -477,6 +485,44 @@ TEST_F(Hardening, NoEscapeSequenceReachesTheTerminal) {
   EXPECT_EQ(message.exit_code, 2);
   EXPECT_FALSE(has(message.err, "\x1b")) << message.err;
   EXPECT_TRUE(has(message.err, "unknown column '\\x1B[31mgrade'")) << message.err;
+}
+
+// A SIGTERM while the outputs are written leaves neither the output nor its temporary (session 24's note: the
+// temporary was left). The second output is a pipe nobody reads yet, so the writer waits inside the write, its first
+// output's temporary already made, while the signal is sent; then the pipe is read and the writer goes on.
+TEST_F(Hardening, ASignalDuringTheWriteLeavesNoTemporary) {
+  const fs::path file = dir_ / "out.csv";
+  const fs::path fifo = dir_ / "pipe";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    try {
+      write_files_atomically({{file.string(), "--output", "a,b\n1,2\n"}, {fifo.string(), "--json", "{}\n"}});
+    } catch (...) {
+      ::_exit(3);
+    }
+    ::_exit(0);
+  }
+  auto temporaries = [&] {
+    int n = 0;
+    for (const auto& e : fs::directory_iterator(dir_)) n += e.path().filename().string().find(".tmp") != std::string::npos;
+    return n;
+  };
+  for (int i = 0; i < 500 && temporaries() == 0; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  ASSERT_EQ(temporaries(), 1) << "the writer never reached the pipe";
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));  // into its open() of the pipe
+  ASSERT_EQ(::kill(child, SIGTERM), 0);
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  const int reader = ::open(fifo.c_str(), O_RDONLY | O_NONBLOCK);  // lets a waiting writer on
+  ASSERT_GE(reader, 0);
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  ::close(reader);
+  ASSERT_TRUE(WIFSIGNALED(status)) << "exit status " << status;
+  EXPECT_EQ(WTERMSIG(status), SIGTERM);
+  EXPECT_FALSE(fs::exists(file));
+  EXPECT_EQ(temporaries(), 0);
 }
 
 }  // namespace

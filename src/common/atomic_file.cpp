@@ -1,7 +1,9 @@
 #include "rollsim/common/atomic_file.hpp"
 
+#include <pthread.h>
 #include <unistd.h>
 
+#include <csignal>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
@@ -78,6 +80,38 @@ fs::path temporary_for(const fs::path& target) {
   return folder_of(target.string()) / name;
 }
 
+// The signals that end a run from outside (Ctrl-C, kill, a closed terminal) are held while the outputs are written, so
+// that one arriving mid-write cannot leave a temporary behind (a SIGTERM during the write did: session 24's note).
+// Held, not handled: a handler would need the temporaries' names in a global. Only this thread's mask changes; the
+// threads a command starts are joined before it writes.
+class TerminationSignalsHeld {
+ public:
+  TerminationSignalsHeld() {
+    sigemptyset(&held_);
+    for (int s : {SIGINT, SIGTERM, SIGHUP, SIGQUIT}) sigaddset(&held_, s);
+    pthread_sigmask(SIG_BLOCK, &held_, &before_);
+  }
+  ~TerminationSignalsHeld() { pthread_sigmask(SIG_SETMASK, &before_, nullptr); }
+  TerminationSignalsHeld(const TerminationSignalsHeld&) = delete;
+  TerminationSignalsHeld& operator=(const TerminationSignalsHeld&) = delete;
+
+  // Whether a held signal would stop the run once let through: one that is ignored (nohup's SIGHUP) would not.
+  [[nodiscard]] bool stop_requested() const {
+    sigset_t pending;
+    if (sigpending(&pending) != 0) return false;
+    for (int s : {SIGINT, SIGTERM, SIGHUP, SIGQUIT}) {
+      if (sigismember(&held_, s) != 1 || sigismember(&before_, s) == 1 || sigismember(&pending, s) != 1) continue;
+      struct sigaction now {};
+      if (sigaction(s, nullptr, &now) == 0 && now.sa_handler != SIG_IGN) return true;
+    }
+    return false;
+  }
+
+ private:
+  sigset_t held_{};
+  sigset_t before_{};
+};
+
 }  // namespace
 
 void check_not_an_input(const std::string& path, const std::string& option, const std::vector<std::string>& inputs) {
@@ -137,6 +171,7 @@ void write_files_atomically(const std::vector<OutputFile>& files) {
   std::vector<Destination> dest;
   for (const auto& f : files) dest.push_back(destination_of(f.path));
   std::vector<fs::path> temporaries(files.size());
+  const TerminationSignalsHeld held;
   // Folders made here, deepest last: a failed write removes them too, so nothing is left (a failed diagnosis left
   // its --report folders behind: session 22's outside testing).
   std::vector<fs::path> created;
@@ -179,6 +214,12 @@ void write_files_atomically(const std::vector<OutputFile>& files) {
   // Devices and pipes last before the renames: a failure there still leaves no regular file written.
   for (std::size_t i = 0; i < files.size(); ++i)
     if (dest[i].in_place) put(files[i], dest[i].path, true);
+  // A stop asked for during the write is obeyed before any file is replaced: the signal, let through as `held` ends,
+  // then ends the run with nothing written (where it is caught instead, as by Python, the error says why).
+  if (!files.empty() && held.stop_requested()) {
+    discard();
+    throw InputError(where(files.front().option, files.front().path), "interrupted by a signal; nothing was written");
+  }
   for (std::size_t i = 0; i < files.size(); ++i) {
     if (dest[i].in_place) continue;
     std::error_code ec;

@@ -34,7 +34,9 @@ struct OutputFile {
 /// Writes every file to a temporary beside its target (creating missing folders; a symlink's target is the
 /// target, and a device or pipe is written in place), and only when all were written renames them into place.
 /// Any failure removes the temporaries and throws InputError naming the
-/// option and path: no output is left half-written, and none is written when another could not be.
+/// option and path: no output is left half-written, and none is written when another could not be. SIGINT, SIGTERM,
+/// SIGHUP and SIGQUIT are held meanwhile; one that arrived removes the temporaries before any rename, and then ends
+/// the run (or, where it is caught, throws InputError).
 void write_files_atomically(const std::vector<OutputFile>& files);
 
 /// One file, its content produced by `write` on a stream: write_files_atomically of a single output.
