@@ -263,6 +263,28 @@ TEST(TyreFile, PressureAndRatingArePlausibleForTheTyresClass) {
                                            "  stiffness_pressure_coeff: 0.00001\n"), "key 'load_index': a rated load of 500 kg"));
 }
 
+// The thesis' constants have ranges of their own: 1e300 for a damping printed negative RRCs, and for a stiffness read
+// as a rigid wheel that simulated 19 % less energy than the tyre, with or without a rated load (session 25).
+TEST(TyreFile, TheThesisConstantsHaveUpperBounds) {
+  const std::string head = "size: \"155/70 R19 84Q\"\npressure_bar: 2.5\nmodel:\n";
+  for (const char* key : {"viscous_damping_ns_per_m", "coulomb_damping_n", "rotational_drag_kg_per_m2"}) {
+    const std::string msg = load_error("damp", head + "  " + key + ": 1e300\n");
+    EXPECT_TRUE(contains(msg, std::string("model.") + key + "': 1e+300 is not allowed: must be in [0, ")) << msg;
+  }
+  for (const char* key : {"stiffness_pressure_coeff", "stiffness_offset_kgf_per_mm"}) {
+    const std::string msg = load_error("stiff", head + "  " + key + ": 1e300\n");
+    EXPECT_TRUE(contains(msg, std::string("model.") + key + "': the stiffness constants make the tyre")) << msg;
+    EXPECT_TRUE(contains(msg, "allowed 0.125 to 8 times")) << msg;
+  }
+  const std::string unrated = load_error("unrated", "outer_radius_m: 0.35\nsection_width_m: 0.155\npressure_bar: 2.5\nmodel:\n"
+                                                    "  stiffness_pressure_coeff: 1e300\n");
+  EXPECT_TRUE(contains(unrated, "times as stiff as the thesis' constants")) << unrated;
+  // Within the bounds a stiffer or softer tyre is a tyre: 3.6 and 1.3 times the thesis' stiffness.
+  EXPECT_EQ(load_error("stiffer", head + "  stiffness_pressure_coeff: 0.1\n"), "");
+  EXPECT_EQ(load_error("offset", head + "  stiffness_offset_kgf_per_mm: 10\n"), "");
+  EXPECT_EQ(load_error("damped", head + "  viscous_damping_ns_per_m: 5\n  coulomb_damping_n: 400\n  rotational_drag_kg_per_m2: 0.01\n"), "");
+}
+
 TEST(TyreFile, DeflectionReachingTheRimIsRejected) {
   // 175/70 R14: sidewall 122.5 mm; at 2.1 bar Kz is about 190 N/mm, so 30 kN deflects ~158 mm: past the rim
   // but still inside the outer radius (300 mm).

@@ -169,14 +169,18 @@ void read_model_map(YamlMap& m, TyreState& state) {
     for (const char* k : kThesisOnly) reject_other_kind(k);
   }
   auto& k = state.constants;
+  // The stiffness is bounded against the thesis' own (check_stiffness_constants). Each damping is bounded where it
+  // alone gives a passenger tyre at 4 kN an RRC of about 0.04 (Coulomb, at any speed), 0.006 (viscous) or 0.013
+  // (rotational drag) at 130 km/h, beyond any road tyre's: 5.5, 40 and 11 times the thesis' values. Unbounded,
+  // 1e300 printed negative RRCs and a CVODE failure (session 25).
   k.stiffness_pressure_coeff = opt_number(m, "stiffness_pressure_coeff", Range::positive()).value_or(k.stiffness_pressure_coeff);
   k.stiffness_offset_kgf_per_mm =
       opt_number(m, "stiffness_offset_kgf_per_mm", Range::non_negative()).value_or(k.stiffness_offset_kgf_per_mm);
   if (thesis) {
-    k.viscous_damping_ns_per_m = opt_number(m, "viscous_damping_ns_per_m", Range::non_negative()).value_or(k.viscous_damping_ns_per_m);
-    k.coulomb_damping_n = opt_number(m, "coulomb_damping_n", Range::non_negative()).value_or(k.coulomb_damping_n);
+    k.viscous_damping_ns_per_m = opt_number(m, "viscous_damping_ns_per_m", Range::closed(0.0, 20.0)).value_or(k.viscous_damping_ns_per_m);
+    k.coulomb_damping_n = opt_number(m, "coulomb_damping_n", Range::closed(0.0, 1000.0)).value_or(k.coulomb_damping_n);
     k.rotational_drag_kg_per_m2 =
-        opt_number(m, "rotational_drag_kg_per_m2", Range::non_negative()).value_or(k.rotational_drag_kg_per_m2);
+        opt_number(m, "rotational_drag_kg_per_m2", Range::closed(0.0, 0.04)).value_or(k.rotational_drag_kg_per_m2);
     if (auto n = opt_number(m, "elements", Range::closed(2, 1e6))) {
       if (*n != std::floor(*n) || static_cast<long>(*n) % 2 != 0) {
         throw InputError(m.where("elements"), format_value(*n) + " is not allowed: must be an even whole number >= 2");
@@ -237,6 +241,24 @@ void check_rating_against_index(double max_kg, const TyreSize& size, const std::
                               std::to_string(*size.load_index) + " rates it " + format_value(index_kg) + " kg: must be in [" +
                               significant(lo, 4) + ", " + significant(hi, 4) + "] kg" +
                               unit_slip_hint(max_kg, Range::closed(lo, hi), "kg", {{"N", 1.0 / units::kStandardGravity_mps2}, {"lb", kKgPerLb}, {"t", 1e3}}));
+}
+
+// Stiffness constants given in a file must leave the tyre within 8 times as stiff or as soft as the thesis' constants
+// make it (at the file's pressure): those deflect a tyre 15-25 % of its section height at its rating, as tyres do;
+// 8 times stiffer is under 3 %, a run-flat's sidewall included, and 8 times softer is past the rim. Unbounded, 1e300
+// read as a rigid wheel, 0.17 kg/t, and simulated 19 % less energy than the tyre (session 25). The bounds hold whether
+// or not the file rates a load.
+void check_stiffness_constants(const TyreState& state, const std::string& where) {
+  TyreState thesis = state;
+  thesis.constants.stiffness_pressure_coeff = TyreModelConstants{}.stiffness_pressure_coeff;
+  thesis.constants.stiffness_offset_kgf_per_mm = TyreModelConstants{}.stiffness_offset_kgf_per_mm;
+  const double kz = vertical_stiffness_n_per_m(state), kz_thesis = vertical_stiffness_n_per_m(thesis);
+  constexpr double kMaxRatio = 8.0;
+  if (kz <= kMaxRatio * kz_thesis && kz * kMaxRatio >= kz_thesis) return;
+  throw InputError(where, "the stiffness constants make the tyre " + significant(kz / kz_thesis, 3) + " times as stiff as the thesis' constants do (" +
+                              significant(kz / 1e3, 4) + " against " + significant(kz_thesis / 1e3, 4) + " N/mm at " +
+                              significant(units::pa_to_bar(state.pressure_pa), 3) + " bar), where those deflect a tyre about 15-25 % of its "
+                              "section height at its rating: allowed " + significant(1.0 / kMaxRatio, 3) + " to " + significant(kMaxRatio, 2) + " times");
 }
 
 // At its rated load a tyre deflects about 15-25 % of its section height (the shipped tyres 9-26 %, at 2.5 bar or
@@ -498,6 +520,7 @@ TyreSpec load_tyre(YamlMap y) {
                                                   format_value(index_kg) + " kg: an index must rate it within [" + significant(index_kg / 1.5, 4) +
                                                   ", " + significant(index_kg * 1.5, 4) + "] kg");
   }
+  std::string stiffness_where;
   if (y.has("model") && y.node()["model"].IsScalar()) {
     spec.state.model = model_kind(y.string("model"), y.where("model"));
     if (spec.state.model == TyreModelKind::Hysteresis) {
@@ -507,7 +530,10 @@ TyreSpec load_tyre(YamlMap y) {
     }
   } else if (auto m = opt_map(y, "model")) {
     read_model_map(*m, spec.state);
+    for (const char* k : {"stiffness_pressure_coeff", "stiffness_offset_kgf_per_mm"})
+      if (stiffness_where.empty() && m->has(k)) stiffness_where = m->where(k);
   }
+  if (!stiffness_where.empty()) check_stiffness_constants(spec.state, stiffness_where);
   if (spec.max_load_n > 0.0) {
     const std::string rating_key = max_kg ? "max_load_kg" : li ? "load_index" : "size";
     check_rated_deflection(spec, y.where(rating_key), max_kg.has_value());
