@@ -86,6 +86,22 @@ enum AccIdx : int {
   kAccumulators
 };
 
+// A scheduled gear whose engine runs into its limiter shifts up, as an automatic's control unit (or a driver) does at
+// the rev limit, where the gear gives under half the force of the next one up: past its top-speed band only, since
+// below it a gear gives at least the next one's force. Without it, an upshift speed the car cannot reach on its
+// rolling radius (the file's check uses the outer radius: 47.9 km/h against 47.0 reachable in 1st) held the car in
+// 1st on the limiter, 23 km/h behind a 70 km/h trace at 9.74 l/100 km, where the replay read 6.16 (session 25's
+// outside testing). The forward simulation and the replay share this rule.
+constexpr double kTopSpeedUpshiftShare = 0.5;
+bool past_top_speed(const Powertrain& p, int gear, double speed_mps, double wheel_radius_m) {
+  return gear < p.num_gears() &&
+         p.max_wheel_force_n(gear, speed_mps, wheel_radius_m) < kTopSpeedUpshiftShare * p.max_wheel_force_n(gear + 1, speed_mps, wheel_radius_m);
+}
+int top_speed_upshift(const Powertrain& p, int gear, double speed_mps, double wheel_radius_m) {
+  while (past_top_speed(p, gear, speed_mps, wheel_radius_m)) ++gear;
+  return gear;
+}
+
 double grade_force_n(double mass_kg, double grade) {
   if (grade == 0.0) return 0.0;  // most traces are flat: no square root per evaluation
   return mass_kg * units::kStandardGravity_mps2 * grade / std::sqrt(1.0 + grade * grade);
@@ -391,7 +407,8 @@ class ForwardSystem final : public OdeSystem {
   // A kicked-down gear also shifts up where its engine reaches its top speed (the gear then gives no force), and a
   // kick-down is only to a gear that gives more force: before, a demand beyond the power took the car down to a gear
   // whose engine was past its limit (ice.yaml ran first gear at 96 km/h, 12,866 rpm against 6300).
-  int num_roots() const override { return m_.powertrain->num_gears() > 1 ? 5 : 0; }
+  // The schedule's own gear shifts up at its engine's limiter (top_speed_upshift).
+  int num_roots() const override { return m_.powertrain->num_gears() > 1 ? 6 : 0; }
 
   void roots(double t, const double* y, double* g) override {
     const double v = y[kSpeed];
@@ -402,6 +419,9 @@ class ForwardSystem final : public OdeSystem {
     g[2] = gear > 1 && kicks_down_to(gear - 1, force_n, v) ? force_n - demand_n : 1.0;
     g[3] = gear < scheduled_gear_ ? kKickdownReturn * max_force(gear + 1, v) - demand_n : -1.0;
     g[4] = gear < scheduled_gear_ && !(force_n > 0.0) ? -1.0 : 1.0;
+    g[5] = gear == scheduled_gear_ && scheduled_gear_ < m_.powertrain->num_gears()
+               ? force_n - kTopSpeedUpshiftShare * max_force(gear + 1, v)
+               : 1.0;
   }
 
   /// Sets the schedule's gear and the gear actually engaged (the schedule's, or lower where the demand needs it).
@@ -419,8 +439,8 @@ class ForwardSystem final : public OdeSystem {
   /// kShiftMargin_mps, as the roots shift.
   int schedule_gear(double speed_mps, int current) const {
     const int up = m_.powertrain->select_gear(speed_mps - kShiftMargin_mps, current);
-    if (up > current) return up;
-    return std::min(current, m_.powertrain->select_gear(speed_mps + kShiftMargin_mps, current));
+    const int scheduled = up > current ? up : std::min(current, m_.powertrain->select_gear(speed_mps + kShiftMargin_mps, current));
+    return top_speed_upshift(*m_.powertrain, scheduled, speed_mps, m_.wheel_radius_m);
   }
 
   /// Where a kicked-down gear's engine reaches its top speed: the next gear up (to the schedule's) that gives force.
@@ -757,6 +777,9 @@ SimulationResult simulate_forward(const VehicleModel& m, const DriveCycle& c, co
         engaged = sys.gear + 1;
       } else if (flags[4] < 0) {
         engaged = sys.upshift_from_top_speed(engaged, v);
+      } else if (flags[5] < 0) {
+        scheduled = std::max(scheduled + 1, top_speed_upshift(*m.powertrain, scheduled, v, m.wheel_radius_m));
+        engaged = sys.kickdown_gear(scheduled, v, demand_n);
       }
       sys.set_gears(scheduled, engaged);
       restart(t, integ.state());
@@ -896,7 +919,7 @@ SimulationResult simulate_replay(const VehicleModel& m, const DriveCycle& c, con
   bool accessories_on = false;  // ... and keeps the accessories on (start-stop)
   std::size_t segment_now = 0;
   auto evaluate_at = [&](double t, double v, double a, double grade, const RoadLoadCoeffs& rl, double dist_m) {
-    scheduled_gear = m.powertrain->select_gear(v, scheduled_gear);
+    scheduled_gear = top_speed_upshift(*m.powertrain, m.powertrain->select_gear(v, scheduled_gear), v, m.wheel_radius_m);
     EffectInputs in{t, v, a, grade, dist_m, 0.0, 0.0, engine_off && v == 0.0 && a == 0.0};
     in.accessories_on = accessories_on;
     set_heading(c, segment_now, in);
