@@ -237,6 +237,8 @@ TEST(Simulation, BadVehicleFilesAreRejectedWithTheKey) {
   expect_error("type: electric", "type: steam", "powertrain.type");
   // An axle carrying (almost) nothing: named by the key, not by a tyre file's domain error (session 20).
   expect_error("front_axle_load_fraction: 0.5", "front_axle_load_fraction: 0.999", "body.front_axle_load_fraction");
+  // A car's frontal area in ft^2 (20-27) gets its unit hint: a hard 20 m^2 had refused it without one (session 25).
+  expect_error("frontal_area_m2: 2.30", "frontal_area_m2: 24.8", "is it in ft^2? (24.8 ft^2 = 2.304 m^2)");
   EXPECT_THROW(load_vehicle_file("/no/such/vehicle.yaml"), InputError);
 }
 
