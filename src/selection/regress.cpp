@@ -21,15 +21,22 @@
 
 namespace rollsim::selection {
 
-Baseline load_baseline(const std::string& path) {
+namespace {
+
+Baseline load_baseline_text(const std::string& text, const std::string& path, bool allow_new_cases) {
   Baseline b;
-  b.text = read_input_file(path, kMaxYamlFileBytes);
+  b.text = text;
   YamlMap root = YamlMap::load_text(b.text, path);
   b.file = path;
-  if (!root.has("cases") || !root.node()["cases"].IsSequence()) {
-    throw InputError(root.where("cases"), "missing: a baseline needs a list 'cases' of {name, vehicle, tyre, cycle, "
-                                          "unit, expected, tolerance_pct}");
+  const std::string shape = "a baseline needs a list 'cases' of {name, vehicle, tyre, cycle, expected, tolerance_pct, "
+                            "unit (optional)}";
+  // A misspelt 'cases' is named as such, and one that is not a list is not called missing (session 25).
+  if (!root.has("cases")) {
+    root.accept("cases");
+    root.finish();
+    throw InputError(root.where("cases"), "missing: " + shape);
   }
+  if (!root.node()["cases"].IsSequence()) throw InputError(root.where("cases"), "is not a list: " + shape);
   root.accept("cases");
   root.finish();
   const YAML::Node list = root.node()["cases"];
@@ -37,10 +44,12 @@ Baseline load_baseline(const std::string& path) {
     const std::string item = "cases[" + std::to_string(i) + "]";
     if (!list[i].IsMap()) {
       throw InputError(path + ": line " + std::to_string(list[i].Mark().line + 1) + ": " + item,
-                       "expected a mapping {name, vehicle, tyre, cycle, unit, expected, tolerance_pct}");
+                       "expected a mapping {name, vehicle, tyre, cycle, expected, tolerance_pct, unit (optional)}");
     }
     YamlMap m(list[i], path, item + ".");
     RegressCase c;
+    c.case_line = list[i].Mark().line;
+    c.case_column = list[i].Mark().column;
     c.name = m.string("name");
     // A case is named in every message about it: an empty or blank name read "case '' drifted", a line break in it
     // forged a line of its own on stderr, and a byte that is no UTF-8 became U+FFFD on --update (session 23).
@@ -52,13 +61,23 @@ Baseline load_baseline(const std::string& path) {
     c.vehicle = m.string("vehicle");
     c.tyre = m.string("tyre");
     c.cycle = m.string("cycle");
-    c.unit = m.string("unit");
-    if (c.unit != "kwh_per_10km" && c.unit != "l_per_100km") {
-      throw InputError(m.where("unit"), "'" + c.unit + "' is not allowed: must be kwh_per_10km or l_per_100km");
+    // The unit is the car's (energy for a battery car, fuel for an engine): given, it is checked against the car.
+    c.unit = m.string_or("unit", "");
+    if (!c.unit.empty() && c.unit != "kwh_per_10km" && c.unit != "l_per_100km") {
+      throw InputError(m.where("unit"), "'" + c.unit + "' is not allowed: must be kwh_per_10km or l_per_100km (or left out: the car's)");
     }
-    c.expected = m.number("expected", Range::positive());
-    c.expected_line = list[i]["expected"].Mark().line;
-    c.expected_column = list[i]["expected"].Mark().column;
+    // A new case has no value yet: --update fills it in (a user had to invent placeholders: session 25). The bound
+    // is far above any car's (a value of 1e300 was printed as 301 digits).
+    if (m.has("expected") || !allow_new_cases) {
+      try {
+        c.expected = m.number("expected", Range::open_low(0.0, 1e4));
+      } catch (const InputError& e) {
+        if (m.has("expected")) throw;
+        throw InputError(e.where(), e.problem() + "; 'rollsim regress " + path + " --update' fills in a new case's value");
+      }
+      c.expected_line = list[i]["expected"].Mark().line;
+      c.expected_column = list[i]["expected"].Mark().column;
+    }
     // --update writes `expected` to 6 significant digits (up to 0.0005 % off): a tolerance must hold that rounding.
     c.tolerance_pct = m.number("tolerance_pct", Range::closed(0.001, 100.0));
     m.finish();
@@ -71,6 +90,12 @@ Baseline load_baseline(const std::string& path) {
   return b;
 }
 
+}  // namespace
+
+Baseline load_baseline(const std::string& path, bool allow_new_cases) {
+  return load_baseline_text(read_input_file(path, kMaxYamlFileBytes), path, allow_new_cases);
+}
+
 std::vector<RegressOutcome> run_baseline(const Baseline& b) {
   std::vector<RegressOutcome> out;
   for (const auto& c : b.cases) {
@@ -81,16 +106,21 @@ std::vector<RegressOutcome> run_baseline(const Baseline& b) {
       fit_tyres(v, load_tyre_file(resolve_data_file_beside(c.tyre, b.file, "tyres", ".yaml", "tyre")));
       const DriveCycle cycle = load_cycle(path_beside(c.cycle, b.file), "cycle");
       require_distance(cycle);
-      if (energy_unit(v) != c.unit) {
+      if (!c.unit.empty() && energy_unit(v) != c.unit) {
         throw InputError("unit", "'" + c.unit + "' does not match the car (" + energy_unit(v) + ")");
       }
       RegressOutcome o;
       o.c = c;
+      o.c.unit = energy_unit(v);
       const EnergyFigure e = run_forward(v, cycle);
       o.actual = e.value;
       o.trace = e.trace;
-      o.drift_pct = (o.actual / c.expected - 1.0) * 100.0;
-      o.drifted = !(std::abs(o.drift_pct) <= c.tolerance_pct);
+      if (c.is_new()) {
+        o.drift_pct = std::nan("");
+      } else {
+        o.drift_pct = (o.actual / c.expected - 1.0) * 100.0;
+        o.drifted = !(std::abs(o.drift_pct) <= c.tolerance_pct);
+      }
       out.push_back(o);
     } catch (const InputError& e) {
       throw InputError(where, e.what());
@@ -130,8 +160,20 @@ std::optional<std::string> updated_in_place(const Baseline& b, const std::vector
   for (std::size_t nl; (nl = b.text.find('\n', start)) != std::string::npos; start = nl + 1) lines.push_back(b.text.substr(start, nl - start + 1));
   if (start < b.text.size()) lines.push_back(b.text.substr(start));
   static const std::regex number(R"((["']?)([-+]?[0-9.]+(?:[eE][-+]?[0-9]+)?)\1)");
+  // A new case's value goes on a line of its own after the first of its mapping, at its keys' indent; lines are
+  // inserted last, from the bottom, so that the lines read stay where they were.
+  std::vector<std::pair<std::size_t, std::string>> inserts;
   for (std::size_t i = 0; i < b.cases.size() && i < outcomes.size(); ++i) {
     const RegressCase& c = b.cases[i];
+    if (c.is_new()) {
+      if (c.case_line < 0 || c.case_line >= static_cast<int>(lines.size()) || c.case_column < 0) return std::nullopt;
+      const std::string& first = lines[static_cast<std::size_t>(c.case_line)];
+      if (first.size() <= static_cast<std::size_t>(c.case_column) || first[static_cast<std::size_t>(c.case_column)] == '{') return std::nullopt;
+      const std::string end = first.size() >= 2 && first[first.size() - 2] == '\r' ? "\r\n" : "\n";
+      inserts.emplace_back(static_cast<std::size_t>(c.case_line) + 1,
+                           std::string(static_cast<std::size_t>(c.case_column), ' ') + "expected: " + baseline_value_text(outcomes[i].actual) + end);
+      continue;
+    }
     if (c.expected_line < 0 || c.expected_line >= static_cast<int>(lines.size())) return std::nullopt;
     std::string& line = lines[static_cast<std::size_t>(c.expected_line)];
     const auto col = static_cast<std::size_t>(std::max(0, c.expected_column));
@@ -144,8 +186,21 @@ std::optional<std::string> updated_in_place(const Baseline& b, const std::vector
     if (std::strtod(digits.c_str(), &end) != c.expected) return std::nullopt;
     line = line.substr(0, col) + m[1].str() + baseline_value_text(outcomes[i].actual) + m[1].str() + rest.substr(static_cast<std::size_t>(m.length(0)));
   }
+  if (!inserts.empty() && !lines.empty() && lines.back().back() != '\n') lines.back() += "\n";
+  for (auto it = inserts.rbegin(); it != inserts.rend(); ++it) lines.insert(lines.begin() + static_cast<std::ptrdiff_t>(it->first), it->second);
   std::string out;
   for (const auto& l : lines) out += l;
+  if (inserts.empty()) return out;
+  // An insertion is kept only where the file reads back with every case's value (a block scalar in a case's first
+  // line would have taken the new line as its text).
+  try {
+    const Baseline back = load_baseline_text(out, b.file, false);
+    if (back.cases.size() != outcomes.size()) return std::nullopt;
+    for (std::size_t i = 0; i < outcomes.size(); ++i)
+      if (baseline_value_text(back.cases[i].expected) != baseline_value_text(outcomes[i].actual)) return std::nullopt;
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
   return out;
 }
 
@@ -167,7 +222,7 @@ std::string baseline_yaml(const Baseline& b, const std::vector<RegressOutcome>& 
       << "    vehicle: " << yaml_scalar(c.vehicle) << "\n"
       << "    tyre: " << yaml_scalar(c.tyre) << "\n"
       << "    cycle: " << yaml_scalar(c.cycle) << "\n"
-      << "    unit: " << c.unit << "\n"
+      << "    unit: " << (i < outcomes.size() ? outcomes[i].c.unit : c.unit) << "\n"
       << "    expected: " << baseline_value_text(value) << "\n"
       << "    tolerance_pct: " << significant(c.tolerance_pct, 6) << "\n";
   }

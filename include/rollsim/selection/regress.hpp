@@ -13,11 +13,14 @@ struct RegressCase {
   std::string vehicle;        ///< path or shipped name
   std::string tyre;           ///< path or shipped name
   std::string cycle;          ///< shipped name or path
-  std::string unit;           ///< "kwh_per_10km" or "l_per_100km"
-  double expected = 0.0;
+  std::string unit;           ///< "kwh_per_10km" or "l_per_100km"; empty where the file leaves it to the car
+  double expected = 0.0;      ///< 0 for a new case (no value yet; only with --update)
   double tolerance_pct = 0.5;
   int expected_line = -1;    ///< where `expected`'s value sits in the file (0-based), for an update in place
   int expected_column = -1;
+  int case_line = -1;        ///< where the case's mapping starts (0-based line and column): a new value goes there
+  int case_column = -1;
+  bool is_new() const { return expected_line < 0; }
 };
 
 struct Baseline {
@@ -26,13 +29,14 @@ struct Baseline {
   std::vector<RegressCase> cases;
 };
 
-/// Reads a baseline file (strict keys, see tests/energy_baseline.yaml). Throws InputError.
-Baseline load_baseline(const std::string& path);
+/// Reads a baseline file (strict keys, see tests/energy_baseline.yaml). A case without `expected` is new, allowed
+/// only with `allow_new_cases` (--update fills it in). Throws InputError.
+Baseline load_baseline(const std::string& path, bool allow_new_cases = false);
 
 struct RegressOutcome {
-  RegressCase c;
+  RegressCase c;  ///< the case, its unit the car's
   double actual = 0.0;
-  double drift_pct = 0.0;  ///< (actual - expected) / expected, %
+  double drift_pct = 0.0;  ///< (actual - expected) / expected, %; NaN for a new case (never drifted)
   bool drifted = false;    ///< |drift| > tolerance
   TraceFollowing trace;  ///< not followed: the car fell behind the case's cycle (its figure guards a slower drive)
 };
