@@ -75,27 +75,34 @@ ElevationGrade grade_from_elevation(const std::vector<double>& time_s, const std
   const double total = s.back();
   if (total < 2.0 * opt.grid_m) return out;
   // Average onto a distance grid: standing still gives many samples at one place, which must weigh as one place.
+  // Each cell's mean elevation is placed at its samples' mean distance, not at its centre, and the profile is read
+  // at the centres between those points (beyond the first and last, along the line through the nearest two): a car
+  // accelerating through a cell has its samples bunched at the cell's start, which read a constant 5 % climb over a
+  // 300 m trip as 4.70-5.10 % and booked 0.56 % less climb than m g dh (session 25's outside testing).
   const std::size_t cells = static_cast<std::size_t>(std::floor(total / opt.grid_m)) + 1;
-  std::vector<double> sum(cells, 0.0), count(cells, 0.0);
+  std::vector<double> sum_h(cells, 0.0), sum_s(cells, 0.0), count(cells, 0.0);
   for (std::size_t i = 0; i < n; ++i) {
     const auto c = std::min(cells - 1, static_cast<std::size_t>(s[i] / opt.grid_m));
-    sum[c] += h[i];
+    sum_h[c] += h[i];
+    sum_s[c] += s[i];
     count[c] += 1.0;
   }
-  std::vector<double> prof(cells, 0.0);
-  std::size_t last = cells;  // last filled cell
+  std::vector<double> at_s, at_h;  // the filled cells' mean distance and elevation, ascending in distance
   for (std::size_t c = 0; c < cells; ++c) {
     if (count[c] == 0.0) continue;
-    prof[c] = sum[c] / count[c];
-    if (last == cells) {
-      for (std::size_t k = 0; k < c; ++k) prof[k] = prof[c];
-    } else {
-      for (std::size_t k = last + 1; k < c; ++k)
-        prof[k] = prof[last] + (prof[c] - prof[last]) * static_cast<double>(k - last) / static_cast<double>(c - last);
-    }
-    last = c;
+    at_s.push_back(sum_s[c] / count[c]);
+    at_h.push_back(sum_h[c] / count[c]);
   }
-  for (std::size_t k = last + 1; k < cells; ++k) prof[k] = prof[last];
+  std::vector<double> prof(cells, at_h.front());
+  if (at_s.size() > 1) {
+    std::size_t k = 0;  // the segment [k, k + 1] of the points that a centre is read on
+    for (std::size_t c = 0; c < cells; ++c) {
+      const double x = (static_cast<double>(c) + 0.5) * opt.grid_m;
+      while (k + 2 < at_s.size() && at_s[k + 1] < x) ++k;
+      const double span = at_s[k + 1] - at_s[k];
+      prof[c] = span > 0.0 ? at_h[k] + (at_h[k + 1] - at_h[k]) * (x - at_s[k]) / span : at_h[k];
+    }
+  }
   // Slope of a least-squares cubic over filter_length_m of distance (a Savitzky-Golay derivative): a cubic keeps a
   // hill's curvature, where the moving average it replaces flattened 1.5 km hills by 6 %. The window keeps its
   // length at the ends of the trip, off-centre.
