@@ -298,10 +298,11 @@ py::dict api_simulate(py::object vehicle, py::object tyre, py::object cycle, py:
   for (const auto& c : report::run_caveats(run.result)) warn(c);  // as the command line's text and --json say them
   py::dict out;
   JsonObject summary = report::to_json(run.result, run.tyre_label);
-  // As simulate --json: the files read, null for a dict, arrays or the vehicle's own tyres.
-  report::add_input_files(summary, {py::isinstance<py::dict>(vehicle) ? "" : base.source,
-                                    tyre_set && !py::isinstance<py::dict>(tyre) ? tyre_set->source : "",
-                                    py::isinstance<py::str>(fspath_or_self(cycle)) ? c.source : ""});
+  // As simulate --json: the files read (the car's own tyres' too), null for a dict or arrays.
+  const auto [front_file, rear_file] = tyre_files(run);
+  const bool tyre_dict = tyre_set && py::isinstance<py::dict>(tyre);
+  report::add_input_files(summary, {py::isinstance<py::dict>(vehicle) ? "" : base.source, tyre_dict ? "" : front_file,
+                                    py::isinstance<py::str>(fspath_or_self(cycle)) ? c.source : "", tyre_dict ? "" : rear_file});
   out["summary"] = from_json(summary.str());
   py::dict columns;
   if (trace)

@@ -141,4 +141,12 @@ TEST(CliSimulate, ACarWithTwoTyreSizesNamesBoth) {
   EXPECT_NE(table.text.find("nedc   front 125-80R13 / rear 145-80R13"), std::string::npos) << table.text;
   const auto json = run("simulate --vehicle twizy --json");
   EXPECT_NE(json.text.find("\"tyre\": \"front 125-80R13 / rear 145-80R13\""), std::string::npos) << json.text;
+  // The files of the car's own tyres are named too: with a same-named tyre file beside a vehicle file, which one was
+  // read could not be told (tyre_file was null: session 25's outside testing).
+  EXPECT_NE(json.text.find("tyres/125-80R13.yaml\", \"cycle_file\""), std::string::npos) << json.text;
+  EXPECT_NE(json.text.find("\"rear_tyre_file\": \""), std::string::npos) << json.text;
+  EXPECT_NE(json.text.find("tyres/145-80R13.yaml\"}"), std::string::npos) << json.text;
+  const auto one_set = run("simulate --vehicle ev --json");
+  EXPECT_NE(one_set.text.find("tyres/nominal.yaml\", \"cycle_file\""), std::string::npos) << one_set.text;
+  EXPECT_EQ(one_set.text.find("rear_tyre_file"), std::string::npos) << one_set.text;
 }

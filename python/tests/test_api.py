@@ -148,6 +148,12 @@ class SimulateApi(unittest.TestCase):
                 self.assertAlmostEqual(got[key] / expected[key], 1.0, delta=tol, msg=key)
             for key, kwh in expected["energy_breakdown_kwh"].items():
                 self.assertAlmostEqual(got["energy_breakdown_kwh"][key], kwh, delta=tol * abs(kwh), msg=key)
+        # The car's own tyres are named as files, as the command line names them (session 25).
+        own = rollsim.simulate(vehicle="twizy", trace=False)["summary"]
+        (own_cli,), _, _ = cli("simulate", "--vehicle", "twizy", "--json")
+        self.assertTrue(own["tyre_file"].endswith("tyres/125-80R13.yaml"), own["tyre_file"])
+        self.assertTrue(own["rear_tyre_file"].endswith("tyres/145-80R13.yaml"), own["rear_tyre_file"])
+        self.assertEqual((own["tyre_file"], own["rear_tyre_file"]), (own_cli["tyre_file"], own_cli["rear_tyre_file"]))
 
 
 class SelectionApi(unittest.TestCase):

@@ -33,7 +33,8 @@ struct SimulateOptions {
 struct Run {
   std::string tyre_label;
   SimulationResult result;
-  std::string tyre_file;   ///< empty: the vehicle's own tyres
+  std::string tyre_file;       ///< the front tyres' file (the set given, or the car's own); empty: none
+  std::string rear_tyre_file;  ///< the rear tyres' file
   std::string cycle_file;
 };
 
@@ -74,7 +75,8 @@ void run_simulate(const SimulateOptions& o) {
                   << fixed(v.coastdown->a_n, 1) << " N (" << fixed(100.0 * tyre_a_n / v.coastdown->a_n, 1)
                   << " %)\n";
       }
-      runs.push_back({run.tyre_label, std::move(run.result), tyre ? tyre->source : "", cycle.source});
+      const auto [front_file, rear_file] = tyre_files(run);
+      runs.push_back({run.tyre_label, std::move(run.result), front_file, rear_file, cycle.source});
     }
   }
 
@@ -85,7 +87,7 @@ void run_simulate(const SimulateOptions& o) {
     // The files too: two cycles or tyres of one name (a user's udds.csv beside the shipped one) read alike (session 22).
     for (const auto& run : runs) {
       JsonObject j = report::to_json(run.result, run.tyre_label);
-      report::add_input_files(j, {base.source, run.tyre_file, run.cycle_file});
+      report::add_input_files(j, {base.source, run.tyre_file, run.cycle_file, run.rear_tyre_file});
       std::cout << j.str() << "\n";
     }
     // The text's warnings (a battery run empty, a trace not followed) go where warnings go: the JSON alone gave a

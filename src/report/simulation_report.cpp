@@ -182,6 +182,7 @@ void add_input_files(JsonObject& j, const RunInputFiles& files) {
     if (path->empty()) j.add_null(key);
     else j.add(key, *path);
   }
+  if (!files.rear_tyre.empty() && files.rear_tyre != files.tyre) j.add("rear_tyre_file", files.rear_tyre);
 }
 
 JsonObject to_json(const SimulationResult& r, const std::string& tyre_label) {

@@ -43,4 +43,9 @@ VehicleRun run_vehicle(const Vehicle& base, const std::optional<TyreSpec>& tyre,
   return run;
 }
 
+std::pair<std::string, std::string> tyre_files(const VehicleRun& run) {
+  const Vehicle& v = run.vehicle;
+  return {v.front_tyre ? v.front_tyre->source : "", v.rear_tyre ? v.rear_tyre->source : ""};
+}
+
 }  // namespace rollsim

@@ -38,10 +38,13 @@ std::vector<std::string> run_caveats(const SimulationResult& r);
 /// energy_breakdown_kwh, max_speed_error_kmh.
 JsonObject to_json(const SimulationResult& r, const std::string& tyre_label);
 
-/// The input files a run was read from, as `vehicle_file`, `tyre_file` and `cycle_file` (null where the input was
-/// not a file: the vehicle's own tyres, a Python dict or arrays). Two cycles or tyres of one name read alike without them.
+/// The input files a run was read from, as `vehicle_file`, `tyre_file` (the front tyres', the car's own where no tyre
+/// set was given), `cycle_file` (null where the input was not a file: a Python dict or arrays, a car without tyres),
+/// and `rear_tyre_file` where the rear tyres came from another file. Two cycles or tyres of one name read alike
+/// without them.
 struct RunInputFiles {
   std::string vehicle, tyre, cycle;  ///< empty: not a file
+  std::string rear_tyre;             ///< empty: the front's
 };
 void add_input_files(JsonObject& j, const RunInputFiles& files);
 

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <optional>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,10 @@ struct VehicleRun {
   std::vector<std::string> warnings;  ///< overloaded tyres (allowed, but said)
   SimulationResult result;
 };
+
+/// The files the run's front and rear tyres were read from ("" for a car without tyres): the tyre set given, or
+/// the car's own, which a JSON result names (a same-named file beside the vehicle file was read unsaid: session 25).
+std::pair<std::string, std::string> tyre_files(const VehicleRun& run);
 
 /// Fits `tyre` (if given) to all four wheels and runs the car forward (driver + CVODE) or as a kinematic replay.
 /// A solver failure becomes a std::runtime_error naming the car and cycle: no result is reported.
