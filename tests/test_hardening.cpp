@@ -492,6 +492,21 @@ TEST_F(Hardening, NoEscapeSequenceReachesTheTerminal) {
   EXPECT_TRUE(has(message.err, "unknown column '\\x1B[31mgrade'")) << message.err;
 }
 
+// An output under /proc is refused before any computation, for root too, whom the permission bits let through: a
+// diagnosis ran in full and printed its result before "cannot write there" (session 25's outside testing).
+TEST_F(Hardening, AnOutputWherePermissionBitsLieIsRefusedBeforeTheRun) {
+  if (!fs::is_directory("/proc")) GTEST_SKIP() << "no /proc";
+  const CmdResult trace = run_rollsim("simulate --vehicle ev --trace /proc/version");
+  EXPECT_EQ(trace.exit_code, 2);
+  EXPECT_TRUE(has(trace.err, "--trace '/proc/version': cannot write there: folder '/proc' is not a writable folder")) << trace.err;
+  EXPECT_TRUE(trace.out.empty()) << trace.out;
+  const CmdResult report = run_rollsim("diagnose --vehicle twizy --preset rsk_twizy --recording '" + std::string(ROLLSIM_SHARED_DIR) +
+                                       "/data/recordings/rsk_renault_twizy/T2_03_29_2021.csv' --report /proc/nope");
+  EXPECT_EQ(report.exit_code, 2);
+  EXPECT_TRUE(has(report.err, "--report '/proc/nope': cannot be created: '/proc' is not a writable folder")) << report.err;
+  EXPECT_TRUE(report.out.empty()) << report.out;
+}
+
 // A SIGTERM while the outputs are written leaves neither the output nor its temporary (session 24's note: the
 // temporary was left). The second output is a pipe nobody reads yet, so the writer waits inside the write, its first
 // output's temporary already made, while the signal is sent; then the pipe is read and the writer goes on.

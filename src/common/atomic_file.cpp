@@ -5,6 +5,7 @@
 
 #include <csignal>
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -24,9 +25,18 @@ fs::path folder_of(const std::string& path) {
   return p.has_parent_path() ? p.parent_path() : fs::path(".");
 }
 
+// A folder a file can be made in. access() answers from the permission bits, which root passes everywhere: /proc and
+// /sys (or a read-only mount) passed the check and the write failed after the whole computation (a diagnosis run in
+// full, then "cannot write there": session 25's outside testing). So a file is made there and removed at once.
 bool writable_dir(const fs::path& dir) {
   std::error_code ec;
-  return fs::is_directory(dir, ec) && ::access(dir.c_str(), W_OK | X_OK) == 0;
+  if (!fs::is_directory(dir, ec) || ::access(dir.c_str(), W_OK | X_OK) != 0) return false;
+  std::string probe = (dir / ".rollsim-probe-XXXXXX").string();
+  const int fd = ::mkstemp(probe.data());
+  if (fd < 0) return false;
+  ::close(fd);
+  ::unlink(probe.c_str());
+  return true;
 }
 
 // Where an output's content lands. A symlink is followed (through a chain, to a file that may not exist yet): its

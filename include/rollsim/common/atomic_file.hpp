@@ -21,7 +21,8 @@ void check_not_an_input(const std::string& path, const std::string& option, cons
 void check_outputs_distinct(const std::vector<std::pair<std::string, std::string>>& path_and_option);
 
 /// Checks that `dir` is a writable folder, or can be created as one (its nearest existing parent is a
-/// writable folder). Creates nothing. Throws InputError naming `option` and the folder otherwise.
+/// writable folder: a probe file is made there and removed, since root passes the permission bits under /proc).
+/// Creates nothing that stays. Throws InputError naming `option` and the folder otherwise.
 void check_output_dir(const std::string& dir, const std::string& option);
 
 /// One output of a command: where it goes, the option that asked for it (for errors), its whole content.
