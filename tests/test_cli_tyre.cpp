@@ -145,7 +145,7 @@ TEST(CliTyre, LoadAboveRatingIsAllowedWithAWarning) {
 TEST(CliTyre, ASpeedAboveTheSpeedSymbolIsWarned) {
   const CmdResult above = tyre("155-70R19 --speed-kmh 100,170");
   EXPECT_EQ(above.exit_code, 0) << above.err;
-  EXPECT_TRUE(has(above.err, "warning: --speed-kmh reaches 170.0 km/h, above tyre '155-70R19''s speed rating Q (160 km/h)"))
+  EXPECT_TRUE(has(above.err, "warning: --speed-kmh reaches 170.0 km/h, above the speed rating of tyre '155-70R19', Q (160 km/h)"))
       << above.err;
   EXPECT_EQ(lines(above.out).size(), 5u) << above.out;  // the table is still printed: title, header, rule, 2 rows
   EXPECT_FALSE(has(tyre("155-70R19 --speed-kmh 160").err, "speed rating"));
@@ -156,7 +156,7 @@ TEST(CliTyre, ASpeedAboveTheSpeedSymbolIsWarned) {
   std::ofstream(dir + "/fast.csv") << "time_s,speed_kmh\n0,0\n60,170\n120,170\n180,0\n";
   const CmdResult sim = rollsim::test::run_rollsim("simulate --vehicle ev --tyre 155-70R19 --replay --cycle " + dir + "/fast.csv");
   EXPECT_EQ(sim.exit_code, 0) << sim.err;
-  EXPECT_TRUE(has(sim.err, "reaches 170.0 km/h, above tyre '155-70R19''s speed rating Q (160 km/h)")) << sim.err;
+  EXPECT_TRUE(has(sim.err, "reaches 170.0 km/h, above the speed rating of tyre '155-70R19', Q (160 km/h)")) << sim.err;
   EXPECT_FALSE(has(rollsim::test::run_rollsim("simulate --vehicle ev --tyre 155-70R19").err, "speed rating"));
 }
 

@@ -81,7 +81,7 @@ class TyreApi(unittest.TestCase):
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             rollsim.tyre("155-70R19", speed_kmh=np.array([100.0, 170.0]))
-        self.assertTrue(any("above tyre '155-70R19''s speed rating Q (160 km/h)" in str(w.message) for w in caught),
+        self.assertTrue(any("above the speed rating of tyre '155-70R19', Q (160 km/h)" in str(w.message) for w in caught),
                         [str(w.message) for w in caught])
 
 

@@ -324,7 +324,7 @@ std::string speed_rating_warning(const TyreSpec& tyre, double speed_mps, const s
   if (!tyre.size || !tyre.size->speed_symbol) return "";
   const auto rated_mps = speed_symbol_max_mps(*tyre.size->speed_symbol);
   if (!rated_mps || speed_mps <= *rated_mps * (1.0 + 1e-9)) return "";
-  return what + " reaches " + fixed(units::mps_to_kmh(speed_mps), 1) + " km/h, above tyre '" + tyre.name + "''s speed rating " +
+  return what + " reaches " + fixed(units::mps_to_kmh(speed_mps), 1) + " km/h, above the speed rating of tyre '" + tyre.name + "', " +
          *tyre.size->speed_symbol + " (" + format_value(std::round(units::mps_to_kmh(*rated_mps))) +
          " km/h): the model runs there, but the tyre is not built for it";
 }
