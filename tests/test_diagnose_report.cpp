@@ -417,6 +417,14 @@ TEST(DiagnoseReportCli, CamryRecordingsGiveAReportAndAnUnwritableDirFailsFirst) 
   ASSERT_EQ(ok.exit_code, 0) << ok.text;
   EXPECT_TRUE(fs::exists(out + "/report.html"));
   EXPECT_TRUE(fs::exists(out + ".json"));
+  // These two recordings' one finding is 'unexplained', which fits no effect: the after line is the before line and
+  // its key says so (it read "after the findings' effects": session 25's outside testing).
+  std::ifstream json_in(out + ".json");
+  const std::string json((std::istreambuf_iterator<char>(json_in)), {});
+  ASSERT_NE(json.find("\"effect\": \"unexplained\""), std::string::npos) << json;
+  std::ifstream svg_in(out + "/cumulative.svg");
+  const std::string svg((std::istreambuf_iterator<char>(svg_in)), {});
+  EXPECT_NE(svg.find("after (no effect fitted: same as before)"), std::string::npos);
 
   // A recording kept in the report's folder under one of the report's names was replaced by the figure (session 22's
   // outside testing); it is refused as any output that is an input is, and nothing is written.

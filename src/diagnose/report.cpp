@@ -4,6 +4,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <set>
@@ -72,7 +73,11 @@ std::vector<Figure> residual_figures(const Diagnosis& d, const fs::path& work) {
   write_windows(work / "windows.dat", d);
   using report::gnuplot_string;
   const std::string dat = gnuplot_string((work / "windows.dat").string());
-  const std::string after = gnuplot_string(d.findings.empty() ? "after (no findings: same as before)" : "after the findings' effects");
+  // An 'unexplained' finding has no effect to fit: with only such, the after line is the before line, and says so.
+  const bool fitted = std::any_of(d.findings.begin(), d.findings.end(), [](const auto& f) { return f.effect != "unexplained"; });
+  const std::string after = gnuplot_string(d.findings.empty() ? "after (no findings: same as before)"
+                                           : fitted           ? "after the findings' effects"
+                                                              : "after (no effect fitted: same as before)");
   // Window residuals before and after, as points against one signature variable (a column of windows.dat).
   auto residual_against = [&](const std::string& file, const std::string& what, const std::string& xlabel, int column) {
     std::ostringstream script;
@@ -86,8 +91,9 @@ std::vector<Figure> residual_figures(const Diagnosis& d, const fs::path& work) {
        "set xlabel 'time, recordings one after another [min]'\nset ylabel 'mean power per window [W]'\nplot " + dat +
            " u 1:2 w lp pt 7 ps 0.5 lw 2 t 'measured', " + dat + " u 1:3 w l lw 1 dt 2 t 'simulated (nominal)', " + dat +
            " u 1:4 w l lw 2 t 'calibrated', " + dat + " u 1:5 w l lw 2 t " + after + "\n", 400},
+      // A margin above and below: a line ending just under the frame's 0 kJ was read as cut off by it (session 25).
       {"cumulative.svg", "Cumulative residual (measured minus model) over time",
-       "set xlabel 'time, recordings one after another [min]'\nset ylabel 'cumulative residual energy [kJ]'\nplot " + dat +
+       "set offsets 0, 0, graph 0.05, graph 0.05\nset xlabel 'time, recordings one after another [min]'\nset ylabel 'cumulative residual energy [kJ]'\nplot " + dat +
            " u 1:6 w l lw 2 t 'before (calibrated)', " + dat + " u 1:7 w l lw 2 t " + after + "\n", 400},
       residual_against("residual_speed.svg", "mean speed", "mean speed in the window [km/h]", 8),
       residual_against("residual_accel.svg", "mean positive acceleration", "mean of max(0, a) in the window [m/s^2]", 9),
