@@ -122,7 +122,8 @@ std::vector<Figure> regime_figures(const Diagnosis& d, const fs::path& work) {
     labels << "set label " << k + 1 << " " << gnuplot_string(label) << " at graph -0.02, first " << y << " right\n";
   }
   std::ostringstream script;
-  script << labels.str() << "unset ytics\nset yrange [-0.7:" << n - 0.3 << "]\nset grid noytics\n"
+  // A margin left and right: an interval ending on the frame (the Camry US06's at 14000 W) read as cut off by it.
+  script << labels.str() << "unset ytics\nset yrange [-0.7:" << n - 0.3 << "]\nset offsets graph 0.03, graph 0.03, 0, 0\nset grid noytics\n"
          << "set xlabel 'mean residual power, measured minus calibrated model [W]'\nset lmargin " << std::min<std::size_t>(longest, 60) + 2 << "\n"
          << "set arrow from 0, graph 0 to 0, graph 1 nohead lc 'black'\n"
          << "plot " << dat << " u ($5 > 0 ? $2 : 1/0):1:3:4 w xerrorbars pt 7 ps 1 lw 2 lc rgb '#b03a2e' t 'interval excludes 0', "
