@@ -387,6 +387,18 @@ TEST(CliTyreFit, AJ2452SetGivenTwiceOrJudgedOnItsOwnTrainingIsRefused) {
   EXPECT_TRUE(has(same.err, "a held-out tyre must not be one the constants are fitted on")) << same.err;
 }
 
+// A held-out tyre that is also a fitting one is refused by the library itself, not only by the command line (which
+// had held the check: session 24's note), naming both sources.
+TEST(J2452HeldOut, ATyreAmongTheFittingSetsIsRefusedByTheLibrary) {
+  const auto sets = load_j2452_csv(kJ2452Csv);
+  try {
+    evaluate_j2452_held_out(sets, {load_j2452_csv(kHeldOutCsv).front(), sets[2]}, kJ2452DrumRadius_m, "fit.csv", "held.csv");
+    FAIL() << "accepted a fitting tyre as held out";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("held.csv: the set " + sets[2].name + " is also in fit.csv"), std::string::npos) << e.what();
+  }
+}
+
 TEST(J2452HeldOut, TheFileHoldsEightSetsAndOneFlaggedReading) {
   const auto sets = load_j2452_csv(kHeldOutCsv);
   ASSERT_EQ(sets.size(), 8u);

@@ -5,6 +5,7 @@
 #include <functional>
 #include <stdexcept>
 
+#include "rollsim/common/error.hpp"
 #include "rollsim/common/json.hpp"
 #include "rollsim/common/statistics.hpp"
 #include "rollsim/common/units.hpp"
@@ -346,7 +347,13 @@ J2452Evaluation evaluate_j2452(const std::vector<J2452Set>& sets, double drum_ra
 }
 
 J2452Evaluation evaluate_j2452_held_out(const std::vector<J2452Set>& training, const std::vector<J2452Set>& test,
-                                        double drum_radius_m) {
+                                        double drum_radius_m, const std::string& training_source, const std::string& test_source) {
+  // Judged on a tyre it was fitted on, the table's "none of the tyres below" would be false.
+  for (const auto& h : test)
+    for (const auto& s : training)
+      if (same_j2452_tyre(h, s))
+        throw InputError(test_source, "the set " + h.name + " is also in " + training_source + " (" + s.name +
+                                          "): a held-out tyre must not be one the constants are fitted on");
   J2452Evaluation out;
   out.leave_one_out = false;
   out.shared_all = fit_shared_constants(training, drum_radius_m);

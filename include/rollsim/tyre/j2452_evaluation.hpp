@@ -108,9 +108,10 @@ J2452Evaluation evaluate_j2452(const std::vector<J2452Set>& sets, double drum_ra
 
 /// The same judgement of `test` tyres with the shared constants (and the median J2452 shape) fitted once on
 /// `training`: tyres the model never saw. `shared_all` is the training fit; the common-shape bound is the test
-/// tyres'.
+/// tyres'. A test tyre that is also a training one (same_j2452_tyre) throws InputError naming both sources.
 J2452Evaluation evaluate_j2452_held_out(const std::vector<J2452Set>& training, const std::vector<J2452Set>& test,
-                                        double drum_radius_m);
+                                        double drum_radius_m, const std::string& training_source = "the fitting sets",
+                                        const std::string& test_source = "the held-out sets");
 
 /// Each tyre's RMS error under plan `k` (ev.plans[k]), in the tyres' order.
 std::vector<double> plan_rms_column(const J2452Evaluation& ev, std::size_t k);
