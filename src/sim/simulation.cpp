@@ -884,6 +884,7 @@ SimulationResult simulate_replay(const VehicleModel& m, const DriveCycle& c, con
   constexpr double kMaxReplayPiece_s = 1.0;
   const std::vector<double> regime_speeds = m.powertrain->braking_regime_speeds_mps(m.wheel_radius_m);
   const std::vector<double> traction_speeds = m.powertrain->traction_regime_speeds_mps(m.wheel_radius_m);
+  const std::vector<double> braking_kinks = m.powertrain->braking_kink_speeds_mps(m.wheel_radius_m);
   // Every speed where the gear schedule shifts, in either direction (a ramp is cut there, below).
   std::vector<double> shift_speeds;
   for (int g = 1; g <= m.powertrain->num_gears(); ++g) {
@@ -1049,9 +1050,11 @@ SimulationResult simulate_replay(const VehicleModel& m, const DriveCycle& c, con
           }
         };
         for (double vr : shift_speeds) cut_at(vr);
-        if (a < 0.0)
+        if (a < 0.0) {
           for (double vr : regime_speeds) cut_at(vr);
-        if (a > 0.0)  // where a kicked-down gear's limiter cuts in, the force it gives kinks
+          for (double vr : braking_kinks) cut_at(vr);
+        }
+        if (a > 0.0)  // where the most force kinks: an engine's limiter, a motor's torque-to-power turn and band
           for (double vr : traction_speeds) cut_at(vr);
         const std::size_t cuts = cut.size();
         for (std::size_t p = 0; p + 1 < cuts; ++p) {

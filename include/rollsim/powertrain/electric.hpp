@@ -67,6 +67,8 @@ class ElectricPowertrain final : public Powertrain {
   int select_gear(double, int) const override { return 0; }
   std::vector<double> shift_speeds_mps(int) const override { return {}; }
   std::vector<double> braking_regime_speeds_mps(double wheel_radius_m) const override;
+  std::vector<double> traction_regime_speeds_mps(double wheel_radius_m) const override;
+  std::vector<double> braking_kink_speeds_mps(double wheel_radius_m) const override;
   double max_wheel_force_n(int gear, double speed_mps, double wheel_radius_m) const override;
   const BatteryParams* battery() const override { return &p_.battery; }
   /// From the battery terminals (its own I^2 R for the extra current is neglected: under 1 % of the load at
@@ -86,6 +88,8 @@ class ElectricPowertrain final : public Powertrain {
   double torque_loss_w(double torque_nm, double speed_radps) const;
   /// The speed limiter's factor on the torque limit at this motor speed: 1 below the band, 0 at max speed.
   double speed_limit_factor(double speed_radps) const;
+  /// Road speeds [m/s] of the speed limiter's band: where it starts and the machine's top speed.
+  std::vector<double> speed_band_speeds_mps(double wheel_radius_m) const;
   ElectricPowertrainParams p_;
 };
 

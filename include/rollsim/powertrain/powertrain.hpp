@@ -86,9 +86,14 @@ class Powertrain {
   /// the speed does not feel, so a simulation splits its steps where a deceleration falls through them. Ascending;
   /// empty by default. `wheel_radius_m` as for deliver().
   virtual std::vector<double> braking_regime_speeds_mps(double /*wheel_radius_m*/) const { return {}; }
-  /// Speeds [m/s] at which the most force a gear gives kinks (an engine's limiter cutting in and at its end), for a
-  /// replay to split an acceleration's steps there. Empty by default.
+  /// Speeds [m/s] at which the most force a gear gives kinks (an engine's limiter cutting in and at its end, a motor's
+  /// torque limit giving way to its power limit and its speed limiter's band), for a replay to split an
+  /// acceleration's steps there. Empty by default.
   virtual std::vector<double> traction_regime_speeds_mps(double /*wheel_radius_m*/) const { return {}; }
+  /// Speeds [m/s] at which a braking force's split kinks without a step (a machine's regenerating torque limit
+  /// giving way to its power limit, its speed limiter's band), for a replay to split a deceleration's steps there;
+  /// the forward simulation's error control takes them in its stride. Empty by default.
+  virtual std::vector<double> braking_kink_speeds_mps(double /*wheel_radius_m*/) const { return {}; }
 
   /// The traction battery, or nullptr when the powertrain has none.
   virtual const BatteryParams* battery() const { return nullptr; }
