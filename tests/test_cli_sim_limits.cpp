@@ -44,6 +44,9 @@ TEST_F(SimLimitsCli, EmptyBatteryIsReportedWithTimeAndDistance) {
   ASSERT_EQ(text.exit_code, 0) << text.err;
   EXPECT_TRUE(has(text.out, "WARNING: the usable battery ran empty at t = ")) << text.out;
   EXPECT_FALSE(has(text.out, "% -> -")) << text.out;
+  // What more it would need is a share of the usable capacity, said so (session 25: "534.3 % more" read as more than
+  // the energy it had).
+  EXPECT_TRUE(has(text.out, " % of the usable capacity more)")) << text.out;
   const auto json = run_rollsim("simulate --vehicle ev --json --cycle " + cycle);
   ASSERT_EQ(json.exit_code, 0) << json.err;
   EXPECT_TRUE(has(json.out, "\"battery_empty\": true")) << json.out;

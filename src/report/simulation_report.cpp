@@ -94,7 +94,7 @@ std::string summary_text(const SimulationResult& r, bool solver_stats) {
     o << "  WARNING: the usable battery ran empty at t = " << fixed(r.battery_empty->time_s, 0) << " s, after "
       << fixed(r.battery_empty->distance_m / 1000.0, 3) << " km (state of charge "
       << fixed(r.battery->initial_soc * 100, 1) << " % -> 0 %); the rest of the trace was driven on energy the battery "
-      << "does not hold (it would need " << fixed(-r.battery->final_soc * 100, 1) << " % more)\n";
+      << "does not hold (it would need " << fixed(-r.battery->final_soc * 100, 1) << " % of the usable capacity more)\n";
   }
   const double source_j = r.source_energy_j();
   TextTable t({"energy", "kWh", "share %"});
