@@ -661,6 +661,17 @@ TEST(Simulation, AReplayBrakingThroughTheMotorsKinksIsSplitThere) {
   EXPECT_NEAR(coarse / fine, 1.0, 5e-4);  // 0.03 % now, +0.65 % before
 }
 
+// Where the car was behind is read at the solver's steps too, not only at the trace's samples: on a three-row trace
+// the car behind from the start until it caught up was said to be behind "from t = 5 to 5 s" (session 25's outside
+// testing). ev.yaml cannot reach 100 km/h in 5 s.
+TEST(Simulation, AShortfallIsPlacedBetweenTheTracesSamples) {
+  const auto r = simulate_forward(model_of("vehicles/ev.yaml"), points_only({{0.0, 0.0}, {5.0, 100.0}, {25.0, 100.0}}));
+  ASSERT_EQ(r.shortfalls.size(), 1u);
+  EXPECT_LT(r.shortfalls.front().start_s, 2.0);
+  EXPECT_GT(r.shortfalls.front().end_s, 6.0);
+  EXPECT_LT(r.shortfalls.front().end_s, 25.0);
+}
+
 // A kicked-down gear shifts up at its limiter too. ice.yaml cannot reach 100 km/h in 12 s: it kicks down, and the
 // kicked-down gear settled on its limiter (the force there only tends to zero, so the top-speed root never fired),
 // holding 2nd at 84.9 km/h for the whole minute at 100 km/h, 11.3 l/100 km where the replay reads 8.47 (session 25's
