@@ -86,12 +86,12 @@ enum AccIdx : int {
   kAccumulators
 };
 
-// A scheduled gear whose engine runs into its limiter shifts up, as an automatic's control unit (or a driver) does at
-// the rev limit, where the gear gives under half the force of the next one up: past its top-speed band only, since
-// below it a gear gives at least the next one's force. Without it, an upshift speed the car cannot reach on its
-// rolling radius (the file's check uses the outer radius: 47.9 km/h against 47.0 reachable in 1st) held the car in
-// 1st on the limiter, 23 km/h behind a 70 km/h trace at 9.74 l/100 km, where the replay read 6.16 (session 25's
-// outside testing). The forward simulation and the replay share this rule.
+// A gear whose engine runs into its limiter shifts up, the schedule's or a kicked-down one, as an automatic's control
+// unit (or a driver) does at the rev limit: where the gear gives under half the force of the next one up, which is
+// within its limiter's band only, since below it a gear gives at least the next one's force. Without it, an upshift
+// speed the car cannot reach on its rolling radius (the file's check uses the outer radius: 47.9 km/h against 47.0
+// reachable in 1st) held the car in 1st on the limiter, 23 km/h behind a 70 km/h trace at 9.74 l/100 km, where the
+// replay read 6.16 (session 25's outside testing). The forward simulation and the replay share this rule.
 constexpr double kTopSpeedUpshiftShare = 0.5;
 bool past_top_speed(const Powertrain& p, int gear, double speed_mps, double wheel_radius_m) {
   return gear < p.num_gears() &&

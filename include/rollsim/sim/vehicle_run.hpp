@@ -2,8 +2,8 @@
 #pragma once
 
 #include <optional>
-#include <utility>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "rollsim/cycle/drive_cycle.hpp"
