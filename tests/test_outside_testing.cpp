@@ -727,6 +727,12 @@ TEST_F(OutsideTesting, UnitSlipsInARecordingAreSaidNotDiagnosed) {
   EXPECT_TRUE(has(r.err, "(x3.5")) << r.err;  // x3.58: CAN and GPS distances differ by a few % on the shipped trips
   expect_refused("diagnose --vehicle twizy --preset rsk_twizy --recording '" + write("soc.csv", twizy_scaled(2, 100.0)) + "'",
                  "its soc channel stays within");
+  // A recording 1.5 times the energy the model gives (0.55 x, as an EV's speed in mph read as km/h gave 0.57 with no
+  // word: session 25's outside testing) is said; the band was 0.5-2.
+  const std::string deep = write("soc_deep.csv", recording_edited(std::string(ROLLSIM_SHARED_DIR) + "/data/recordings/rsk_renault_twizy/T1_07_01_2021.csv",
+                                                                  [](int, std::vector<std::string>& f) { f.at(2) = std::to_string(100.0 - (100.0 - std::stod(f.at(2))) * 1.5); }));
+  EXPECT_TRUE(has(run_rollsim("diagnose --vehicle twizy --preset rsk_twizy --recording '" + deep + "'").err,
+                  "warning: the model's energy is 0.55 x the recording's"));
   // The shipped trip as it is: no warning.
   const CmdResult ok = run_rollsim("diagnose --vehicle twizy --preset rsk_twizy --recording '" + std::string(ROLLSIM_SHARED_DIR) +
                                    "/data/recordings/rsk_renault_twizy/T1_07_01_2021.csv'");

@@ -87,6 +87,9 @@ Eigen::VectorXd window_energies(const std::vector<std::vector<double>>& power_w,
                                 const std::vector<std::vector<double>>* end_w = nullptr);
 /// The variant's window energies, read as it was sampled (its end_w when it has them).
 Eigen::VectorXd window_energies(const Variant& v, const Observations& o, double lag_samples);
+/// The variant's power at sample `i` of recording `recording`, shifted by a (fractional) channel lag, read as it was
+/// sampled: what the window energies sum, one sample at a time.
+double lagged_power_w(const Variant& v, std::size_t recording, std::size_t i, double lag_samples);
 
 /// Channel lag (calibration): the continuous shift of the simulated power, 0-10 samples, that best matches the
 /// measured one (interpolated channel), with its profile interval.

@@ -164,6 +164,10 @@ Eigen::VectorXd window_energies(const Variant& v, const Observations& o, double 
   return window_energies(v.power_w, o, lag_samples, v.end_w.empty() ? nullptr : &v.end_w);
 }
 
+double lagged_power_w(const Variant& v, std::size_t recording, std::size_t i, double lag_samples) {
+  return shifted(v.power_w[recording], v.end_w.empty() ? nullptr : ends_of(&v.end_w, recording), i, lag_samples);
+}
+
 namespace {
 double median_dt_s(const Observations& o) {
   std::vector<double> dts(o.dt_s.front());
