@@ -109,8 +109,8 @@ TEST_F(SimLimitsCli, CycleValuesBeyondPhysicalBoundsAreNamedErrors) {
   struct Case {
     std::string csv, expect_value, expect_allowed;
   };
-  for (const Case& c : {Case{"time_s,speed_kmh\n0,0\n10,1e300\n", "1e+300", "<= 500 km/h"},
-                        Case{"time_s,speed_mps\n0,0\n10,1000\n", "1000", "<= 138.9 m/s"},
+  for (const Case& c : {Case{"time_s,speed_kmh\n0,0\n10,1e300\n", "1e+300", "[0, 500] km/h"},
+                        Case{"time_s,speed_mps\n0,0\n10,1000\n", "1000", "[0, 138.9] m/s"},
                         Case{"time_s,speed_kmh\n0,0\n1e300,50\n", "1e+300", "0.001 to 86400 s"},
                         Case{"time_s,speed_kmh\n0,0\n1e-300,0\n2,10\n", "1e-300", "0.001 to 86400 s"},
                         Case{"time_s,speed_kmh\n0,0\n1,100\n", "27.7", "19.6 m/s^2"}}) {

@@ -360,6 +360,11 @@ TEST_F(DriveCycleFiles, BadInputNamesFileLineColumnAndValue) {
   EXPECT_TRUE(has(m, "missing column 'time_s'"));
   m = error_of("time_s,speed_kmh,speed_mps\n0,0,0\n1,1,1\n");
   EXPECT_TRUE(has(m, "both"));
+  // A speed out of range says its range as every other key does (it read "must be in >= 0 and <= 500 km/h").
+  m = error_of("time_s,speed_kmh\n0,0\n1,-5\n2,0\n");
+  EXPECT_TRUE(has(m, "line 3, column 'speed_kmh': -5 is not allowed: speed must be in [0, 500] km/h"));
+  m = error_of("time_s,speed_mps\n0,0\n1,200\n2,0\n");
+  EXPECT_TRUE(has(m, "200 is not allowed: speed must be in [0, 138.9] m/s (500 km/h)"));
   m = error_of("time_s,speed_kmh\n0,0\n1,fast\n2,3\n");  // text in a number column
   EXPECT_TRUE(has(m, "bad.csv: line 3, column 'speed_kmh'"));
   EXPECT_TRUE(has(m, "'fast' is not a number"));
@@ -377,7 +382,7 @@ TEST_F(DriveCycleFiles, BadInputNamesFileLineColumnAndValue) {
   m = error_of("time_s,speed_kmh\n0,0\n1,-2\n");
   EXPECT_TRUE(has(m, "line 3"));
   EXPECT_TRUE(has(m, "-2"));
-  EXPECT_TRUE(has(m, ">= 0"));
+  EXPECT_TRUE(has(m, "[0, 500] km/h"));
   m = error_of("time_s,speed_kmh\n0,0\n1,5\n1,6\n");  // time repeats: both lines named
   EXPECT_TRUE(has(m, "line 4, column 'time_s'"));
   EXPECT_TRUE(has(m, "line 3"));

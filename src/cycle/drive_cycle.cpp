@@ -339,7 +339,7 @@ DriveCycle cycle_from_table(const CsvTable& table, const std::string& name) {
     const double v_max = col_kmh ? kMaxCycleSpeed_kmh : units::kmh_to_mps(kMaxCycleSpeed_kmh);
     if (!(v >= 0.0 && v <= v_max * (1.0 + 1e-12))) {
       throw InputError(table.where(r, col_v), format_value(v) + " is not allowed: speed must be in " +
-                                                  (col_kmh ? std::string(">= 0 and <= 500 km/h") : std::string(">= 0 and <= 138.9 m/s (500 km/h)")));
+                                                  (col_kmh ? std::string("[0, 500] km/h") : std::string("[0, 138.9] m/s (500 km/h)")));
     }
     c.speed_mps[r] = col_kmh ? units::kmh_to_mps(v) : v;
     if (r > 0 && std::abs(c.speed_mps[r] - c.speed_mps[r - 1]) / dt > kMaxCycleAccel_mps2) {
