@@ -98,7 +98,7 @@ class TerminationSignalsHeld {
  public:
   TerminationSignalsHeld() {
     sigemptyset(&held_);
-    for (int s : {SIGINT, SIGTERM, SIGHUP, SIGQUIT}) sigaddset(&held_, s);
+    for (int s : kSignals) sigaddset(&held_, s);
     pthread_sigmask(SIG_BLOCK, &held_, &before_);
   }
   ~TerminationSignalsHeld() { pthread_sigmask(SIG_SETMASK, &before_, nullptr); }
@@ -109,7 +109,7 @@ class TerminationSignalsHeld {
   [[nodiscard]] bool stop_requested() const {
     sigset_t pending;
     if (sigpending(&pending) != 0) return false;
-    for (int s : {SIGINT, SIGTERM, SIGHUP, SIGQUIT}) {
+    for (int s : kSignals) {
       if (sigismember(&held_, s) != 1 || sigismember(&before_, s) == 1 || sigismember(&pending, s) != 1) continue;
       struct sigaction now {};
       if (sigaction(s, nullptr, &now) == 0 && now.sa_handler != SIG_IGN) return true;
@@ -118,6 +118,7 @@ class TerminationSignalsHeld {
   }
 
  private:
+  static constexpr int kSignals[] = {SIGINT, SIGTERM, SIGHUP, SIGQUIT};
   sigset_t held_{};
   sigset_t before_{};
 };

@@ -418,10 +418,12 @@ class ForwardSystem final : public OdeSystem {
     g[1] = shifts_down_ > 0.0 ? v - (shifts_down_ - kShiftMargin_mps) : 1.0;
     const double demand_n = force_request(t, y);
     const double force_n = max_force(gear, v);
+    const bool has_next = gear < m_.powertrain->num_gears();
+    const double next_force_n = has_next ? max_force(gear + 1, v) : 0.0;  // read once for g[3] and g[5]
     g[2] = gear > 1 && kicks_down_to(gear - 1, force_n, v) ? force_n - demand_n : 1.0;
-    g[3] = gear < scheduled_gear_ ? kKickdownReturn * max_force(gear + 1, v) - demand_n : -1.0;
+    g[3] = gear < scheduled_gear_ ? kKickdownReturn * next_force_n - demand_n : -1.0;
     g[4] = gear < scheduled_gear_ && !(force_n > 0.0) ? -1.0 : 1.0;
-    g[5] = gear < m_.powertrain->num_gears() ? force_n - kTopSpeedUpshiftShare * max_force(gear + 1, v) : 1.0;
+    g[5] = has_next ? force_n - kTopSpeedUpshiftShare * next_force_n : 1.0;
   }
 
   /// Sets the schedule's gear and the gear actually engaged (the schedule's, or lower where the demand needs it).
