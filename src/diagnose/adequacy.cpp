@@ -8,6 +8,7 @@
 #include "pipeline.hpp"
 
 #include "rollsim/common/units.hpp"
+#include "rollsim/cycle/elevation.hpp"
 
 namespace rollsim::diag {
 namespace {
@@ -15,11 +16,17 @@ namespace {
 struct Block {
   std::size_t rec = 0;
   double start_s = 0.0, end_s = 0.0, residual_j = 0.0, distance_start_m = 0.0, distance_end_m = 0.0;
+  Eigen::RowVectorXd grade_j;  // the grade noise's energy over the block, per draw (empty without elevation)
 };
+
+// A block's expected noise variance: white at the short scale, plus the grade's errors (their draws' mean square:
+// zero-mean by construction).
+double grade_variance_j2(const Block& b) { return b.grade_j.size() > 0 ? b.grade_j.squaredNorm() / static_cast<double>(b.grade_j.size()) : 0.0; }
+double expected_variance_j2(const Block& b, const NoiseFloor& nf) { return nf.variance_per_s * (b.end_s - b.start_s) + grade_variance_j2(b); }
 
 // Consecutive windows of each recording summed into blocks of at least `scale_s` (a last one of half kept).
 std::vector<Block> blocks_of(const Observations& o, const std::vector<Recording>& recs, const Eigen::VectorXd& resid,
-                             double scale_s) {
+                             const Eigen::MatrixXd& grade_window_j, double scale_s) {
   std::vector<Block> out;
   std::vector<std::vector<double>> dist(recs.size());
   for (std::size_t r = 0; r < recs.size(); ++r) {
@@ -38,12 +45,14 @@ std::vector<Block> blocks_of(const Observations& o, const std::vector<Recording>
     const Recording& r = recs[win.rec];
     if (open && cur.rec != win.rec) close();
     if (!open) {
-      cur = {win.rec, r.time_s[win.begin] - r.time_s.front(), 0.0, 0.0, dist[win.rec][win.begin], 0.0};
+      cur = {win.rec, r.time_s[win.begin] - r.time_s.front(), 0.0, 0.0, dist[win.rec][win.begin], 0.0, {}};
+      if (grade_window_j.rows() == o.n()) cur.grade_j = Eigen::RowVectorXd::Zero(grade_window_j.cols());
       open = true;
     }
     cur.end_s = r.time_s[win.end] - r.time_s.front();
     cur.distance_end_m = dist[win.rec][win.end];
     cur.residual_j += resid[w];
+    if (cur.grade_j.size() > 0) cur.grade_j += grade_window_j.row(w);
     if (cur.end_s - cur.start_s >= scale_s - 1e-9) close();
   }
   close();
@@ -85,21 +94,27 @@ Adequacy test_adequacy(const Observations& o, const std::vector<Recording>& recs
   Adequacy best;
   if (!(nf.variance_per_s > 0.0)) return best;
   for (double scale : opt.adequacy_scales_s) {
-    const std::vector<Block> blocks = blocks_of(o, recs, resid, std::max(scale, o.window_s));
+    const std::vector<Block> blocks = blocks_of(o, recs, resid, nf.grade_window_j, std::max(scale, o.window_s));
     if (blocks.size() < 4) continue;
-    double ss = 0.0, expected = 0.0;
+    double ss = 0.0, expected = 0.0, grade = 0.0;
     for (const auto& b : blocks) {
       ss += b.residual_j * b.residual_j;
-      expected += nf.variance_per_s * (b.end_s - b.start_s);
+      expected += expected_variance_j2(b, nf);
+      grade += grade_variance_j2(b);
     }
     const double ratio = ss / expected;
-    // ln ratio under noise alone: chi^2 over the blocks, and the floor's own estimate (
-    // second differences, under 2/3 efficient): variance 2 / blocks + 3 / triples.
-    const double z = std::log(ratio) / std::sqrt(2.0 / static_cast<double>(blocks.size()) + 3.0 / nf.triples);
+    const double grade_share = grade / expected;
+    // ln ratio under noise alone: chi^2 over the blocks, the floor's own estimate (second differences, under 2/3
+    // efficient) and the grade noise's (a mean square of as many draws, weighed by its share): variance
+    // 2 / blocks + 3 / triples + 2 share^2 / draws.
+    const double draws = std::max<double>(1.0, static_cast<double>(nf.grade_window_j.cols()));
+    const double z = std::log(ratio) / std::sqrt(2.0 / static_cast<double>(blocks.size()) + 3.0 / nf.triples +
+                                                 2.0 * grade_share * grade_share / draws);
     if (z <= best.z) continue;
     best.z = z;
     best.ratio = ratio;
     best.scale_s = std::max(scale, o.window_s);
+    best.grade_share = grade_share;
     best.inadequate = z >= opt.adequacy_z && ratio >= opt.adequacy_min_ratio;
     // Where: the blocks beyond three noise sds.
     best.flagged = 0;
@@ -108,7 +123,7 @@ Adequacy test_adequacy(const Observations& o, const std::vector<Recording>& recs
     best.first_s = 1e300, best.last_s = 0.0, best.first_m = 1e300, best.last_m = 0.0;
     double moving_s = 0.0, moving_m = 0.0;
     for (const auto& b : blocks) {
-      if (std::abs(b.residual_j) <= 3.0 * std::sqrt(nf.variance_per_s * (b.end_s - b.start_s))) continue;
+      if (std::abs(b.residual_j) <= 3.0 * std::sqrt(expected_variance_j2(b, nf))) continue;
       ++best.flagged;
       best.flagged_j += b.residual_j;
       best.first_s = std::min(best.first_s, b.start_s);
@@ -133,7 +148,9 @@ Finding adequacy_finding(const Adequacy& a, const NoiseFloor& nf, const Observat
   const double total_j = std::max(1e-9, std::abs(o.measured_j.sum()));
   f.description = "the residual is " + fixed(a.ratio, 1) + " times the recording's own noise floor (variance, over " +
                   fixed(a.scale_s, 0) + " s blocks; floor " + fixed(std::sqrt(nf.variance_per_s * nf.window_s) / 1e3, 2) +
-                  " kJ per " + fixed(nf.window_s, 0) + " s, z " + fixed(a.z, 1) + "), and no catalogue effect explains it";
+                  " kJ per " + fixed(nf.window_s, 0) + " s" +
+                  (a.grade_share > 0.0 ? ", with the recorded elevation's noise " + fixed(100.0 * a.grade_share, 1) + " % of it" : "") +
+                  ", z " + fixed(a.z, 1) + "), and no catalogue effect explains it";
   if (a.flagged > 0)
     f.description += ": " + std::to_string(a.flagged) + " of " + std::to_string(a.blocks) + " blocks beyond 3 noise sd, between " +
                      fixed(a.first_s / 60.0, 0) + " and " + fixed(a.last_s / 60.0, 0) + " min since the start (" +
@@ -158,10 +175,52 @@ Finding adequacy_finding(const Adequacy& a, const NoiseFloor& nf, const Observat
 }  // namespace rollsim::diag
 
 namespace rollsim::diag {
+namespace {
+
+// Draws of the grade's errors: the mean square of 64 has a relative sd of 18 %, weighed in the z by its share.
+constexpr int kGradeDraws = 64;
+
+// Per window and draw, the energy the grade's errors from each recorded elevation's white noise add: per sample, the
+// channel's power per newton of a force along the road (the unit constant-force basis, run through the powertrain
+// as the grade's force is) times m g per unit grade, over the sample's interval. First order in the grade's error;
+// the lag is left out (a fraction of a second against errors correlated over 300 m of road).
+Eigen::MatrixXd grade_noise_energies(const Observations& o, const std::vector<Recording>& recs, const Signatures& s,
+                                     double channel_scale, double mass_kg) {
+  const auto unit = std::find_if(s.basis.begin(), s.basis.end(), [](const BasisShape& b) {
+    return b.kind == BasisShape::force && b.shape == ForceShape::constant && b.decay_s == 0.0;
+  });
+  if (unit == s.basis.end() || unit->power_w.size() != recs.size()) return {};
+  std::vector<std::vector<std::vector<double>>> draws(recs.size());
+  bool any = false;
+  for (std::size_t r = 0; r < recs.size(); ++r) {
+    const Recording& rec = recs[r];
+    if (rec.grade || !rec.elevation_m) continue;
+    const ElevationGrade read = grade_from_elevation(rec.time_s, rec.speed_mps, *rec.elevation_m);
+    draws[r] = grade_noise_draws(rec.time_s, rec.speed_mps, *rec.elevation_m, read.noise_sd_m, kGradeDraws,
+                                 0x9e3779b9u + static_cast<unsigned>(r));
+    any = any || !draws[r].empty();
+  }
+  if (!any) return {};
+  Eigen::MatrixXd e = Eigen::MatrixXd::Zero(o.n(), kGradeDraws);
+  const double per_grade_n = mass_kg * units::kStandardGravity_mps2;
+  for (Eigen::Index w = 0; w < o.n(); ++w) {
+    const Window& win = o.windows[static_cast<std::size_t>(w)];
+    if (draws[win.rec].empty()) continue;
+    const auto& unit_w = unit->power_w[win.rec];
+    const auto& base_w = s.base.power_w[win.rec];
+    for (std::size_t i = win.begin; i < win.end; ++i) {
+      const double j_per_grade = channel_scale * per_grade_n * (unit_w[i] - base_w[i]) * o.dt_s[win.rec][i];
+      for (int d = 0; d < kGradeDraws; ++d) e(w, d) += j_per_grade * draws[win.rec][static_cast<std::size_t>(d)][i];
+    }
+  }
+  return e;
+}
+
+}  // namespace
 
 // The calibrated model's residual on short windows, and the floor from it.
 NoiseFloor calibrated_noise_floor(const Observations& o, const std::vector<Recording>& recs, const Signatures& s,
-                                  const Calibration& cal, double lag_samples, const DiagnoseOptions& opt) {
+                                  const Calibration& cal, double lag_samples, double mass_kg, const DiagnoseOptions& opt) {
   double dt = 1.0;
   if (!o.dt_s.empty() && !o.dt_s.front().empty()) {
     std::vector<double> d = o.dt_s.front();
@@ -174,7 +233,9 @@ NoiseFloor calibrated_noise_floor(const Observations& o, const std::vector<Recor
   const Eigen::VectorXd b = window_energies(s.base, shortw, lag_samples);
   const Eigen::VectorXd sim = k[0] * b + k[1] * (window_energies(s.rrc, shortw, lag_samples) - b) +
                               k[2] * (window_energies(s.drag, shortw, lag_samples) - b);
-  return noise_floor(shortw, shortw.measured_j - sim);
+  NoiseFloor f = noise_floor(shortw, shortw.measured_j - sim);
+  f.grade_window_j = grade_noise_energies(o, recs, s, k[0], mass_kg);
+  return f;
 }
 
 }  // namespace rollsim::diag

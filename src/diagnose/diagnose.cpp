@@ -39,6 +39,16 @@ void note_engine_state(const DriveCycle& c, const Recording& r, const EngineStar
                                    " s in all (standing with zero fuel flow): no fuel there, and a cold engine cools"));
 }
 
+// The rms over the moving samples of per-sample values (draws of a grade's error), 0 without any.
+double moving_rms(const Recording& r, const std::vector<std::vector<double>>& draws) {
+  double ss = 0.0;
+  std::size_t count = 0;
+  for (const auto& d : draws)
+    for (std::size_t i = 0; i < d.size() && i < r.speed_mps.size(); ++i)
+      if (r.speed_mps[i] > 0.0) ss += d[i] * d[i], ++count;
+  return count > 0 ? std::sqrt(ss / static_cast<double>(count)) : 0.0;
+}
+
 std::vector<DriveCycle> cycles_of(const std::vector<Recording>& recordings, const DiagnoseOptions& opt,
                                   std::vector<std::string>& notes) {
   std::vector<DriveCycle> cycles;
@@ -46,10 +56,15 @@ std::vector<DriveCycle> cycles_of(const std::vector<Recording>& recordings, cons
     const Recording& r = recordings[k];
     const EngineStart start = k < opt.engine_start.size() ? opt.engine_start[k] : EngineStart::infer;
     cycles.push_back(cycle_of_recording(r, opt.engine_off_min_s, start));
-    if (!r.grade && r.elevation_m)
-      notes.push_back(r.source + ": grade from recorded elevation (" +
-                      std::to_string(grade_from_elevation(r.time_s, r.speed_mps, *r.elevation_m).rejected_steps) +
-                      " elevation steps rejected as glitches, Savitzky-Golay slope over 300 m)");
+    if (!r.grade && r.elevation_m) {
+      const ElevationGrade read = grade_from_elevation(r.time_s, r.speed_mps, *r.elevation_m);
+      notes.push_back(r.source + ": grade from recorded elevation (" + std::to_string(read.rejected_steps) +
+                      " elevation steps rejected as glitches, Savitzky-Golay slope over 300 m; white noise of " +
+                      fixed(read.noise_sd_m, 2) + " m per reading about the road, " +
+                      fixed(100.0 * moving_rms(r, grade_noise_draws(r.time_s, r.speed_mps, *r.elevation_m, read.noise_sd_m, 16, 1u)), 2) +
+                      " % of grade rms after the filter, carried into the noise floor; the uphill and downhill regimes "
+                      "are read on this grade, so its errors put a residual of their own there)");
+    }
   }
   return cycles;
 }
@@ -356,7 +371,7 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
   report_calibration(cal, obs, lag, out);
   SelectionContext sc{rp, obs, sig.base, lag.samples, ctx, amb, recordings, opt, {}};
   out.located = locate_regimes(obs, recordings, cycles, sig, cal.model.fit.coef, lag.samples, &sc.standing);
-  const NoiseFloor floor = calibrated_noise_floor(obs, recordings, sig, cal, lag.samples, opt);
+  const NoiseFloor floor = calibrated_noise_floor(obs, recordings, sig, cal, lag.samples, ctx.mass_kg, opt);
   const Adequacy before = test_adequacy(obs, recordings, per_recording_residual(cal.model, obs, recordings.size()), floor, opt);
   out.noise_floor_j = std::sqrt(floor.variance_per_s * floor.window_s);
   out.residual_to_noise_ratio = before.ratio, out.residual_to_noise_z = before.z, out.adequacy_scale_s = before.scale_s;

@@ -355,12 +355,17 @@ struct NoiseFloor {
   double variance_per_s = 0.0;  // of a window's noise energy [J^2], per second of window
   int triples = 0;
   double window_s = 0.0;
+  /// Per window of the observations, per Monte Carlo draw: the energy the grade's errors from a recorded elevation's
+  /// white noise add [J] (errors in the model's input, correlated over the filter's 300 m: no short window sees them).
+  /// Empty without an elevation column.
+  Eigen::MatrixXd grade_window_j;
 };
 /// From the calibrated residual of short windows (`short_obs`): the mean squared second difference over 6.
 NoiseFloor noise_floor(const Observations& short_obs, const Eigen::VectorXd& resid);
 
 struct Adequacy {
   double ratio = 0.0, z = -1e300, scale_s = 0.0;  // at the scale of largest z
+  double grade_share = 0.0;  // of the expected variance there, the recorded elevation's noise
   bool inadequate = false;
   int blocks = 0, flagged = 0;
   double flagged_j = 0.0, first_s = 0.0, last_s = 0.0, first_m = 0.0, last_m = 0.0, flagged_mean_speed_mps = 0.0;
@@ -378,8 +383,10 @@ Finding adequacy_finding(const Adequacy& a, const NoiseFloor& nf, const Observat
 }  // namespace rollsim::diag
 
 namespace rollsim::diag {
+/// The calibrated model's short-window floor, and the energies the recorded elevations' noise adds through the grade
+/// (`mass_kg` the grade force's mass).
 NoiseFloor calibrated_noise_floor(const Observations& o, const std::vector<Recording>& recs, const Signatures& s,
-                                  const Calibration& cal, double lag_samples, const DiagnoseOptions& opt);
+                                  const Calibration& cal, double lag_samples, double mass_kg, const DiagnoseOptions& opt);
 std::string calibration_outside_prior_text(const Calibration& c, const Observations& o, const std::vector<Candidate>& cands,
                                            bool with_explanations = true);
 }  // namespace rollsim::diag

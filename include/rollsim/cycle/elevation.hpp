@@ -9,7 +9,8 @@ namespace rollsim {
 /// Fixed in advance for GPS altitude (1 m resolution, glitches of tens to hundreds of metres, 0 for "no fix").
 struct ElevationGradeOptions {
   double max_step_grade = 0.20;     ///< a step steeper than this over the distance covered is a glitch
-  double step_tolerance_m = 5.0;    ///< allowed on top (1 m resolution, metre noise: 3.5 sd of a step)
+  double step_tolerance_m = 5.0;    ///< allowed on top (1 m resolution, metre noise: 3.5 sd of a step); at least
+                                    ///< 5 sds of a step where the readings' own noise is larger
   double grid_m = 5.0;              ///< distance grid the profile is averaged onto
   /// Savitzky-Golay window over distance: a cubic's slope over 300 m keeps 99.84 % of a 1 km hill's grade (99.97 % at
   /// 1.5 km); white elevation noise of 1 m per 5 m cell becomes grade noise of 0.36 % sd (docs/diagnose.md).
@@ -20,6 +21,11 @@ struct ElevationGradeOptions {
 struct ElevationGrade {
   std::vector<double> grade;  ///< rise over run, per sample
   int rejected_steps = 0;     ///< elevation steps treated as glitches
+  /// White noise on each reading about the road [m], from each moving reading's deviation from the line through its
+  /// neighbours along the road (what a GPS altitude jitters by from fix to fix; noise correlated over tens of seconds
+  /// looks like the road and is not in it).
+  double noise_sd_m = 0.0;
+  int noise_triples = 0;  ///< readings it is estimated from
 };
 
 /// Grade per sample from elevation: distance from the speed (trapezoid); each sample-to-sample elevation step
@@ -36,5 +42,13 @@ std::vector<double> cubic_slope_weights(std::ptrdiff_t first, std::ptrdiff_t las
 
 ElevationGrade grade_from_elevation(const std::vector<double>& time_s, const std::vector<double>& speed_mps,
                                     const std::vector<double>& elevation_m, const ElevationGradeOptions& opt = {});
+
+/// The grade's errors that white noise of `noise_sd_m` on each reading makes, by Monte Carlo through the same filter:
+/// per draw, per sample, the grade of the corrected profile with fresh noise on its moving readings (a standstill's
+/// or a dropped glitch's copy keeps its source's) less its grade without. Glitches are dropped where the recording's
+/// own were, so the draws carry the filter's noise gain, not more glitches. Empty without noise or samples.
+std::vector<std::vector<double>> grade_noise_draws(const std::vector<double>& time_s, const std::vector<double>& speed_mps,
+                                                   const std::vector<double>& elevation_m, double noise_sd_m, int draws,
+                                                   unsigned seed, const ElevationGradeOptions& opt = {});
 
 }  // namespace rollsim
