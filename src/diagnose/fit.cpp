@@ -155,6 +155,49 @@ double Scored::amplitude_se(double inflate) const {
   return std::sqrt(std::max(0.0, fit.cov(j, j))) * inflate / std::max(1e-300, std::abs(fit.coef[0]));
 }
 
+namespace {
+
+bool box_active(const Prior& prior, const Eigen::VectorXd& coef) {
+  for (const auto& b : prior.boxes)
+    if (std::abs(coef[b.column] - b.low) < 1e-12 || std::abs(coef[b.column] - b.high) < 1e-12) return true;
+  return false;
+}
+
+double penalised_criterion(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, const Prior& prior, const Eigen::VectorXd& c) {
+  double v = (y - x * c).squaredNorm();
+  for (const auto& r : prior.rows) v += r.weight * r.weight * (c[r.column] - r.target) * (c[r.column] - r.target);
+  return v;
+}
+
+}  // namespace
+
+std::pair<double, double> amplitude_interval(const Model& m, const Eigen::VectorXd& signature, const Scored& s, double inflate) {
+  const double value = s.amplitude(), se = s.amplitude_se(inflate);
+  const std::pair<double, double> wald{value - 1.96 * se, value + 1.96 * se};
+  if (!box_active(m.prior, s.fit.coef) || !(se > 0.0)) return wald;
+  // At amplitude a the model is c0 (x0 + a signature) + the rest: linear in the coefficients, boxes kept.
+  auto rise = [&](double a) {
+    Eigen::MatrixXd x = m.x;
+    x.col(0) += a * signature;
+    const Fit f = least_squares(x, *m.y, m.prior);
+    return penalised_criterion(x, *m.y, m.prior, f.coef);
+  };
+  const Eigen::Index n = m.x.rows(), p = m.x.cols() + 1;
+  const double variance = s.fit.rss / std::max<double>(1.0, static_cast<double>(n - p));
+  const double minimum = rise(value), threshold = minimum + 1.96 * 1.96 * inflate * inflate * variance;
+  // Each end: stepped out from the Wald end (doubling) until the criterion passes the threshold, then bisected.
+  auto end = [&](double direction) {
+    double inside = value, outside = value + direction * 1.96 * se;
+    for (int k = 0; k < 12 && rise(outside) < threshold; ++k) inside = outside, outside = value + direction * 1.96 * se * std::pow(2.0, k + 1);
+    for (int k = 0; k < 40; ++k) {
+      const double mid = 0.5 * (inside + outside);
+      (rise(mid) < threshold ? inside : outside) = mid;
+    }
+    return 0.5 * (inside + outside);
+  };
+  return {std::min(wald.first, end(-1.0)), std::max(wald.second, end(+1.0))};
+}
+
 double delta_bic(const Model& m, double rss_with) { return m.n_eff * std::log(m.fit.rss / rss_with) - std::log(m.n_eff); }
 
 Scored score_column(const Model& m, const Eigen::VectorXd& signature) {

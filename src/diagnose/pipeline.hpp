@@ -167,6 +167,13 @@ struct Scored {
 };
 Eigen::VectorXd heldout_prediction(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, const std::vector<int>& fold_of,
                                    const Prior& prior);
+/// The amplitude's 95 % interval (per channel scale 1) of `s`, the model `m` with `signature` as its last column.
+/// Without an active box it is the fit's own, +-1.96 amplitude_se. With one (a scale pinned at its prior's bound),
+/// the fit's covariance holds the pinned coefficient fixed and its interval is too narrow. This one is the
+/// amplitude's profile: every other coefficient is refitted within its box, and the interval is where the penalised
+/// criterion rises less than 1.96^2 inflate^2 times the residual variance (without a box, the same interval), or the
+/// fit's own where that is wider. It widens where the pinned coefficient could move inward.
+std::pair<double, double> amplitude_interval(const Model& m, const Eigen::VectorXd& signature, const Scored& s, double inflate);
 double delta_bic(const Model& m, double rss_with);
 Scored score_column(const Model& m, const Eigen::VectorXd& signature);
 /// True when the candidate fits better out of fold than the model without it.

@@ -102,13 +102,14 @@ std::optional<Finding> describe_unexplained(const SelectionContext& sc, const st
   Finding f;
   f.effect = "unexplained";
   f.delta_bic = best.dbic;
-  const double value = best.amplitude(), se = best.amplitude_se(m.inflate), s = best.fit.coef[0];
+  const double value = best.amplitude(), s = best.fit.coef[0];
+  const auto [low, high] = amplitude_interval(m, b.signature, best, m.inflate);
   double vmax = 0.0;
   for (const auto& r : sc.recordings)
     for (double v : r.speed_mps) vmax = std::max(vmax, v);
   const BasisWords w = words_of(b, value, vmax > units::kmh_to_mps(90.0) ? 100.0 : 50.0, sc.obs.channel);
   set_finding_metrics(f, m, b.signature, best);
-  f.parameters.push_back({w.name, w.unit, value, value - 1.96 * se, value + 1.96 * se});
+  f.parameters.push_back({w.name, w.unit, value, low, high});
   std::string when;
   if (prof) {
     const auto& pi = prof->interval;
