@@ -209,6 +209,7 @@ PowerFlow ConventionalPowertrain::deliver(double wheel_force_n, double speed_mps
       out.engaged_gear = op.gear;
       if (cut_off) {
         out.aux_power_w = 0.0;
+        out.fuel_cut = true;
         out.machine_speed_radps = op.engine_speed_radps;
         out.gear_ratio = op.ratio;
         return out;

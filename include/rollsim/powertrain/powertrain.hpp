@@ -27,7 +27,8 @@ class EngineMap;
 
 /// Books an electric load of `power_w` carried by an engine through its alternator: the fuel it costs at the
 /// engine's marginal efficiency (extra fuel per extra brake work at part load), and the loss that is not the load.
-/// One rule for every fuel-burning powertrain.
+/// On the overrun with the fuel cut off the wheels carry it, booked as braking, as they carry the car's own
+/// accessories: no fuel. One rule for every fuel-burning powertrain.
 void add_alternator_load(double power_w, double alternator_efficiency, double marginal_efficiency,
                          const FuelParams& fuel, PowerFlow& flow);
 
@@ -53,6 +54,7 @@ struct PowerFlow {
   int engaged_gear = 0;                 ///< the gear a powertrain that picks its own engaged (1 = first); 0 otherwise
   double gear_ratio = 0.0;              ///< the engaged gear's (or a CVT's) input per output speed; 0 when none is
   bool force_limited = false;           ///< true when the request exceeded what the powertrain can deliver
+  bool fuel_cut = false;                ///< true while an engine is motored on the overrun with its fuel cut off
 };
 
 /// A powertrain. Implementations know their own parameters; the simulator calls only this interface, so the
