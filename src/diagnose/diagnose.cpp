@@ -10,6 +10,7 @@
 #include "rollsim/common/error.hpp"
 #include "rollsim/common/units.hpp"
 #include "rollsim/cycle/elevation.hpp"
+#include "rollsim/cycle/speed_resolution.hpp"
 
 namespace rollsim {
 namespace {
@@ -56,6 +57,11 @@ std::vector<DriveCycle> cycles_of(const std::vector<Recording>& recordings, cons
     const Recording& r = recordings[k];
     const EngineStart start = k < opt.engine_start.size() ? opt.engine_start[k] : EngineStart::infer;
     cycles.push_back(cycle_of_recording(r, opt.engine_off_min_s, start));
+    if (const SpeedResolution res = read_speed_resolution(r.time_s, r.speed_mps); res.smoothed)
+      notes.push_back(r.source + ": speed on a " + fixed(units::mps_to_kmh(res.quantum_mps), 3) + " km/h lattice, one step per "
+                      "sample a " + fixed(res.step_accel_mps2, 2) + " m/s^2 acceleration the car did not make: the replay "
+                      "follows a quadratic fitted over " + std::to_string(2 * res.half_window + 1) +
+                      " samples about each (standstills kept)");
     if (!r.grade && r.elevation_m) {
       const ElevationGrade read = grade_from_elevation(r.time_s, r.speed_mps, *r.elevation_m);
       notes.push_back(r.source + ": grade from recorded elevation (" + std::to_string(read.rejected_steps) +
@@ -317,7 +323,8 @@ DriveCycle cycle_of_recording(const Recording& r, double engine_off_min_s, Engin
   // Time from the start of the recording: effects that decay from the start of a trip read it.
   c.time_s = r.time_s;
   for (double& t : c.time_s) t -= r.time_s.front();
-  c.speed_mps = r.speed_mps;
+  // A staircase speed (a coarse channel sampled fast) replayed as it is fakes accelerations of a step per sample.
+  c.speed_mps = read_speed_resolution(r.time_s, r.speed_mps).speed_mps;
   if (r.grade) c.grade = *r.grade;
   else if (r.elevation_m) c.grade = grade_from_elevation(r.time_s, r.speed_mps, *r.elevation_m).grade;
   else c.grade.assign(r.time_s.size(), 0.0);
