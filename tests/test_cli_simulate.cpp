@@ -121,6 +121,18 @@ TEST(CliSimulate, BadInputGivesOneClearErrorAndNonZeroExit) {
   }
 }
 
+TEST(CliSimulate, AFileAfterJsonIsToldWhereJsonGoes) {
+  // `--json` prints on stdout everywhere but in diagnose, where it names a file; a file after it elsewhere was
+  // refused as "The following argument was not expected" alone (session 26's outside testing).
+  for (const std::string cmd : {"simulate --vehicle ev --json out.json", "validate --json out.json"}) {
+    const auto out = run(cmd);
+    EXPECT_EQ(out.exit_code, 2) << cmd;
+    EXPECT_NE(out.text.find("takes no file: it prints JSON on stdout"), std::string::npos) << cmd << ": " << out.text;
+    EXPECT_NE(out.text.find("rollsim diagnose --json FILE"), std::string::npos) << out.text;
+  }
+  EXPECT_EQ(run("tyre --json 175-70R14").exit_code, 0);  // a positional after the flag is still one
+}
+
 // A tyre loaded above its rating runs, with a warning naming it (load index 75: 387 kg, 3795 N < 4000 N).
 TEST(CliSimulate, OverloadedTyreRunsWithAWarning) {
   const auto tyre = rollsim::test::temp_dir() / "li75.yaml";

@@ -102,6 +102,18 @@ int checked_stdout(const rollsim::ProcessGroup& group, int code) {
 
 }  // namespace
 
+// `--json` is a flag that prints on stdout in every command but diagnose, where it names a file: a file name after
+// it elsewhere was refused as "The following argument was not expected" (session 26's outside testing).
+std::string json_file_hint(int argc, char** argv, const std::string& parse_error) {
+  if (argc < 2 || std::string(argv[1]) == "diagnose") return "";
+  for (int i = 2; i + 1 < argc; ++i) {
+    if (std::string(argv[i]) != "--json" || parse_error.find(argv[i + 1]) == std::string::npos) continue;
+    return std::string("--json ") + argv[i + 1] + ": `rollsim " + argv[1] + " --json` takes no file: it prints JSON on stdout "
+           "(redirect it: --json > " + argv[i + 1] + "); `rollsim diagnose --json FILE` is the one that writes a file";
+  }
+  return "";
+}
+
 int main(int argc, char** argv) {
   std::optional<rollsim::ProcessGroup> started;
   try {
@@ -147,6 +159,10 @@ int main(int argc, char** argv) {
     // --help and --version answer with exit 0; every other parse error is bad input, exit 2 like the rest (CLI11's
     // own codes, 105-109, would tell a script nothing more).
     // The help and version text go to stdout too, and a failed write there is said (it exited 0: session 22).
+    if (const std::string hint = json_file_hint(argc, argv, e.what()); !hint.empty()) {
+      std::cerr << "error: " << hint << "\n";
+      return 2;
+    }
     const int code = app.exit(e);
     return code == 0 ? checked_stdout(group, 0) : 2;
   } catch (const rollsim::InputError& e) {
