@@ -100,8 +100,6 @@ int checked_stdout(const rollsim::ProcessGroup& group, int code) {
   return code == 0 ? 2 : code;
 }
 
-}  // namespace
-
 // `--json` is a flag that prints on stdout in every command but diagnose, where it names a file: a file name after
 // it elsewhere was refused as "The following argument was not expected" (session 26's outside testing).
 std::string json_file_hint(int argc, char** argv, const std::string& parse_error) {
@@ -113,6 +111,8 @@ std::string json_file_hint(int argc, char** argv, const std::string& parse_error
   }
   return "";
 }
+
+}  // namespace
 
 int main(int argc, char** argv) {
   std::optional<rollsim::ProcessGroup> started;

@@ -1,5 +1,5 @@
-// A recorded speed's lattice found from its smallest step; its staircase replaced by the line through the steps'
-// midpoints where one step per sample is a real acceleration's size.
+// A recorded speed's lattice found from its smallest step; its staircase smoothed by a local quadratic where one step
+// per sample is a real acceleration's size.
 #include "rollsim/cycle/speed_resolution.hpp"
 
 #include <algorithm>
@@ -8,7 +8,8 @@
 namespace rollsim {
 namespace {
 
-// The smallest non-zero step, if the speeds lie on its lattice (rounding in a unit conversion allowed for).
+// The smallest non-zero step, if the moving speeds lie on its lattice (rounding in a unit conversion allowed for;
+// standstills, on every lattice, are not counted).
 double lattice_quantum(const std::vector<double>& v) {
   double q = 0.0;
   for (std::size_t i = 1; i < v.size(); ++i) {
@@ -16,9 +17,13 @@ double lattice_quantum(const std::vector<double>& v) {
     if (d > 1e-9 && (q == 0.0 || d < q)) q = d;
   }
   if (!(q > 0.0)) return 0.0;
-  std::size_t on = 0;
-  for (double x : v) on += std::abs(x / q - std::round(x / q)) < 0.02;
-  return static_cast<double>(on) >= 0.95 * static_cast<double>(v.size()) ? q : 0.0;
+  std::size_t on = 0, moving = 0;
+  for (double x : v) {
+    if (x == 0.0) continue;
+    ++moving;
+    on += std::abs(x / q - std::round(x / q)) < 0.02;
+  }
+  return moving > 0 && static_cast<double>(on) >= 0.95 * static_cast<double>(moving) ? q : 0.0;
 }
 
 double median_interval_s(const std::vector<double>& t) {
