@@ -165,6 +165,12 @@ TEST(DiagnoseAdequacy, NoiseInARecordedElevationIsNotReadAsPhysics) {
     const std::string text = diagnosis_text(d);
     EXPECT_NE(text.find("carried into the noise floor"), std::string::npos) << text;
   }
+  // Recorded without noise, the hills are known physics. Each sample's grade was read at the sample and held over
+  // its segment, half a segment behind the road; this null read 7.1 x its floor, missing_physics (session 26).
+  Recording exact = recording(v, std::make_shared<Hills>(v.body.test_mass_kg), 1.0, 0.0, 1.0, 27);
+  record_elevation(exact, true, 1e-9, 127);
+  const Diagnosis e = run(v, exact, 60.0);
+  EXPECT_EQ(e.verdict, "nothing_missing") << diagnosis_text(e);
   // The same hills recorded through the same noise are known physics, not missing (this one read 2.5 x the floor,
   // missing_physics, before; the level nulls above passed then too, their logger's 300 W noise being the larger).
   Recording hilly = recording(v, std::make_shared<Hills>(v.body.test_mass_kg), 1.0, 0.0, 1.0, 24);

@@ -178,5 +178,31 @@ TEST(Elevation, GradeNoiseDrawsHoldTheFiltersErrorOnFreshNoise) {
   EXPECT_TRUE(grade_noise_draws(one.t, one.v, one.h, 0.0, 64, 5u).empty());
 }
 
+
+TEST(Elevation, EachSamplesGradeIsItsSegmentsMeanGrade) {
+  // The replay holds a sample's grade over its segment to the next, so the grade must be that segment's mean, read at
+  // its middle along the road. Read at the sample it lagged by half a segment (10 m at 20 m/s and 1 Hz), and a
+  // noise-free hilly null read 13 x its floor (session 26's outside testing). A 1 km hill 20 m high at 1 Hz.
+  std::vector<double> t, v, h;
+  for (int i = 0; i <= 1500; ++i) {
+    t.push_back(i);
+    v.push_back(20.0);
+    h.push_back(150.0 + 20.0 * std::sin(kTwoPi * 20.0 * i / 1000.0));
+  }
+  const ElevationGrade g = grade_from_elevation(t, v, h);
+  double ss = 0.0, ss_start = 0.0;
+  int count = 0;
+  for (std::size_t i = 100; i + 100 < t.size(); ++i) {
+    const double mean_sine = (h[i + 1] - h[i]) / 20.0;  // the segment's rise over its road length
+    const double mean = mean_sine / std::sqrt(1.0 - mean_sine * mean_sine);
+    const double at_start = 20.0 * kTwoPi / 1000.0 * std::cos(kTwoPi * 20.0 * i / 1000.0);
+    ss += (g.grade[i] - mean) * (g.grade[i] - mean);
+    ss_start += (at_start - mean) * (at_start - mean);
+    ++count;
+  }
+  EXPECT_LT(std::sqrt(ss / count), 0.001);       // 0.1 % of grade
+  EXPECT_GT(std::sqrt(ss_start / count), 0.005);  // what reading it at the sample missed by: a real check
+}
+
 }  // namespace
 }  // namespace rollsim

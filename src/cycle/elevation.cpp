@@ -137,8 +137,12 @@ std::vector<double> grade_of_profile(const std::vector<double>& s, const std::ve
     const double sine = std::clamp(slope / opt.grid_m, -0.99, 0.99);
     g[static_cast<std::size_t>(c)] = std::clamp(sine / std::sqrt(1.0 - sine * sine), -opt.max_grade, opt.max_grade);
   }
+  // Each sample's grade is held over its segment to the next (the replay's and the cycle's rule), so it is read at
+  // the segment's middle along the road: read at its start it lagged the road by half a sample, 7-15 m at 1 Hz,
+  // and a noise-free hilly null read 13 x its floor (session 26's outside testing).
   for (std::size_t i = 0; i < n; ++i) {
-    const double x = s[i] / opt.grid_m;  // cell centres are at (c + 0.5) grid; interpolate between them
+    const double mid_m = i + 1 < n ? 0.5 * (s[i] + s[i + 1]) : s[i];
+    const double x = mid_m / opt.grid_m;  // cell centres are at (c + 0.5) grid; interpolate between them
     const double u = std::clamp(x - 0.5, 0.0, static_cast<double>(cells - 1));
     const auto c0 = static_cast<std::size_t>(std::floor(u));
     const std::size_t c1 = std::min(cells - 1, c0 + 1);

@@ -325,8 +325,12 @@ DriveCycle cycle_of_recording(const Recording& r, double engine_off_min_s, Engin
   for (double& t : c.time_s) t -= r.time_s.front();
   // A staircase speed (a coarse channel sampled fast) replayed as it is fakes accelerations of a step per sample.
   c.speed_mps = read_speed_resolution(r.time_s, r.speed_mps).speed_mps;
-  if (r.grade) c.grade = *r.grade;
-  else if (r.elevation_m) c.grade = grade_from_elevation(r.time_s, r.speed_mps, *r.elevation_m).grade;
+  if (r.grade) {
+    // A recorded grade is read at each instant, and the replay holds a sample's grade over its segment to the next:
+    // the segment's mean is the two ends' (the instant's lagged the road by half a sample: session 26's outside testing).
+    c.grade = *r.grade;
+    for (std::size_t i = 0; i + 1 < c.grade.size(); ++i) c.grade[i] = 0.5 * ((*r.grade)[i] + (*r.grade)[i + 1]);
+  } else if (r.elevation_m) c.grade = grade_from_elevation(r.time_s, r.speed_mps, *r.elevation_m).grade;
   else c.grade.assign(r.time_s.size(), 0.0);
   // Quantised to 0.05 % (under 0.3 N per 100 kg of grade force error): the simulator prepares the tyre model once
   // per distinct grade, which otherwise is once per sample and 90 % of a hilly recording's diagnosis.

@@ -19,7 +19,7 @@ struct ElevationGradeOptions {
 };
 
 struct ElevationGrade {
-  std::vector<double> grade;  ///< rise over run, per sample
+  std::vector<double> grade;  ///< rise over run, per sample: over its segment to the next (read at its middle)
   int rejected_steps = 0;     ///< elevation steps treated as glitches
   /// White noise on each reading about the road [m], from each moving reading's deviation from the line through its
   /// neighbours along the road (what a GPS altitude jitters by from fix to fix; noise correlated over tens of seconds
