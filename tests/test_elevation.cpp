@@ -204,5 +204,50 @@ TEST(Elevation, EachSamplesGradeIsItsSegmentsMeanGrade) {
   EXPECT_GT(std::sqrt(ss_start / count), 0.005);  // what reading it at the sample missed by: a real check
 }
 
+
+TEST(Elevation, ALostFixIsBridgedAlongTheRoad) {
+  // 15 readings of 0 ("no fix") on a 2 km hill 10 m high at 20 m/s: the road goes on climbing under them. Held level,
+  // the run flattened 300 m of hill (session 26's outside testing); bridged, the grade there is the chord's.
+  std::vector<double> t, v, h;
+  for (int i = 0; i <= 600; ++i) {
+    t.push_back(i);
+    v.push_back(20.0);
+    h.push_back(150.0 + 10.0 * std::sin(kTwoPi * 20.0 * i / 2000.0 - 0.44));
+  }
+  auto clean_h_at = [&](int i) { return 150.0 + 10.0 * std::sin(kTwoPi * 20.0 * i / 2000.0 - 0.44); };
+  for (int i = 300; i < 315; ++i) h[static_cast<std::size_t>(i)] = 0.0;
+  const ElevationGrade g = grade_from_elevation(t, v, h);
+  EXPECT_EQ(g.rejected_steps, 1);  // the drop; the return is taken from the last good reading
+  // The climb booked from 200 m before the gap to 200 m after it (each grade over its 20 m segment) against the
+  // road's: held level, the gap's own 9 m were missing.
+  double booked = 0.0;
+  for (std::size_t i = 290; i < 325; ++i) booked += 20.0 * g.grade[i] / std::sqrt(1.0 + g.grade[i] * g.grade[i]);
+  const double road = h[325] - h[290], gap = clean_h_at(315) - clean_h_at(300);
+  EXPECT_GT(std::abs(gap), 5.0);
+  EXPECT_NEAR(booked, road, 0.1 * std::abs(gap));
+}
+
+TEST(Elevation, AWanderingAltitudeShowsAtStandstills) {
+  // Standing, the road does not move, so the readings' spread is the GPS's: its white noise alone, or several times
+  // that where the altitude drifts over tens of seconds (AR(1), 30 s, 3 m here, seen in 20 s stops), which the
+  // filter takes for road.
+  auto trace = [](bool drift) {
+    std::mt19937 rng(12);
+    std::normal_distribution<double> n(0.0, 1.0);
+    Trace tr = stop_and_go(30, 0.0, 1);
+    double a = 0.0;
+    const double phi = std::exp(-1.0 / 30.0);
+    for (auto& x : tr.h) {
+      a = phi * a + 3.0 * std::sqrt(1.0 - phi * phi) * n(rng);
+      x += 0.5 * n(rng) + (drift ? a : 0.0);
+    }
+    return grade_from_elevation(tr.t, tr.v, tr.h);
+  };
+  const ElevationGrade white = trace(false), drifting = trace(true);
+  EXPECT_GT(white.standing_s, 500.0);  // thirty 20 s stops
+  EXPECT_NEAR(white.standing_wander_m, white.noise_sd_m, 0.15 * white.noise_sd_m);
+  EXPECT_GT(drifting.standing_wander_m, 1.5 * drifting.noise_sd_m + 0.2);
+}
+
 }  // namespace
 }  // namespace rollsim

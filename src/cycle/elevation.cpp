@@ -62,9 +62,14 @@ CorrectedProfile corrected_profile(const std::vector<double>& time_s, const std:
   // booked as a 6 m climb per stop, the snap-back being the one step dropped as a glitch (11 % more energy on a level
   // route with six stops: session 23's outside testing).
   std::size_t ref = 0;
+  bool no_fix = false;  // within a run of "0 = no fix" readings that began with a dropped step; ref is the last good
   for (std::size_t i = 1; i < n; ++i) {
     const double ds = 0.5 * (speed_mps[i] + speed_mps[i - 1]) * (time_s[i] - time_s[i - 1]);
     p.s_m[i] = p.s_m[i - 1] + ds;
+    if (no_fix && elevation_m[i] == 0.0) {
+      p.h_m[i] = p.h_m[i - 1];
+      continue;
+    }
     if (p.s_m[i] - p.s_m[ref] < kStandingStep_m) {
       p.h_m[i] = p.h_m[i - 1];
       continue;
@@ -75,10 +80,22 @@ CorrectedProfile corrected_profile(const std::vector<double>& time_s, const std:
     if (std::abs(dh) > opt.max_step_grade * (p.s_m[i] - p.s_m[ref]) + opt.step_tolerance_m) {
       p.h_m[i] = p.h_m[i - 1];
       ++p.rejected_steps;
+      // A drop to exactly 0 is a lost fix: the road goes on under it, so the readings after it are taken from the last
+      // good one and the run is bridged along the road. Held level, a 15 s run flattened 130-250 m of hill (session
+      // 26's outside testing).
+      if (!no_fix && elevation_m[i] == 0.0) {
+        no_fix = true;
+        continue;
+      }
+    } else if (no_fix) {
+      const double h0 = p.h_m[ref], s0 = p.s_m[ref], h1 = p.h_m[ref] + dh;
+      for (std::size_t k = ref + 1; k <= i; ++k) p.h_m[k] = h0 + (h1 - h0) * (p.s_m[k] - s0) / (p.s_m[i] - s0);
+      p.own_reading[i] = 1;
     } else {
       p.h_m[i] = p.h_m[i - 1] + dh;
       p.own_reading[i] = 1;
     }
+    no_fix = false;
     ref = i;
   }
   return p;
@@ -198,6 +215,35 @@ CorrectedProfile noise_aware_profile(const std::vector<double>& time_s, const st
 }
 }  // namespace
 
+namespace {
+// Standstills this long show a wandering GPS altitude (a light's red phase; shorter ones hold too few readings).
+constexpr double kWanderStandstill_s = 20.0;
+
+void estimate_standing_wander(const std::vector<double>& time_s, const std::vector<double>& speed_mps,
+                              const std::vector<double>& elevation_m, ElevationGrade& out) {
+  const std::size_t n = time_s.size();
+  double ss = 0.0, count = 0.0;
+  std::size_t i = 0;
+  while (i < n) {
+    if (speed_mps[i] != 0.0) {
+      ++i;
+      continue;
+    }
+    std::size_t j = i;
+    while (j + 1 < n && speed_mps[j + 1] == 0.0) ++j;
+    if (time_s[j] - time_s[i] >= kWanderStandstill_s) {
+      double mean = 0.0;
+      for (std::size_t k = i; k <= j; ++k) mean += elevation_m[k] / static_cast<double>(j - i + 1);
+      for (std::size_t k = i; k <= j; ++k) ss += (elevation_m[k] - mean) * (elevation_m[k] - mean);
+      count += static_cast<double>(j - i);  // one degree of freedom per run for its mean
+      out.standing_s += time_s[j] - time_s[i];
+    }
+    i = j + 1;
+  }
+  out.standing_wander_m = count > 0.0 ? std::sqrt(ss / count) : 0.0;
+}
+}  // namespace
+
 ElevationGrade grade_from_elevation(const std::vector<double>& time_s, const std::vector<double>& speed_mps,
                                     const std::vector<double>& elevation_m, const ElevationGradeOptions& opt) {
   const std::size_t n = time_s.size();
@@ -206,6 +252,7 @@ ElevationGrade grade_from_elevation(const std::vector<double>& time_s, const std
   if (n < 2 || speed_mps.size() != n || elevation_m.size() != n) return out;
   const CorrectedProfile p = noise_aware_profile(time_s, speed_mps, elevation_m, opt, out);
   out.grade = grade_of_profile(p.s_m, p.h_m, opt);
+  estimate_standing_wander(time_s, speed_mps, elevation_m, out);
   return out;
 }
 

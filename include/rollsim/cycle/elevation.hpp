@@ -26,6 +26,11 @@ struct ElevationGrade {
   /// looks like the road and is not in it).
   double noise_sd_m = 0.0;
   int noise_triples = 0;  ///< readings it is estimated from
+  /// How far the readings wander while the car stands for 20 s or more [m]: the rms about each standstill's mean,
+  /// pooled. White noise wanders by its own sd; a GPS altitude drifting over tens of seconds (noise this module does
+  /// not carry) by several times that.
+  double standing_wander_m = 0.0;
+  double standing_s = 0.0;  ///< the standstills' time it is estimated from
 };
 
 /// Grade per sample from elevation: distance from the speed (trapezoid); each sample-to-sample elevation step
