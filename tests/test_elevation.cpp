@@ -247,6 +247,12 @@ TEST(Elevation, AWanderingAltitudeShowsAtStandstills) {
   EXPECT_GT(white.standing_s, 500.0);  // thirty 20 s stops
   EXPECT_NEAR(white.standing_wander_m, white.noise_sd_m, 0.15 * white.noise_sd_m);
   EXPECT_GT(drifting.standing_wander_m, 1.5 * drifting.noise_sd_m + 0.2);
+  // The drift, from how the standstills' differences grow with their time apart: 20 s stops see its start only (a
+  // rate of 2 sd^2 / time, 0.6 m^2/s here), so the sd and time are not each the truth's; the rate within a factor 2.
+  EXPECT_LT(white.drift_sd_m, 0.3);
+  const double rate = 2.0 * drifting.drift_sd_m * drifting.drift_sd_m / drifting.drift_time_s;
+  EXPECT_GT(rate, 0.3);
+  EXPECT_LT(rate, 1.2);
 }
 
 }  // namespace

@@ -218,11 +218,16 @@ CorrectedProfile noise_aware_profile(const std::vector<double>& time_s, const st
 namespace {
 // Standstills this long show a wandering GPS altitude (a light's red phase; shorter ones hold too few readings).
 constexpr double kWanderStandstill_s = 20.0;
+// Standing time in such standstills below which no drift is estimated (three lights' worth).
+constexpr double kMinStandstillForDrift_s = 60.0;
 
 void estimate_standing_wander(const std::vector<double>& time_s, const std::vector<double>& speed_mps,
                               const std::vector<double>& elevation_m, ElevationGrade& out) {
   const std::size_t n = time_s.size();
   double ss = 0.0, count = 0.0;
+  // Per lag in samples (up to 60 s at 1 Hz): sums of squared differences, of times apart, and pairs.
+  constexpr std::size_t kLags = 60;
+  std::vector<double> d2(kLags + 1, 0.0), dt(kLags + 1, 0.0), pairs(kLags + 1, 0.0);
   std::size_t i = 0;
   while (i < n) {
     if (speed_mps[i] != 0.0) {
@@ -237,10 +242,37 @@ void estimate_standing_wander(const std::vector<double>& time_s, const std::vect
       for (std::size_t k = i; k <= j; ++k) ss += (elevation_m[k] - mean) * (elevation_m[k] - mean);
       count += static_cast<double>(j - i);  // one degree of freedom per run for its mean
       out.standing_s += time_s[j] - time_s[i];
+      for (std::size_t lag = 1; lag <= kLags; ++lag)
+        for (std::size_t k = i; k + lag <= j; ++k) {
+          const double d = elevation_m[k + lag] - elevation_m[k];
+          d2[lag] += d * d, dt[lag] += time_s[k + lag] - time_s[k], pairs[lag] += 1.0;
+        }
     }
     i = j + 1;
   }
   out.standing_wander_m = count > 0.0 ? std::sqrt(ss / count) : 0.0;
+  if (out.standing_s < kMinStandstillForDrift_s) return;
+  // D(t) = 2 white^2 + 2 sd^2 (1 - exp(-t / time)): sd^2 by weighted least squares at each time of a grid, the time of
+  // least squared misfit kept (weights: the pairs, most at short lags).
+  const double white2 = 2.0 * out.noise_sd_m * out.noise_sd_m;
+  double best = 1e300;
+  for (double time : {2.0, 3.0, 5.0, 8.0, 12.0, 20.0, 30.0, 50.0, 80.0, 120.0, 200.0, 300.0}) {
+    double sxy = 0.0, sxx = 0.0;
+    for (std::size_t lag = 1; lag <= kLags; ++lag) {
+      if (pairs[lag] == 0.0) continue;
+      const double x = 2.0 * (1.0 - std::exp(-dt[lag] / pairs[lag] / time));
+      sxy += pairs[lag] * x * (d2[lag] / pairs[lag] - white2);
+      sxx += pairs[lag] * x * x;
+    }
+    const double var = sxx > 0.0 ? std::max(0.0, sxy / sxx) : 0.0;
+    double sse = 0.0;
+    for (std::size_t lag = 1; lag <= kLags; ++lag) {
+      if (pairs[lag] == 0.0) continue;
+      const double e = d2[lag] / pairs[lag] - white2 - var * 2.0 * (1.0 - std::exp(-dt[lag] / pairs[lag] / time));
+      sse += pairs[lag] * e * e;
+    }
+    if (sse < best) best = sse, out.drift_sd_m = std::sqrt(var), out.drift_time_s = time;
+  }
 }
 }  // namespace
 
@@ -258,9 +290,11 @@ ElevationGrade grade_from_elevation(const std::vector<double>& time_s, const std
 
 std::vector<std::vector<double>> grade_noise_draws(const std::vector<double>& time_s, const std::vector<double>& speed_mps,
                                                    const std::vector<double>& elevation_m, double noise_sd_m, int draws,
-                                                   unsigned seed, const ElevationGradeOptions& opt) {
+                                                   unsigned seed, double drift_sd_m, double drift_time_s,
+                                                   const ElevationGradeOptions& opt) {
   const std::size_t n = time_s.size();
-  if (n < 2 || speed_mps.size() != n || elevation_m.size() != n || !(noise_sd_m > 0.0) || draws < 1) return {};
+  const bool drift = drift_sd_m > 0.0 && drift_time_s > 0.0;
+  if (n < 2 || speed_mps.size() != n || elevation_m.size() != n || !(noise_sd_m > 0.0 || drift) || draws < 1) return {};
   ElevationGrade stats;
   const CorrectedProfile p = noise_aware_profile(time_s, speed_mps, elevation_m, opt, stats);
   const std::vector<double> clean = grade_of_profile(p.s_m, p.h_m, opt);
@@ -269,9 +303,13 @@ std::vector<std::vector<double>> grade_noise_draws(const std::vector<double>& ti
   std::vector<std::vector<double>> out;
   std::vector<double> h(n);
   for (int d = 0; d < draws; ++d) {
-    double e = 0.0;
+    double e = 0.0, walk = drift ? drift_sd_m * unit(rng) : 0.0;
     for (std::size_t i = 0; i < n; ++i) {
-      if (p.own_reading[i]) e = noise_sd_m * unit(rng);  // a copy (standing, a glitch dropped) keeps its source's error
+      if (i > 0 && drift) {
+        const double phi = std::exp(-std::max(0.0, time_s[i] - time_s[i - 1]) / drift_time_s);
+        walk = phi * walk + drift_sd_m * std::sqrt(1.0 - phi * phi) * unit(rng);
+      }
+      if (p.own_reading[i]) e = noise_sd_m * unit(rng) + walk;  // a copy (standing, a glitch dropped) keeps its source's
       h[i] = p.h_m[i] + e;
     }
     std::vector<double> g = grade_of_profile(p.s_m, h, opt);

@@ -197,7 +197,7 @@ Eigen::MatrixXd grade_noise_energies(const Observations& o, const std::vector<Re
     if (rec.grade || !rec.elevation_m) continue;
     const ElevationGrade read = grade_from_elevation(rec.time_s, rec.speed_mps, *rec.elevation_m);
     draws[r] = grade_noise_draws(rec.time_s, rec.speed_mps, *rec.elevation_m, read.noise_sd_m, kGradeDraws,
-                                 0x9e3779b9u + static_cast<unsigned>(r));
+                                 0x9e3779b9u + static_cast<unsigned>(r), read.drift_sd_m, read.drift_time_s);
     any = any || !draws[r].empty();
   }
   if (!any) return {};

@@ -64,23 +64,30 @@ std::vector<DriveCycle> cycles_of(const std::vector<Recording>& recordings, cons
                       " samples about each (standstills kept)");
     if (!r.grade && r.elevation_m) {
       const ElevationGrade read = grade_from_elevation(r.time_s, r.speed_mps, *r.elevation_m);
+      const double grade_rms = moving_rms(r, grade_noise_draws(r.time_s, r.speed_mps, *r.elevation_m, read.noise_sd_m, 16, 1u,
+                                                               read.drift_sd_m, read.drift_time_s));
       notes.push_back(r.source + ": grade from recorded elevation (" + std::to_string(read.rejected_steps) +
                       " elevation steps rejected as glitches, Savitzky-Golay slope over 300 m; white noise of " +
-                      fixed(read.noise_sd_m, 2) + " m per reading about the road, " +
-                      fixed(100.0 * moving_rms(r, grade_noise_draws(r.time_s, r.speed_mps, *r.elevation_m, read.noise_sd_m, 16, 1u)), 2) +
+                      fixed(read.noise_sd_m, 2) + " m per reading about the road" +
+                      (read.drift_sd_m > 0.0
+                           ? " and a drift of " + fixed(read.drift_sd_m, 2) + " m correlated over " +
+                                 fixed(read.drift_time_s, 0) + " s (from its standstills)"
+                           : std::string()) +
+                      ", " + fixed(100.0 * grade_rms, 2) +
                       " % of grade rms after the filter, carried into the noise floor; the uphill and downhill regimes "
                       "are read on this grade, so its errors put a residual of their own there)");
-      // A drifting altitude (noise correlated over tens of seconds) looks like road and is not carried: said, where
-      // the standstills show it wandering well beyond its white noise. On session 26's outside tester's UDDS and WLTC
-      // nulls the ratio was 0.95-1.17 for white noise, 1 m steps and glitches, and 1.89-3.0 for AR(1) and random-walk
-      // drifts of 2-5 m; with 200 readings standing, 1.5 is some ten of white noise's sds. A route without standstills
-      // (HWFET) cannot show it.
+      // A drifting altitude (noise correlated over tens of seconds) looks like road: its rate is read off the
+      // standstills and carried as a random walk, and where they show it well beyond the white noise it is said. On
+      // session 26's outside tester's UDDS and WLTC nulls the wander was 0.95-1.17 x the white noise for white noise,
+      // 1 m steps and glitches, and 1.89-3.0 x for AR(1) and random-walk drifts of 2-5 m; with 200 readings standing,
+      // 1.5 is some ten of white noise's sds. A route without standstills (HWFET) cannot show it.
       if (read.standing_s >= 60.0 && read.standing_wander_m > 1.5 * read.noise_sd_m + 0.2)
         notes.push_back("warning: " + r.source + ": the recorded elevation wanders " + fixed(read.standing_wander_m, 1) +
                         " m rms while the car stands (" + fixed(read.standing_s, 0) + " s of standstills of 20 s or more), "
                         "against " + fixed(read.noise_sd_m, 2) + " m of white noise: an altitude drifting over tens of "
-                        "seconds, which the grade's filter takes for road and the noise floor does not carry; read grade, "
-                        "mass and unexplained findings, and the uphill and downhill residuals, as possibly the GPS's");
+                        "seconds, which the grade's filter takes for road. It is carried into the noise floor as the "
+                        "standstills show it; where the GPS drifts otherwise while driving it is not, so read "
+                        "grade, mass and unexplained findings, and the uphill and downhill residuals, with that in mind");
     }
   }
   return cycles;

@@ -31,6 +31,11 @@ struct ElevationGrade {
   /// not carry) by several times that.
   double standing_wander_m = 0.0;
   double standing_s = 0.0;  ///< the standstills' time it is estimated from
+  /// The readings' drift, an AR(1) in time of this sd and correlation time, from how the standstills' differences
+  /// between readings grow with their time apart (up to 60 s) beyond twice the white noise's variance: 2 sd^2
+  /// (1 - exp(-dt / time)), least squares over a grid of times (0 without 60 s of standstills of 20 s or more).
+  double drift_sd_m = 0.0;
+  double drift_time_s = 0.0;
 };
 
 /// Grade per sample from elevation: distance from the speed (trapezoid); each sample-to-sample elevation step
@@ -52,8 +57,11 @@ ElevationGrade grade_from_elevation(const std::vector<double>& time_s, const std
 /// per draw, per sample, the grade of the corrected profile with fresh noise on its moving readings (a standstill's
 /// or a dropped glitch's copy keeps its source's) less its grade without. Glitches are dropped where the recording's
 /// own were, so the draws carry the filter's noise gain, not more glitches. Empty without noise or samples.
+/// With a drift (`drift_sd_m`, `drift_time_s`), an AR(1) in time is added to each reading too (it goes on during
+/// standstills, whose readings are not used: the step after a stop carries what it drifted).
 std::vector<std::vector<double>> grade_noise_draws(const std::vector<double>& time_s, const std::vector<double>& speed_mps,
                                                    const std::vector<double>& elevation_m, double noise_sd_m, int draws,
-                                                   unsigned seed, const ElevationGradeOptions& opt = {});
+                                                   unsigned seed, double drift_sd_m = 0.0, double drift_time_s = 0.0,
+                                                   const ElevationGradeOptions& opt = {});
 
 }  // namespace rollsim
