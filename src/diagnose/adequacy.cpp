@@ -139,7 +139,8 @@ Adequacy test_adequacy(const Observations& o, const std::vector<Recording>& recs
 }
 
 // The residual left above the noise floor, in words: how far above, where, and how much energy.
-Finding adequacy_finding(const Adequacy& a, const NoiseFloor& nf, const Observations& o, const std::vector<RegimeResidual>& located) {
+Finding adequacy_finding(const Adequacy& a, const NoiseFloor& nf, const Observations& o, const std::vector<RegimeResidual>& located,
+                         bool grade_from_elevation) {
   Finding f;
   f.effect = "unexplained";
   f.delta_bic = 0.0;
@@ -168,6 +169,16 @@ Finding adequacy_finding(const Adequacy& a, const NoiseFloor& nf, const Observat
   if (worst)
     f.description += "; most in regime '" + worst->regime + "': " + fixed(worst->mean_w, 0) + " W [" + fixed(worst->ci_low_w, 0) +
                      ", " + fixed(worst->ci_high_w, 0) + "]";
+  // The road profile search runs only where elevation is withheld, so a recorded elevation's own errors are a suspect
+  // the catalogue cannot name (hills withheld behind a noisy level elevation read as a bare residual on 9 of 9:
+  // session 26's outside testing).
+  if (grade_from_elevation) {
+    const bool on_slopes = worst && (worst->regime.rfind("uphill", 0) == 0 || worst->regime.rfind("downhill", 0) == 0);
+    f.description += std::string("; the grade comes from the recorded elevation") +
+                     (on_slopes ? ", and this residual is most where it climbs or falls" : "") +
+                     ": hills it misses or misplaces leave such a residual, so check it against a map's elevation or "
+                     "drive the route both ways";
+  }
   f.parameters.push_back({"flagged_energy_j", "J", a.flagged_j, a.flagged_j, a.flagged_j});
   return f;
 }

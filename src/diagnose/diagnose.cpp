@@ -418,7 +418,9 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
   out.final_residual_to_noise_ratio = after.ratio, out.final_residual_to_noise_z = after.z;
   // Never nothing_missing above the noise floor, nor behind a calibration held at its prior's bound.
   if (after.inadequate || (cal.outside_prior && out.findings.empty())) {
-    Finding f = adequacy_finding(after, floor, obs, out.located);
+    const bool from_elevation = std::any_of(recordings.begin(), recordings.end(),
+                                            [](const Recording& r) { return !r.grade && r.elevation_m; });
+    Finding f = adequacy_finding(after, floor, obs, out.located, from_elevation);
     if (cal.at_bound) f.description += (after.inadequate ? "; " : "") + calibration_outside_prior_text(cal, obs, sig.candidates);
     out.findings.push_back(std::move(f));
   } else if (cal.at_bound) {

@@ -385,7 +385,7 @@ std::vector<RegimeResidual> locate_regimes(const Observations& o, const std::vec
                                            const Eigen::VectorXd& cal_coef, double lag_samples,
                                            SelectionContext::Standing* standing);
 Finding adequacy_finding(const Adequacy& a, const NoiseFloor& nf, const Observations& o,
-                         const std::vector<RegimeResidual>& located);
+                         const std::vector<RegimeResidual>& located, bool grade_from_elevation);
 
 }  // namespace rollsim::diag
 
