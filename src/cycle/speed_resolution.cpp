@@ -4,6 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
+
+#include "rollsim/common/statistics.hpp"
 
 namespace rollsim {
 namespace {
@@ -29,9 +32,7 @@ double lattice_quantum(const std::vector<double>& v) {
 double median_interval_s(const std::vector<double>& t) {
   std::vector<double> d;
   for (std::size_t i = 1; i < t.size(); ++i) d.push_back(t[i] - t[i - 1]);
-  if (d.empty()) return 0.0;
-  std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2), d.end());
-  return d[d.size() / 2];
+  return d.empty() ? 0.0 : median(std::move(d));
 }
 
 }  // namespace

@@ -28,6 +28,13 @@ Fit penalised(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, const std::vec
   return f;
 }
 
+// The criterion least_squares minimises: the residual's sum of squares and the priors' penalties.
+double penalised_criterion(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, const Prior& prior, const Eigen::VectorXd& c) {
+  double v = (y - x * c).squaredNorm();
+  for (const auto& r : prior.rows) v += r.weight * r.weight * (c[r.column] - r.target) * (c[r.column] - r.target);
+  return v;
+}
+
 }  // namespace
 
 // Boxes by active sets: where the free optimum leaves a box, every combination of boxed columns held free, at
@@ -41,11 +48,6 @@ Fit least_squares(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, const Prio
     return true;
   };
   if (feasible(free.coef)) return free;
-  auto criterion = [&](const Eigen::VectorXd& c) {
-    double v = (y - x * c).squaredNorm();
-    for (const auto& r : prior.rows) v += r.weight * r.weight * (c[r.column] - r.target) * (c[r.column] - r.target);
-    return v;
-  };
   const std::size_t nb = prior.boxes.size();
   int combos = 1;
   for (std::size_t k = 0; k < nb; ++k) combos *= 3;
@@ -86,7 +88,7 @@ Fit least_squares(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, const Prio
     for (Eigen::Index c = 0; c < x.cols(); ++c)
       if (!std::isnan(fixed_value[static_cast<std::size_t>(c)])) coef[c] = fixed_value[static_cast<std::size_t>(c)];
     if (!feasible(coef)) continue;
-    const double value = criterion(coef);
+    const double value = penalised_criterion(x, y, prior, coef);
     if (value >= best_value) continue;
     best_value = value;
     best.coef = coef;
@@ -161,12 +163,6 @@ bool box_active(const Prior& prior, const Eigen::VectorXd& coef) {
   for (const auto& b : prior.boxes)
     if (std::abs(coef[b.column] - b.low) < 1e-12 || std::abs(coef[b.column] - b.high) < 1e-12) return true;
   return false;
-}
-
-double penalised_criterion(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, const Prior& prior, const Eigen::VectorXd& c) {
-  double v = (y - x * c).squaredNorm();
-  for (const auto& r : prior.rows) v += r.weight * r.weight * (c[r.column] - r.target) * (c[r.column] - r.target);
-  return v;
 }
 
 }  // namespace
