@@ -8,7 +8,6 @@
 #include "pipeline.hpp"
 
 #include "rollsim/common/units.hpp"
-#include "rollsim/cycle/elevation.hpp"
 
 namespace rollsim::diag {
 namespace {
@@ -188,31 +187,18 @@ Finding adequacy_finding(const Adequacy& a, const NoiseFloor& nf, const Observat
 namespace rollsim::diag {
 namespace {
 
-// Draws of the grade's errors: the mean square of 64 has a relative sd of 18 %, weighed in the z by its share.
-constexpr int kGradeDraws = 64;
-
-// Per window and draw, the energy the grade's errors from each recorded elevation's white noise add: per sample, the
+// Per window and draw, the energy the grade's errors from each recorded elevation's noise add: per sample, the
 // channel's power per newton of a force along the road (the unit constant-force basis, run through the powertrain
 // as the grade's force is) times m g per unit grade, over the sample's interval. First order in the grade's error;
 // the lag is left out (a fraction of a second against errors correlated over 300 m of road).
 Eigen::MatrixXd grade_noise_energies(const Observations& o, const std::vector<Recording>& recs, const Signatures& s,
-                                     double channel_scale, double mass_kg) {
+                                     double channel_scale, double mass_kg, const GradeNoiseDraws& draws) {
   const auto unit = std::find_if(s.basis.begin(), s.basis.end(), [](const BasisShape& b) {
     return b.kind == BasisShape::force && b.shape == ForceShape::constant && b.decay_s == 0.0;
   });
-  if (unit == s.basis.end() || unit->power_w.size() != recs.size()) return {};
-  std::vector<std::vector<std::vector<double>>> draws(recs.size());
-  bool any = false;
-  for (std::size_t r = 0; r < recs.size(); ++r) {
-    const Recording& rec = recs[r];
-    if (rec.grade || !rec.elevation_m) continue;
-    const ElevationGrade read = grade_from_elevation(rec.time_s, rec.speed_mps, *rec.elevation_m);
-    draws[r] = grade_noise_draws(rec.time_s, rec.speed_mps, *rec.elevation_m, read.noise_sd_m, kGradeDraws,
-                                 0x9e3779b9u + static_cast<unsigned>(r), read.drift_sd_m, read.drift_time_s);
-    any = any || !draws[r].empty();
-  }
-  if (!any) return {};
-  Eigen::MatrixXd e = Eigen::MatrixXd::Zero(o.n(), kGradeDraws);
+  if (unit == s.basis.end() || unit->power_w.size() != recs.size() || draws.size() != recs.size()) return {};
+  if (std::all_of(draws.begin(), draws.end(), [](const auto& d) { return d.empty(); })) return {};
+  Eigen::MatrixXd e = Eigen::MatrixXd::Zero(o.n(), kGradeNoiseDraws);
   const double per_grade_n = mass_kg * units::kStandardGravity_mps2;
   for (Eigen::Index w = 0; w < o.n(); ++w) {
     const Window& win = o.windows[static_cast<std::size_t>(w)];
@@ -221,7 +207,7 @@ Eigen::MatrixXd grade_noise_energies(const Observations& o, const std::vector<Re
     const auto& base_w = s.base.power_w[win.rec];
     for (std::size_t i = win.begin; i < win.end; ++i) {
       const double j_per_grade = channel_scale * per_grade_n * (unit_w[i] - base_w[i]) * o.dt_s[win.rec][i];
-      for (int d = 0; d < kGradeDraws; ++d) e(w, d) += j_per_grade * draws[win.rec][static_cast<std::size_t>(d)][i];
+      for (int d = 0; d < kGradeNoiseDraws; ++d) e(w, d) += j_per_grade * draws[win.rec][static_cast<std::size_t>(d)][i];
     }
   }
   return e;
@@ -231,7 +217,8 @@ Eigen::MatrixXd grade_noise_energies(const Observations& o, const std::vector<Re
 
 // The calibrated model's residual on short windows, and the floor from it.
 NoiseFloor calibrated_noise_floor(const Observations& o, const std::vector<Recording>& recs, const Signatures& s,
-                                  const Calibration& cal, double lag_samples, double mass_kg, const DiagnoseOptions& opt) {
+                                  const Calibration& cal, double lag_samples, double mass_kg, const GradeNoiseDraws& grade_draws,
+                                  const DiagnoseOptions& opt) {
   double dt = 1.0;
   if (!o.dt_s.empty() && !o.dt_s.front().empty()) {
     std::vector<double> d = o.dt_s.front();
@@ -245,7 +232,7 @@ NoiseFloor calibrated_noise_floor(const Observations& o, const std::vector<Recor
   const Eigen::VectorXd sim = k[0] * b + k[1] * (window_energies(s.rrc, shortw, lag_samples) - b) +
                               k[2] * (window_energies(s.drag, shortw, lag_samples) - b);
   NoiseFloor f = noise_floor(shortw, shortw.measured_j - sim);
-  f.grade_window_j = grade_noise_energies(o, recs, s, k[0], mass_kg);
+  f.grade_window_j = grade_noise_energies(o, recs, s, k[0], mass_kg, grade_draws);
   return f;
 }
 

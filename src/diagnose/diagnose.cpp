@@ -50,8 +50,14 @@ double moving_rms(const Recording& r, const std::vector<std::vector<double>>& dr
   return count > 0 ? std::sqrt(ss / static_cast<double>(count)) : 0.0;
 }
 
+// The recording's grade is derived from its elevation (not given, and not withheld).
+bool grade_from_recorded_elevation(const Recording& r) { return !r.grade && r.elevation_m.has_value(); }
+
+// The replay's cycle of each recording, what its speed and elevation channels are said to be, and the Monte Carlo
+// draws of its elevation-derived grade's errors (`grade_draws`, one entry per recording) for the noise floor.
 std::vector<DriveCycle> cycles_of(const std::vector<Recording>& recordings, const DiagnoseOptions& opt,
-                                  std::vector<std::string>& notes) {
+                                  std::vector<std::string>& notes, diag::GradeNoiseDraws& grade_draws) {
+  grade_draws.assign(recordings.size(), {});
   std::vector<DriveCycle> cycles;
   for (std::size_t k = 0; k < recordings.size(); ++k) {
     const Recording& r = recordings[k];
@@ -62,10 +68,11 @@ std::vector<DriveCycle> cycles_of(const std::vector<Recording>& recordings, cons
                       "sample a " + fixed(res.step_accel_mps2, 2) + " m/s^2 acceleration the car did not make: the replay "
                       "follows a quadratic fitted over " + std::to_string(2 * res.half_window + 1) +
                       " samples about each (standstills kept)");
-    if (!r.grade && r.elevation_m) {
+    if (grade_from_recorded_elevation(r)) {
       const ElevationGrade read = grade_from_elevation(r.time_s, r.speed_mps, *r.elevation_m);
-      const double grade_rms = moving_rms(r, grade_noise_draws(r.time_s, r.speed_mps, *r.elevation_m, read.noise_sd_m, 16, 1u,
-                                                               read.drift_sd_m, read.drift_time_s));
+      grade_draws[k] = grade_noise_draws(r.time_s, r.speed_mps, *r.elevation_m, read.noise_sd_m, diag::kGradeNoiseDraws,
+                                         0x9e3779b9u + static_cast<unsigned>(k), read.drift_sd_m, read.drift_time_s);
+      const double grade_rms = moving_rms(r, grade_draws[k]);
       notes.push_back(r.source + ": grade from recorded elevation (" + std::to_string(read.rejected_steps) +
                       " elevation steps rejected as glitches, Savitzky-Golay slope over 300 m; white noise of " +
                       fixed(read.noise_sd_m, 2) + " m per reading about the road" +
@@ -374,7 +381,8 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
     }
   }
   Diagnosis out;
-  std::vector<DriveCycle> cycles = cycles_of(recordings, opt, out.notes);
+  GradeNoiseDraws grade_draws;
+  std::vector<DriveCycle> cycles = cycles_of(recordings, opt, out.notes, grade_draws);
   const Observations obs = build_windows(vehicle, recordings, opt.window_s, opt, out.notes);
   out.channel = to_string(obs.channel);
   out.windows = static_cast<int>(obs.n());
@@ -400,7 +408,7 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
   report_calibration(cal, obs, lag, out);
   SelectionContext sc{rp, obs, sig.base, lag.samples, ctx, amb, recordings, opt, {}};
   out.located = locate_regimes(obs, recordings, cycles, sig, cal.model.fit.coef, lag.samples, &sc.standing);
-  const NoiseFloor floor = calibrated_noise_floor(obs, recordings, sig, cal, lag.samples, ctx.mass_kg, opt);
+  const NoiseFloor floor = calibrated_noise_floor(obs, recordings, sig, cal, lag.samples, ctx.mass_kg, grade_draws, opt);
   const Adequacy before = test_adequacy(obs, recordings, per_recording_residual(cal.model, obs, recordings.size()), floor, opt);
   out.noise_floor_j = std::sqrt(floor.variance_per_s * floor.window_s);
   out.residual_to_noise_ratio = before.ratio, out.residual_to_noise_z = before.z, out.adequacy_scale_s = before.scale_s;
@@ -418,8 +426,7 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
   out.final_residual_to_noise_ratio = after.ratio, out.final_residual_to_noise_z = after.z;
   // Never nothing_missing above the noise floor, nor behind a calibration held at its prior's bound.
   if (after.inadequate || (cal.outside_prior && out.findings.empty())) {
-    const bool from_elevation = std::any_of(recordings.begin(), recordings.end(),
-                                            [](const Recording& r) { return !r.grade && r.elevation_m; });
+    const bool from_elevation = std::any_of(recordings.begin(), recordings.end(), grade_from_recorded_elevation);
     Finding f = adequacy_finding(after, floor, obs, out.located, from_elevation);
     if (cal.at_bound) f.description += (after.inadequate ? "; " : "") + calibration_outside_prior_text(cal, obs, sig.candidates);
     out.findings.push_back(std::move(f));

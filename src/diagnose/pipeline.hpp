@@ -390,10 +390,18 @@ Finding adequacy_finding(const Adequacy& a, const NoiseFloor& nf, const Observat
 }  // namespace rollsim::diag
 
 namespace rollsim::diag {
+/// Monte Carlo draws of a recorded elevation's grade errors: the mean square of 64 has a relative sd of 18 %, weighed
+/// in the adequacy test's z by its share.
+constexpr int kGradeNoiseDraws = 64;
+/// Per recording, per draw, per sample: the grade's errors from its recorded elevation's noise (grade_noise_draws with
+/// the noise and drift the recording's own readings show, kGradeNoiseDraws of them); empty for a recording whose grade
+/// is not from a recorded elevation.
+using GradeNoiseDraws = std::vector<std::vector<std::vector<double>>>;
 /// The calibrated model's short-window floor, and the energies the recorded elevations' noise adds through the grade
 /// (`mass_kg` the grade force's mass).
 NoiseFloor calibrated_noise_floor(const Observations& o, const std::vector<Recording>& recs, const Signatures& s,
-                                  const Calibration& cal, double lag_samples, double mass_kg, const DiagnoseOptions& opt);
+                                  const Calibration& cal, double lag_samples, double mass_kg, const GradeNoiseDraws& grade_draws,
+                                  const DiagnoseOptions& opt);
 std::string calibration_outside_prior_text(const Calibration& c, const Observations& o, const std::vector<Candidate>& cands,
                                            bool with_explanations = true);
 }  // namespace rollsim::diag
