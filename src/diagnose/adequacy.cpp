@@ -7,6 +7,7 @@
 
 #include "pipeline.hpp"
 
+#include "rollsim/common/statistics.hpp"
 #include "rollsim/common/units.hpp"
 
 namespace rollsim::diag {
@@ -219,12 +220,7 @@ Eigen::MatrixXd grade_noise_energies(const Observations& o, const std::vector<Re
 NoiseFloor calibrated_noise_floor(const Observations& o, const std::vector<Recording>& recs, const Signatures& s,
                                   const Calibration& cal, double lag_samples, double mass_kg, const GradeNoiseDraws& grade_draws,
                                   const DiagnoseOptions& opt) {
-  double dt = 1.0;
-  if (!o.dt_s.empty() && !o.dt_s.front().empty()) {
-    std::vector<double> d = o.dt_s.front();
-    std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2), d.end());
-    dt = d[d.size() / 2];
-  }
+  const double dt = o.dt_s.empty() || o.dt_s.front().empty() ? 1.0 : median(o.dt_s.front());
   const Observations shortw = rewindow(o, recs, std::min(std::max(opt.noise_window_s, 2.0 * dt), o.window_s));
   if (shortw.n() < 4) return {};
   const Eigen::VectorXd& k = cal.model.fit.coef;

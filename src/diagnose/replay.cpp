@@ -7,6 +7,7 @@
 
 #include "pipeline.hpp"
 #include "rollsim/common/parallel.hpp"
+#include "rollsim/common/statistics.hpp"
 #include "rollsim/sim/simulation.hpp"
 
 namespace rollsim::diag {
@@ -169,11 +170,7 @@ double lagged_power_w(const Variant& v, std::size_t recording, std::size_t i, do
 }
 
 namespace {
-double median_dt_s(const Observations& o) {
-  std::vector<double> dts(o.dt_s.front());
-  std::nth_element(dts.begin(), dts.begin() + static_cast<std::ptrdiff_t>(dts.size() / 2), dts.end());
-  return dts.empty() ? 1.0 : dts[dts.size() / 2];
-}
+double median_dt_s(const Observations& o) { return o.dt_s.front().empty() ? 1.0 : median(o.dt_s.front()); }
 // The longest lag searched, up to 10 samples or 3 s, whichever is longer (loggers lag by 0.3-1.7 s; at 10 Hz that is
 // 17 samples); every lag is scored on the samples from there on.
 int max_lag_samples(double dt_s) { return std::max(10, static_cast<int>(std::ceil(3.0 / dt_s))); }

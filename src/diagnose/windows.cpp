@@ -5,6 +5,7 @@
 
 #include "pipeline.hpp"
 #include "rollsim/common/error.hpp"
+#include "rollsim/common/statistics.hpp"
 
 namespace rollsim::diag {
 namespace {
@@ -18,9 +19,7 @@ double quantum_of(const std::vector<double>& x) {
   std::vector<double> steps;
   for (std::size_t i = 1; i < x.size(); ++i)
     if (x[i] != x[i - 1]) steps.push_back(std::abs(x[i] - x[i - 1]));
-  if (steps.empty()) return 0.0;
-  std::nth_element(steps.begin(), steps.begin() + static_cast<std::ptrdiff_t>(steps.size() / 2), steps.end());
-  return steps[steps.size() / 2];
+  return steps.empty() ? 0.0 : median(std::move(steps));
 }
 
 // SOC: windows lengthened until the quantisation error (sd q / sqrt 6 of two quantised readings) is at most a

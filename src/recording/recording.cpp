@@ -10,6 +10,7 @@
 #include "rollsim/common/csv.hpp"
 #include "rollsim/common/error.hpp"
 #include "rollsim/common/format.hpp"
+#include "rollsim/common/statistics.hpp"
 #include "rollsim/common/text.hpp"
 #include "rollsim/common/units.hpp"
 
@@ -385,9 +386,7 @@ Recording load_recording(const std::string& path, const ColumnMapping& mapping) 
   // slow, or one whose stamps jitter by 20 ms, was refused).
   std::vector<double> steps(n - 1);
   for (std::size_t i = 0; i + 1 < n; ++i) steps[i] = rec.time_s[i + 1] - rec.time_s[i];
-  std::vector<double> sorted = steps;
-  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
-  const double dt = sorted[sorted.size() / 2];
+  const double dt = median(steps);
   if (dt < 0.0098 || dt > 1.02) {
     throw InputError(path + ": column '" + table.header[col_t] + "'",
                      "the typical (median) sample interval is " + format_value(dt) +
