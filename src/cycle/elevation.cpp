@@ -218,8 +218,6 @@ CorrectedProfile noise_aware_profile(const std::vector<double>& time_s, const st
 namespace {
 // Standstills this long show a wandering GPS altitude (a light's red phase; shorter ones hold too few readings).
 constexpr double kWanderStandstill_s = 20.0;
-// Standing time in such standstills below which no drift is estimated (three lights' worth).
-constexpr double kMinStandstillForDrift_s = 60.0;
 
 void estimate_standing_wander(const std::vector<double>& time_s, const std::vector<double>& speed_mps,
                               const std::vector<double>& elevation_m, ElevationGrade& out) {
@@ -251,7 +249,7 @@ void estimate_standing_wander(const std::vector<double>& time_s, const std::vect
     i = j + 1;
   }
   out.standing_wander_m = count > 0.0 ? std::sqrt(ss / count) : 0.0;
-  if (out.standing_s < kMinStandstillForDrift_s) return;
+  if (out.standing_s < ElevationGrade::kMinStandingForDrift_s) return;
   // D(t) = 2 white^2 + 2 sd^2 (1 - exp(-t / time)): sd^2 by weighted least squares at each time of a grid, the time of
   // least squared misfit kept (weights: the pairs, most at short lags).
   const double white2 = 2.0 * out.noise_sd_m * out.noise_sd_m;

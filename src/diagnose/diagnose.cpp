@@ -88,7 +88,7 @@ std::vector<DriveCycle> cycles_of(const std::vector<Recording>& recordings, cons
       // session 26's outside tester's UDDS and WLTC nulls the wander was 0.95-1.17 x the white noise for white noise,
       // 1 m steps and glitches, and 1.89-3.0 x for AR(1) and random-walk drifts of 2-5 m; with 200 readings standing,
       // 1.5 is some ten of white noise's sds. A route without standstills (HWFET) cannot show it.
-      if (read.standing_s >= 60.0 && read.standing_wander_m > 1.5 * read.noise_sd_m + 0.2)
+      if (read.standing_s >= ElevationGrade::kMinStandingForDrift_s && read.standing_wander_m > 1.5 * read.noise_sd_m + 0.2)
         notes.push_back("warning: " + r.source + ": the recorded elevation wanders " + fixed(read.standing_wander_m, 1) +
                         " m rms while the car stands (" + fixed(read.standing_s, 0) + " s of standstills of 20 s or more), "
                         "against " + fixed(read.noise_sd_m, 2) + " m of white noise: an altitude drifting over tens of "

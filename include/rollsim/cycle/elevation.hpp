@@ -31,6 +31,8 @@ struct ElevationGrade {
   /// not carry) by several times that.
   double standing_wander_m = 0.0;
   double standing_s = 0.0;  ///< the standstills' time it is estimated from
+  /// Standing time below which the wander says too little to estimate a drift (three lights' worth) [s].
+  static constexpr double kMinStandingForDrift_s = 60.0;
   /// The readings' drift, an AR(1) in time of this sd and correlation time, from how the standstills' differences
   /// between readings grow with their time apart (up to 60 s) beyond twice the white noise's variance: 2 sd^2
   /// (1 - exp(-dt / time)), least squares over a grid of times (0 without 60 s of standstills of 20 s or more).
