@@ -5,6 +5,7 @@
 #include <cmath>
 #include <random>
 
+#include "rollsim/common/statistics.hpp"
 #include "rollsim/cycle/elevation.hpp"
 
 namespace rollsim {
@@ -92,15 +93,16 @@ TEST(Elevation, NoiseGainIsTheFiltersStated) {
 struct Trace {
   std::vector<double> t, v, h;
 };
-Trace stop_and_go(int runs, double sd_m, unsigned seed) {
+Trace stop_and_go(int runs, double sd_m, unsigned seed, int per_second = 1) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> n(0.0, 1.0);
   Trace tr;
+  const double dt = 1.0 / per_second;
   double t = 0.0;
   for (int k = 0; k < runs; ++k) {
-    for (int i = 0; i < 110; ++i, t += 1.0) {
+    for (int i = 0; i < 110 * per_second; ++i, t += dt) {
       tr.t.push_back(t);
-      tr.v.push_back(i < 90 ? 20.0 * std::sin(kTwoPi * i / 180.0) : 0.0);
+      tr.v.push_back(i < 90 * per_second ? 20.0 * std::sin(kTwoPi * i / (180.0 * per_second)) : 0.0);
       tr.h.push_back(150.0 + sd_m * n(rng));
     }
   }
@@ -227,10 +229,23 @@ TEST(Elevation, ALostFixIsBridgedAlongTheRoad) {
   EXPECT_NEAR(booked, road, 0.1 * std::abs(gap));
 }
 
+// Standing, the road does not move, so the readings' spread is the GPS's: its white noise alone, or several times
+// that where the altitude drifts over tens of seconds (AR(1), 30 s, 3 m here, seen in 20 s stops), which the
+// filter takes for road.
+ElevationGrade wandering_trace(bool drift, int per_second, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> n(0.0, 1.0);
+  Trace tr = stop_and_go(30, 0.0, 1, per_second);
+  double a = 0.0;
+  const double phi = std::exp(-1.0 / (30.0 * per_second));
+  for (auto& x : tr.h) {
+    a = phi * a + 3.0 * std::sqrt(1.0 - phi * phi) * n(rng);
+    x += 0.5 * n(rng) + (drift ? a : 0.0);
+  }
+  return grade_from_elevation(tr.t, tr.v, tr.h);
+}
+
 TEST(Elevation, AWanderingAltitudeShowsAtStandstills) {
-  // Standing, the road does not move, so the readings' spread is the GPS's: its white noise alone, or several times
-  // that where the altitude drifts over tens of seconds (AR(1), 30 s, 3 m here, seen in 20 s stops), which the
-  // filter takes for road.
   auto trace = [](bool drift) {
     std::mt19937 rng(12);
     std::normal_distribution<double> n(0.0, 1.0);
@@ -253,6 +268,25 @@ TEST(Elevation, AWanderingAltitudeShowsAtStandstills) {
   const double rate = 2.0 * drifting.drift_sd_m * drifting.drift_sd_m / drifting.drift_time_s;
   EXPECT_GT(rate, 0.3);
   EXPECT_LT(rate, 1.2);
+}
+
+TEST(Elevation, AWanderingAltitudeLoggedAtTenHertzIsReadOverTheSameSeconds) {
+  // The drift is a process in time: at 10 Hz its fit must see the same tens of seconds of lag as at 1 Hz, not 60
+  // samples (6 s, where it read this 3 m, 30 s drift as 9-18 m over 300 s). Over eight noise draws, as at 1 Hz: the
+  // rate 2 sd^2 / time within a factor 2 of the truth's 0.6 m^2/s, the sd below 1.5 x the truth (20 s stops see the
+  // drift's start only, so neither sd nor time is the truth's alone).
+  std::vector<double> rate, sd;
+  for (unsigned seed = 1; seed <= 8; ++seed) {
+    const ElevationGrade white = wandering_trace(false, 10, seed), drifting = wandering_trace(true, 10, seed);
+    EXPECT_GT(drifting.standing_wander_m, 1.5 * drifting.noise_sd_m + 0.2);
+    EXPECT_LT(white.drift_sd_m, 0.3);
+    EXPECT_LE(drifting.drift_time_s, 60.0);
+    rate.push_back(2.0 * drifting.drift_sd_m * drifting.drift_sd_m / drifting.drift_time_s);
+    sd.push_back(drifting.drift_sd_m);
+  }
+  EXPECT_GT(median(rate), 0.3);
+  EXPECT_LT(median(rate), 1.2);
+  EXPECT_LT(*std::max_element(sd.begin(), sd.end()), 4.5);
 }
 
 }  // namespace
