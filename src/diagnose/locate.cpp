@@ -27,6 +27,47 @@ Mean ar1_mean(const std::vector<double>& v, double rho) {
   return {mean, std::sqrt(var / n_eff), n_eff};
 }
 
+// Do the standstills' mean residuals scatter beyond the noise within them? A one-way analysis of variance over the
+// standstills of 5 samples or more: the noise variance from successive differences within each (a level that
+// switches between standstills does not enter it), inflated for its pooled lag-1 autocorrelation, against the
+// scatter of their means; the chi-square as a normal deviate (Wilson-Hilferty).
+void standstill_switching(const std::vector<std::vector<double>>& runs, SelectionContext::Standing& out) {
+  constexpr std::size_t kMinSamples = 5;
+  std::vector<double> means;
+  std::vector<double> sizes;
+  double diff2 = 0.0, diffs = 0.0, total = 0.0, samples = 0.0;
+  for (const auto& run : runs) {
+    if (run.size() < kMinSamples) continue;
+    double m = 0.0;
+    for (double x : run) m += x / static_cast<double>(run.size());
+    means.push_back(m);
+    sizes.push_back(static_cast<double>(run.size()));
+    total += m * static_cast<double>(run.size()), samples += static_cast<double>(run.size());
+    for (std::size_t k = 1; k < run.size(); ++k) diff2 += (run[k] - run[k - 1]) * (run[k] - run[k - 1]), diffs += 1.0;
+  }
+  out.standstills = static_cast<int>(means.size());
+  if (means.size() < 3 || !(diff2 > 0.0)) return;
+  double c0 = 0.0, c1 = 0.0;
+  std::size_t q = 0;
+  for (const auto& run : runs) {
+    if (run.size() < kMinSamples) continue;
+    const double m = means[q++];
+    for (std::size_t k = 0; k < run.size(); ++k) {
+      c0 += (run[k] - m) * (run[k] - m);
+      if (k > 0) c1 += (run[k] - m) * (run[k - 1] - m);
+    }
+  }
+  const double rho = c0 > 0.0 ? std::clamp(c1 / c0, 0.0, 0.95) : 0.0;
+  const double noise_var = diff2 / (2.0 * diffs) * (1.0 + rho) / (1.0 - rho);
+  const double grand = total / samples;
+  double chi2 = 0.0;
+  for (std::size_t r = 0; r < means.size(); ++r) chi2 += sizes[r] * (means[r] - grand) * (means[r] - grand) / noise_var;
+  const double dof = static_cast<double>(means.size() - 1);
+  out.switching_z = (std::cbrt(chi2 / dof) - (1.0 - 2.0 / (9.0 * dof))) / std::sqrt(2.0 / (9.0 * dof));
+  const auto [lo, hi] = std::minmax_element(means.begin(), means.end());
+  out.low_w = *lo, out.high_w = *hi;
+}
+
 // Mean residual of each regime (in `order`, those with two values or more) with a 95 % normal interval.
 void append_regime_means(const std::vector<std::string>& order, const std::map<std::string, std::vector<double>>& vals,
                          double rho, std::vector<RegimeResidual>& out) {
@@ -90,10 +131,12 @@ std::vector<RegimeResidual> locate_regimes(const Observations& o, const std::vec
                                        "uphill (> 1 %)", "level", "downhill (< -1 %)"};
   std::map<std::string, std::vector<double>> vals;
   std::vector<double> all;
+  std::vector<std::vector<double>> standstills;  // each standstill's residuals, recording by recording
   // The model at the channel's whole lag, fraction included, as the windows read it: rounded to a sample, a null
   // with a 0.4 s lag at 1 Hz read 'accelerating -601 W [-817, -385]' (session 25's outside testing).
   for (std::size_t ri = 0; ri < recordings.size(); ++ri) {
     const Recording& r = recordings[ri];
+    bool standing_before = false;
     for (std::size_t i = 0; i + 1 < r.time_s.size(); ++i) {
       const double base = lagged_power_w(s.base, ri, i, lag_samples);
       const double sim = cal_coef[0] * base + cal_coef[1] * (lagged_power_w(s.rrc, ri, i, lag_samples) - base) +
@@ -103,6 +146,9 @@ std::vector<RegimeResidual> locate_regimes(const Observations& o, const std::vec
       const double t = r.time_s[i] - r.time_s.front();
       all.push_back(res);
       vals[v < 0.3 ? "standing" : a > 0.3 ? "accelerating" : a < -0.3 ? "braking" : "cruising"].push_back(res);
+      if (v < 0.3 && !standing_before) standstills.emplace_back();
+      if (v < 0.3) standstills.back().push_back(res);
+      standing_before = v < 0.3;
       if (v >= 0.3) vals[v < units::kmh_to_mps(50.0) ? "speed 0-50 km/h" : v < units::kmh_to_mps(90.0) ? "speed 50-90 km/h" : "speed >90 km/h"].push_back(res);
       vals[t < 600 ? "first 10 min" : t < 1800 ? "10-30 min" : "after 30 min"].push_back(res);
       // Grade regimes only where the recording gave grade or elevation (the replay trace then carries it).
@@ -118,6 +164,7 @@ std::vector<RegimeResidual> locate_regimes(const Observations& o, const std::vec
   if (standing && vals["standing"].size() >= 2) {
     const Mean m = ar1_mean(vals["standing"], rho);
     *standing = {true, m.mean, m.se, m.n_eff};
+    standstill_switching(standstills, *standing);
   }
   return out;
 }

@@ -309,6 +309,11 @@ struct SelectionContext {
   struct Standing {
     bool available = false;
     double mean_w = 0.0, se_w = 0.0, n_eff = 0.0;
+    /// How far the standstills' own mean residuals scatter beyond the noise within them (a normal deviate), over
+    /// `standstills` of 5 samples or more, whose means span `low_w` to `high_w`.
+    double switching_z = 0.0;
+    int standstills = 0;
+    double low_w = 0.0, high_w = 0.0;
   } standing;
 };
 

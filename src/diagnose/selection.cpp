@@ -203,6 +203,13 @@ double standing_bic(const SelectionContext& sc) {
   return z > 0.0 ? z * z - std::log(st.n_eff) : -1e300;
 }
 
+// The standstills' mean residuals switch beyond their noise on an electrical power channel: a consumer switching on
+// and off (at standstill nothing else draws power; an engine's idle fuel also moves as it warms, so not on fuel).
+bool standing_switches(const SelectionContext& sc) {
+  const bool electric = sc.obs.channel == ChannelKind::battery_power || sc.obs.channel == ChannelKind::battery_voltage_x_current;
+  return electric && sc.standing.available && sc.standing.switching_z >= sc.opt.standing_switch_z;
+}
+
 // Every untried candidate that passes: BIC threshold (or, for aux_load, the standing evidence), amplitude within
 // its bounds (or of the impossible sign: kept apart, never named), and a better held-out fit.
 std::vector<Passing> passing_candidates(const SelectionContext& sc, const std::vector<Candidate>& cands, const Model& m,
@@ -216,7 +223,8 @@ std::vector<Passing> passing_candidates(const SelectionContext& sc, const std::v
     p.wrong_sign = c.min() >= 0.0 && amp < 0.0;
     // The standing evidence names a load only where the fit's own amplitude is a load too: the HWFET with its fuel
     // x1.10 named aux_load 301 W [-108, 710] at Delta BIC -0.21 on a standing residual of 1119 W.
-    p.standing = c.id == EffectId::aux_load && !p.wrong_sign && standing_bic(sc) >= sc.opt.standing_bic_threshold &&
+    p.standing = c.id == EffectId::aux_load && !p.wrong_sign &&
+                 (standing_bic(sc) >= sc.opt.standing_bic_threshold || standing_switches(sc)) &&
                  amp - 1.96 * p.score.amplitude_se(m.inflate) > 0.0;
     if (p.score.dbic < sc.opt.bic_threshold && !p.standing) continue;
     if (!p.wrong_sign && (amp < c.min() || amp > c.max())) continue;
@@ -363,6 +371,11 @@ Finding catalogue_finding(const SelectionContext& sc, const Candidate& c, const 
                     fixed(sc.standing.mean_w + 1.96 * sc.standing.se_w, 0) +
                     "], is an auxiliary load's signature (nothing else draws power at standstill); a duty-cycled one is seen "
                     "by its mean";
+  if (best.standing && standing_switches(sc))
+    f.description += "; it switches: the " + std::to_string(sc.standing.standstills) + " standstills' own means range " +
+                     fixed(sc.standing.low_w, 0) + " to " + fixed(sc.standing.high_w, 0) + " W, " +
+                     fixed(sc.standing.switching_z, 1) + " sd beyond the noise within them (a consumer cycling on and off, "
+                     "such as a compressor or heater; its swing stays in the residual, which widens this interval)";
   if (prof && prof->parameter == "decay_s") {
     const double share = c.shape.at("decaying_share");
     f.description += std::string(f.description.empty() ? "" : "; ") + "decaying from the start of the trip (a heater "

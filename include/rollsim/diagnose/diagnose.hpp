@@ -58,6 +58,11 @@ struct DiagnoseOptions {
   double adequacy_min_ratio = 2.0;  ///< and at least this variance ratio over the floor
   /// A standing residual counts as an auxiliary load's evidence at this BIC-equivalent (z^2 - ln n_eff).
   double standing_bic_threshold = 10.0;
+  /// Or, on an electrical power channel, where the standstills' mean residuals scatter beyond the noise within them by
+  /// this normal deviate (Wilson-Hilferty of their chi-square): a consumer switching on and off, which nothing else
+  /// does to a standing car. Session 27's outside tester's 30 nulls (5 with a 100 W sensor drift over 30 s): at most
+  /// 3.5; its switching loads of 0.5-3 kW: 8-42.
+  double standing_switch_z = 6.0;
   /// SOC channels: windows are lengthened until the SOC quantisation error of a window's energy (sd q / sqrt 6
   /// for two quantised readings) is at most this fraction of the mean window energy.
   double soc_quantisation_fraction = 0.02;
