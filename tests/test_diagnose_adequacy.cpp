@@ -142,6 +142,39 @@ TEST(DiagnoseAdequacy, WithheldRollingHillsAreMissingPhysicsAt10And30And60sWindo
   }
 }
 
+// The same hills with a constant electrical load drawn beside them, standing or driving.
+class HillsAndLoad final : public Effect {
+ public:
+  HillsAndLoad(double mass_kg, double load_w) : hills_(mass_kg), load_w_(load_w) {}
+  std::string id() const override { return "test_hills_and_load"; }
+  double extra_resistance_n(const EffectInputs& in, const double* s) const override { return hills_.extra_resistance_n(in, s); }
+  double extra_electric_power_w(const EffectInputs&, const double*) const override { return load_w_; }
+
+ private:
+  Hills hills_;
+  double load_w_;
+};
+
+TEST(DiagnoseAdequacy, DetectionLimitsBehindWithheldHillsAreTheirProfilesResiduals) {
+  // The detection limits were taken before the road profile, from the hills' own residual: on session 27's outside
+  // tester's SUV behind 25 m hills, aux_load 6.5-10 kW and wind 167-262 m/s. Here (this file's hills and a 400 W
+  // load) aux_load read 5662 W before, now 357 W. Searching
+  // the catalogue again behind the profile was tried and dropped: it named rr_speed 0.17 here, which is not in the
+  // truth.
+  const Vehicle v = ev();
+  const Diagnosis d = run(v, recording(v, std::make_shared<HillsAndLoad>(v.body.test_mass_kg, 400.0), 1.0, 0.0, 1.0, 4), 60.0);
+  ASSERT_FALSE(d.findings.empty()) << diagnosis_text(d);
+  EXPECT_EQ(d.findings.front().effect, "road_profile") << diagnosis_text(d);
+  EXPECT_FALSE(named(d, "rr_speed")) << diagnosis_text(d);
+  bool aux_limit = false;
+  for (const auto& l : d.detection_limits)
+    if (l.effect == "aux_load") {
+      aux_limit = true;
+      EXPECT_LT(l.smallest_detectable, 1000.0) << diagnosis_text(d);
+    }
+  EXPECT_TRUE(aux_limit) << diagnosis_text(d);
+}
+
 // The recording's elevation column: `hills` (the Hills truth's profile, else a level road at 150 m) along the
 // recording's own distance, plus white GPS noise of `sd_m` per reading (this file's generator, not rollsim's).
 void record_elevation(Recording& r, bool hills, double sd_m, unsigned seed) {
@@ -264,6 +297,10 @@ TEST(DiagnoseAdequacy, ALargeSwitchingLoadIsNamedByItsStandstillsSwitching) {
     const ParameterEstimate& p = d.findings.front().parameters.front();
     EXPECT_LE(p.ci_low, 800.0) << diagnosis_text(d);
     EXPECT_GE(p.ci_high, 800.0) << diagnosis_text(d);
+    // Its swing is left, above the floor; beside the fitted mean it nets out, and is said to (it read "net -0 kJ").
+    ASSERT_TRUE(named(d, "unexplained")) << diagnosis_text(d);
+    for (const auto& f : d.findings)
+      if (f.effect == "unexplained") EXPECT_NE(f.description.find("that nets out"), std::string::npos) << diagnosis_text(d);
   }
 }
 

@@ -419,7 +419,16 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
   describe_wind(cycles, out.findings, out.notes);
   out.detection_limits = detection_limits(sig.candidates, chosen, m, opt);
   if (sc.opt.infer_road_profile) {
-    if (auto f = infer_road_profile(sc, cycles, sig, out.findings, chosen, floor, m, out.notes)) out.findings.push_back(std::move(*f));
+    if (auto f = infer_road_profile(sc, cycles, sig, out.findings, chosen, floor, m, out.notes)) {
+      out.findings.push_back(std::move(*f));
+      // The detection limits are the profile's residual's: they had been read from the hills' own residual (aux_load
+      // 6.5-10 kW, wind 167-262 m/s behind 25 m hills; session 27's outside tester). The catalogue is not searched
+      // again behind the profile: the linearised profile leaves shapes that a second search named (rr_speed 0.17
+      // beside a 400 W load, test WhatWithheldHillsHideIsLookedForBehindTheirProfile); what it leaves is described by
+      // the unexplained basis below.
+      chosen.push_back(EffectId::road_profile);  // the profile's column, so that each later column keeps its effect
+      out.detection_limits = detection_limits(sig.candidates, chosen, m, opt);
+    }
   }
   if (auto f = describe_unexplained(sc, cycles, sig.basis, m)) out.findings.push_back(std::move(*f));
   const Adequacy after = test_adequacy(obs, recordings, per_recording_residual(m, obs, recordings.size()), floor, opt);

@@ -381,6 +381,7 @@ struct Adequacy {
   bool inadequate = false;
   int blocks = 0, flagged = 0;
   double flagged_j = 0.0, first_s = 0.0, last_s = 0.0, first_m = 0.0, last_m = 0.0, flagged_mean_speed_mps = 0.0;
+  double flagged_abs_j = 0.0;  ///< the flagged blocks' residuals summed by size, whatever their sign
 };
 Adequacy test_adequacy(const Observations& o, const std::vector<Recording>& recs, const Eigen::VectorXd& resid,
                        const NoiseFloor& nf, const DiagnoseOptions& opt);
