@@ -1223,5 +1223,16 @@ TEST_F(OutsideTesting, AVehicleFilesCalibrationPriorsAreReadAndChecked) {
                  "calibration_priors.drag_sd");
 }
 
+// Session 27's outside tester: a fuel channel was told it might lack a "usable capacity" (a state of charge's
+// scale), and a level road's profile note read "-162.9 sd beyond the rolling resistance's -0.5 %", backwards.
+TEST_F(OutsideTesting, TheCamrysWordingFitsAFuelChannelAndALevelRoad) {
+  const CmdResult r = run_rollsim("diagnose --vehicle camry_2018 --preset anl_d3 --recording '" + kCamryUdds + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(has(r.out, "(none takes 80 % of it within its bounds): an engine or drive efficiency or consumer the model "
+                         "lacks, or several effects together")) << r.out;
+  EXPECT_FALSE(has(r.out, "usable capacity")) << r.out;
+  EXPECT_TRUE(has(r.out, "(not steeper than the rolling resistance's -0.8 %, 3.3 sd needed): not named")) << r.out;
+}
+
 }  // namespace
 }  // namespace rollsim::test

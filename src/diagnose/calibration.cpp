@@ -97,6 +97,16 @@ Calibration calibrate(const Observations& o, const Variant& base, const Variant&
   return c;
 }
 
+// What the model may lack where no one effect takes the calibration's excess: usable capacity is a state of
+// charge's scale, an engine's efficiency a fuel channel's (the Camry's fuel channel was offered usable capacity).
+std::string lacks_text(ChannelKind channel) {
+  switch (channel) {
+    case ChannelKind::soc: return "a drive efficiency, usable capacity or consumer the model lacks";
+    case ChannelKind::fuel_rate: return "an engine or drive efficiency or consumer the model lacks";
+    default: return "a drive efficiency or consumer the model lacks";
+  }
+}
+
 // What the boxes leave, and which catalogue effects could take a level error of that size: an effect whose
 // signature alone explains at least 80 % of it with an amplitude inside its bounds.
 std::string calibration_outside_prior_text(const Calibration& c, const Observations& o, const std::vector<Candidate>& cands,
@@ -123,8 +133,8 @@ std::string calibration_outside_prior_text(const Calibration& c, const Observati
          fixed(100.0 * c.absorbed_j / std::max(1e-9, std::abs(o.measured_j.sum())), 1) + " % of the measured energy" +
          (!with_explanations ? std::string() : ". ") +
          (!with_explanations ? std::string()
-          : could.empty() ? std::string("No catalogue effect alone explains that energy: a drive efficiency, usable capacity "
-                                      "or consumer the model lacks")
+          : could.empty() ? std::string("No catalogue effect alone explains that energy (none takes 80 % of it within its bounds): ") +
+                                lacks_text(o.channel) + ", or several effects together"
                         : "Effects that could explain it, not separable from each other on this data: " + could +
                               " (to separate: log a long standstill, steady-speed runs at two speeds and the route both ways)");
 }

@@ -405,8 +405,11 @@ std::optional<Finding> infer_road_profile(const SelectionContext& sc, const std:
                   ", held-out RMSE " + fixed(rmse_before / 1e3, 1) + " -> " + fixed(rmse_after / 1e3, 1) + " kJ, standing residual " +
                   fixed(still.ratio, 2) + " x the floor (" + std::to_string(still.windows) + " windows; moving " + fixed(still.moving_ratio, 1) + " x)" +
                   (loop ? ", a loop (net climb held at 0)" : "") + ", steepest descent " + fixed(100.0 * descent.grade, 1) + " % (" +
-                  fixed(descent.z, 1) + " sd beyond the rolling resistance's " + fixed(-100.0 * descent.rolling_grade, 1) + " %, " +
-                  fixed(descent.z_needed, 1) + " needed)" + (named ? ": named" : ": not named"));
+                  // A level profile is far from steeper; "-162.9 sd beyond" read backwards (session 27's outside tester).
+                  (descent.z > 0.0 ? fixed(descent.z, 1) + " sd steeper than the rolling resistance's "
+                                   : std::string("not steeper than the rolling resistance's ")) +
+                  fixed(-100.0 * descent.rolling_grade, 1) + " %, " + fixed(descent.z_needed, 1) + " sd needed)" +
+                  (named ? ": named" : ": not named"));
   if (!named) return std::nullopt;
 
   // The profile: elevations at the knots, relative to the start, with a 95 % band from the sandwich covariance
