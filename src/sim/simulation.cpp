@@ -318,7 +318,9 @@ TracePoint trace_point(const VehicleModel& m, double t, double target_mps, doubl
   TracePoint p{};
   p.time_s = t;
   p.target_speed_mps = target_mps;
-  p.speed_mps = v;
+  // The integrator may end a stop a few 1e-5 m/s below zero, within its tolerance; the car does not roll back, and a
+  // trace written with -0.0003 km/h was refused when read back as a cycle (session 27's outside tester).
+  p.speed_mps = std::max(0.0, v);
   p.accel_mps2 = a;
   p.grade = grade;
   p.rolling_force_n = s.rolling_n;
