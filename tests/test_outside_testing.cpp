@@ -1234,5 +1234,24 @@ TEST_F(OutsideTesting, TheCamrysWordingFitsAFuelChannelAndALevelRoad) {
   EXPECT_TRUE(has(r.out, "(not steeper than the rolling resistance's -0.8 %, 3.3 sd needed): not named")) << r.out;
 }
 
+// Session 27's outside tester: a coast-down car's tyre sweep and sensitivity printed fuel figures that hold only the
+// tyre's gearing (pressure elasticity -0.009 on fuel beside -0.36 on the tyre's power), with no word; and tyres
+// needing more than the car's whole coast-down A were a plain line (106.5 %).
+TEST_F(OutsideTesting, ACoastDownCarsTyreFiguresSayTheyHoldOnlyTheGearing) {
+  const std::string said = "this car's road load is its coast-down curve";
+  const CmdResult s = run_rollsim("sensitivity --vehicle camry_2018 --cycle nedc --tyre nominal");
+  ASSERT_EQ(s.exit_code, 0) << s.err;
+  EXPECT_TRUE(has(s.err, "warning: ") && has(s.err, said)) << s.err;
+  const CmdResult w = run_rollsim("sweep --tyre nominal --vehicle camry_2018 --param pressure --from 1.8 --to 2.4 --steps 3");
+  ASSERT_EQ(w.exit_code, 0) << w.err;
+  EXPECT_TRUE(has(w.err, said)) << w.err;
+  const CmdResult own = run_rollsim("sensitivity --vehicle ice --cycle nedc --tyre nominal");
+  EXPECT_FALSE(has(own.err, said)) << own.err;  // a car with its own tyres' rolling resistance
+  const CmdResult sim = run_rollsim("simulate --vehicle camry_2018 --tyre nominal --cycle us06");
+  ASSERT_EQ(sim.exit_code, 0) << sim.err;
+  EXPECT_TRUE(has(sim.err, "warning: nominal: these tyres alone need 125.6 N at standstill, more than the coast-down's "
+                           "whole A of 117.9 N")) << sim.err;
+}
+
 }  // namespace
 }  // namespace rollsim::test

@@ -33,6 +33,7 @@ void run_sensitivity(const SensitivityOptionsText& o) {
       units::kmh_to_mps(parse_option_number(o.speed_kmh, "--speed-kmh", Range::open_low(0.0, 500.0)));
   std::optional<Vehicle> vehicle;
   if (!o.vehicle.empty()) vehicle = load_vehicle_file(resolve_data_file(o.vehicle, "vehicles", ".yaml", "--vehicle"));
+  if (vehicle) warn_if_coastdown(*vehicle, "the car's energy and fuel elasticities");
   std::optional<TyreSpec> tyre;
   if (!o.tyre.empty()) tyre = load_tyre_file(resolve_data_file(o.tyre, "tyres", ".yaml", "--tyre"));
   std::optional<double> load_n;

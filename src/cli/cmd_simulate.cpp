@@ -74,6 +74,13 @@ void run_simulate(const SimulateOptions& o) {
         std::cout << "tyres' share of coast-down A: " << fixed(tyre_a_n, 1) << " N of "
                   << fixed(v.coastdown->a_n, 1) << " N (" << fixed(100.0 * tyre_a_n / v.coastdown->a_n, 1)
                   << " %)\n";
+        // More than the whole A term: these tyres roll harder than the tested car's tyres and driveline together,
+        // which its coast-down cannot show (the road load stays the coast-down's).
+        if (tyre_a_n > v.coastdown->a_n)
+          std::cerr << "warning: " << run.tyre_label << ": these tyres alone need " << fixed(tyre_a_n, 1)
+                    << " N at standstill, more than the coast-down's whole A of " << fixed(v.coastdown->a_n, 1)
+                    << " N (tyres and driveline): the figures keep the coast-down's road load, so they do not show "
+                       "these tyres' rolling resistance\n";
       }
       const auto [front_file, rear_file] = tyre_files(run);
       runs.push_back({run.tyre_label, std::move(run.result), front_file, rear_file, cycle.source});

@@ -152,6 +152,7 @@ void run_sweep(const SweepOptionsText& o, const ProcessGroup& group) {
   std::optional<DriveCycle> drive;
   if (!o.vehicle.empty()) {
     vehicle = load_vehicle_file(resolve_data_file(o.vehicle, "vehicles", ".yaml", "--vehicle"));
+    warn_if_coastdown(*vehicle, "the energy and fuel columns");
     drive = load_cycle_noted(cycle, "--cycle");
     for (const auto& f : vehicle_input_files(*vehicle)) inputs.push_back(f);
     inputs.push_back(drive->source);

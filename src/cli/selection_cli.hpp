@@ -12,6 +12,7 @@
 
 #include "rollsim/common/error.hpp"
 #include "rollsim/common/yaml_reader.hpp"
+#include "rollsim/vehicle/vehicle.hpp"
 
 namespace rollsim::cli {
 
@@ -34,5 +35,16 @@ class Progress {
   bool on_;
   std::mutex m_;
 };
+
+/// A car whose road load is its coast-down curve takes no rolling resistance from its tyres, only their gearing: a
+/// tyre's figures for it say so, or a pressure elasticity of -0.009 on fuel beside -0.36 on the tyre's own power reads
+/// as "pressure barely matters" (session 27's outside tester; `compare` refuses such a car).
+inline void warn_if_coastdown(const Vehicle& v, const std::string& what) {
+  if (!v.coastdown) return;
+  std::cerr << "warning: " << v.source << ": this car's road load is its coast-down curve (coastdown: A, B, C), which "
+            << "holds its tyres' rolling resistance at the tested tyres': a tyre changes only its gearing here, so "
+            << what << " carry no rolling resistance of the tyre (give the car a body with tyres and no coastdown block "
+               "to see it)\n";
+}
 
 }  // namespace rollsim::cli
