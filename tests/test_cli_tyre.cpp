@@ -129,6 +129,12 @@ TEST(CliTyre, ExplainPrintsElasticitiesAndMechanisms) {
   EXPECT_LT(json_number(j.out, "elasticity_rrc_outer_diameter"), 0.0);
   EXPECT_LT(json_number(j.out, "elasticity_rrc_pressure"), 0.0);
   EXPECT_NEAR(json_number(j.out, "elasticity_power_speed"), 1.0 + json_number(j.out, "elasticity_rrc_speed"), 1e-6);
+  // The JSON carries what the table and text do (session 27's outside tester: the mechanisms were dropped).
+  EXPECT_NEAR(json_number(j.out, "elasticity_deflection_load"), 1.0, 1e-3);
+  EXPECT_TRUE(has(j.out, "\"mechanism_pressure\": \"Higher pressure lowers RRC")) << j.out;
+  // An unknown rim is null, not 0 m.
+  EXPECT_TRUE(has(tyre("--outer-radius-m 0.305 --width-m 0.195 --pressure-bar 2.1 --load-n 4000 --json").out,
+                  "\"rim_radius_m\": null"));
 }
 
 TEST(CliTyre, LoadAboveRatingIsAllowedWithAWarning) {

@@ -247,7 +247,7 @@ TEST_F(OutsideTesting, AllowedLimitsWrittenInDecimalAreInside) {
   // An engine turning 15000 rpm at 60 mph in top gear was simulated (2.1 mpg against 17.7); it is a skipped field now.
   const std::string fast = with(",23.0,1,Not eqipped", ",250,1,Not eqipped");  // N/V Ratio
   v = run_rollsim("validate --epa-test-car-list '" + fast + "' --json");
-  EXPECT_EQ(v.exit_code, 0) << v.err;
+  EXPECT_EQ(v.exit_code, 2) << v.err;  // its only row skipped: nothing validated
   EXPECT_TRUE(has(v.out, "N/V ratio of an engine's top gear [rpm/mph] = 250")) << v.out;
   // A skip says what is wrong: a negative gear count read as "empty or not a number", and an absurd measured result
   // as a hybrid (the hybrid rule compared it with the car's other result).
@@ -262,6 +262,19 @@ TEST_F(OutsideTesting, AllowedLimitsWrittenInDecimalAreInside) {
                   "' --json");
   EXPECT_EQ(lines(v.out).size(), 2u) << v.out;
   for (const auto& l : lines(v.out)) EXPECT_TRUE(has(l, "measured result outside any car of its kind: 0.5 mpg")) << l;
+  // Nothing simulated is not a result: exit 2 after the rows' reasons, no figure (session 27's outside tester: exit 0
+  // and an empty plot).
+  const fs::path none_svg = dir_ / "none.svg";
+  v = run_rollsim("validate --epa-test-car-list '" + (dir_ / "both.csv").string() + "' --plot '" + none_svg.string() + "'");
+  EXPECT_EQ(v.exit_code, 2) << v.out;
+  EXPECT_TRUE(has(v.err, "none of its 2 rows was simulated (each row's skip reason is in the summary above); no figure drawn"))
+      << v.err;
+  EXPECT_FALSE(fs::exists(none_svg));
+  // One car within a decade of mpg: its figure labels ticks inside that decade (there were none on either axis).
+  const fs::path one_svg = dir_ / "one.svg";
+  v = run_rollsim("validate --epa-test-car-list '" + with(",5.200,", ",9,") + "' --plot '" + one_svg.string() + "'");
+  ASSERT_EQ(v.exit_code, 0) << v.err;
+  EXPECT_TRUE(std::regex_search(slurp(one_svg.string()), std::regex(">\\s*17\\s*</text>"))) << slurp(one_svg.string());
 }
 
 // A measured-points CSV with a column twice: the first copy won without a word (cycle CSVs refused it).
@@ -1251,6 +1264,25 @@ TEST_F(OutsideTesting, ACoastDownCarsTyreFiguresSayTheyHoldOnlyTheGearing) {
   ASSERT_EQ(sim.exit_code, 0) << sim.err;
   EXPECT_TRUE(has(sim.err, "warning: nominal: these tyres alone need 125.6 N at standstill, more than the coast-down's "
                            "whole A of 117.9 N")) << sim.err;
+}
+
+// Session 27's outside tester's unclear errors: a negative speed scale was blamed on the recording's line 23; a
+// misspelt `expected` was told to use --update, which fails on the same key; too many shift speeds read "needs exactly
+// 4 values".
+TEST_F(OutsideTesting, ErrorsNameTheirCause) {
+  expect_refused("diagnose --vehicle camry_2018 --preset anl_d3 --scale speed_kmh=-1 --recording '" + kCamryUdds + "'",
+                 "error: --scale 'speed_kmh=-1': -1 is not allowed: a speed's scale must be positive");
+  const std::string base = write("b.yaml", "cases:\n  - name: a\n    vehicle: ev\n    tyre: nominal\n    cycle: nedc\n"
+                                           "    expcted: 1.6\n    tolerance_pct: 0.5\n");
+  const CmdResult r = run_rollsim("regress '" + base + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, "(misspelt as 'expcted'?)")) << r.err;
+  EXPECT_FALSE(has(r.err, "--update")) << r.err;
+  const std::string ice = write("ice5.yaml", shipped_vehicle_with("ice.yaml", "upshift_speeds_kmh: [16, 33, 48, 65]",
+                                                                  "upshift_speeds_kmh: [16, 33, 48, 65, 80]"));
+  expect_refused("simulate --vehicle '" + ice + "'",
+                 "key 'powertrain.gearbox.upshift_speeds_kmh': has 5 speeds; 5 gear ratios have 4 shifts, one speed "
+                 "each, up and down");
 }
 
 }  // namespace

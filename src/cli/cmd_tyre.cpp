@@ -126,7 +126,11 @@ void run_tyre(const TyreOptions& o) {
       JsonObject j = tyre_point_json(spec, load.load_n, speeds_kmh[i], r);
       if (o.explain) {
         for (const auto& p : explanations[i].parameters) {
+          // All the table and the text give (the mechanisms were dropped from --json: session 27's outside tester).
           j.add("elasticity_rrc_" + p.key, p.rrc_elasticity).add("elasticity_power_" + p.key, p.power_elasticity);
+          j.add("elasticity_deflection_" + p.key, p.deflection_elasticity)
+              .add("elasticity_contact_length_" + p.key, p.contact_length_elasticity)
+              .add("mechanism_" + p.key, p.mechanism);
         }
       }
       std::cout << j.str() << "\n";

@@ -156,7 +156,26 @@ void plot(const validate::Validation& v, const std::string& file) {
      << "set xlabel 'measured [mpg or mpge]'\nset ylabel 'predicted [mpg or mpge]'\n"
      << "set logscale xy\nset grid\nset key top left\nset size square\n";
   // Both axes over the data's own span (gnuplot's log autoscale widens to whole decades: 1-1000 for 9-200 mpg).
-  if (lo > 0.0 && hi > lo) gp << "set xrange [" << lo / 1.1 << ":" << hi * 1.1 << "]\nset yrange [" << lo / 1.1 << ":" << hi * 1.1 << "]\n";
+  if (lo > 0.0 && hi >= lo) {  // one row (or all on the line) still has a span about it
+    gp << "set xrange [" << lo / 1.1 << ":" << hi * 1.1 << "]\nset yrange [" << lo / 1.1 << ":" << hi * 1.1 << "]\n";
+    // Labelled ticks inside the span: a list within one decade (19-55 mpg) had none on either axis, gnuplot's log
+    // ticks being the powers of ten (session 27's outside tester). Over a factor 3 or more, 1, 2, 3 and 5 of each
+    // decade; below it, evenly spaced at 1, 2 or 5 of a power of ten, some five of them.
+    const double a = lo / 1.1, b = hi * 1.1;
+    std::vector<double> at;
+    if (b / a >= 3.0) {
+      for (double decade = std::pow(10.0, std::floor(std::log10(a))); decade <= b; decade *= 10.0)
+        for (double m : {1.0, 2.0, 3.0, 5.0})
+          if (m * decade >= a && m * decade <= b) at.push_back(m * decade);
+    } else {
+      const double raw = (b - a) / 5.0, power = std::pow(10.0, std::floor(std::log10(raw)));
+      const double step = raw <= power ? power : raw <= 2.0 * power ? 2.0 * power : raw <= 5.0 * power ? 5.0 * power : 10.0 * power;
+      for (double t = std::ceil(a / step) * step; t <= b; t += step) at.push_back(t);
+    }
+    std::ostringstream ticks;
+    for (std::size_t k = 0; k < at.size(); ++k) ticks << (k ? ", " : "") << at[k];
+    if (!at.empty()) gp << "set xtics (" << ticks.str() << ")\nset ytics (" << ticks.str() << ")\n";
+  }
   gp << "plot x title 'predicted = measured' lc rgb 'black'";
   std::size_t i = 0;
   for (const auto& [name, points] : series) {
@@ -181,13 +200,18 @@ void run_validate(const ValidateOptionsText& o, const ProcessGroup& group) {
   if (!o.plot.empty()) check_plot_target(o.plot);
   const auto rows = validate::read_epa_test_car_list(o.list);
   const auto v = validate::validate_epa_list(rows, threads, group.mapper());
-  if (!o.plot.empty() && group.is_root()) plot(v, o.plot);
+  const bool any = std::any_of(v.rows.begin(), v.rows.end(), [](const auto& r) { return r.skip == validate::SkipReason::none; });
+  if (any && !o.plot.empty() && group.is_root()) plot(v, o.plot);
   if (o.json) {
     for (const auto& r : v.rows) std::cout << validate::row_json(r).str() << "\n";
   } else {
     print_summary(v);
   }
   for (const auto& w : validate::validation_warnings(v)) std::cerr << "warning: " << w << "\n";
+  // Nothing validated is not a result (it exited 0 and drew an empty figure: session 27's outside tester).
+  if (!any)
+    throw InputError(o.list, "none of its " + std::to_string(v.rows.size()) + " rows was simulated (each row's skip reason is " +
+                                 (o.json ? "in its JSON" : "in the summary above") + ")" + (o.plot.empty() ? "" : "; no figure drawn"));
 }
 
 }  // namespace

@@ -131,6 +131,11 @@ int main(int argc, char** argv) {
   CLI::App app{"rollsim: tyre rolling resistance and vehicle energy simulation"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "rollsim 0.1.0");
+  // The parser's errors read like every other: one line after "error: " (CLI11's own read "--pressure-bar: At Most 1
+  // required but received 2" with no prefix; session 27's outside tester).
+  app.failure_message([](const CLI::App*, const CLI::Error& e) {
+    return "error: " + std::string(e.what()) + "\nRun with --help for more information.\n";
+  });
   rollsim::cli::register_commands(app, group);
   refuse_option_names_as_values(app);
   // CLI11 answers an unknown first word with "A subcommand is required"; name it and the known ones instead.

@@ -198,6 +198,10 @@ void parse_scale_option(const std::string& text, ColumnMapping& mapping, const s
   const auto f = parse_number(value);
   if (!f) throw InputError(where, "'" + value + "' is not a number");
   if (!std::isfinite(*f) || *f == 0.0) throw InputError(where, format_value(*f) + " is not allowed: must be finite and non-zero");
+  // A power's sign is a logger's convention, a speed's is not: a negative speed scale was blamed on the recording's
+  // line 23 (session 27's outside tester).
+  if (*f < 0.0 && canonical.rfind("speed_", 0) == 0)
+    throw InputError(where, format_value(*f) + " is not allowed: a speed's scale must be positive");
   if (mapping.scale_for_canonical.count(canonical)) throw InputError(where, "'" + canonical + "' is already scaled; give it once");
   mapping.scale_for_canonical[canonical] = *f;
 }
@@ -223,6 +227,8 @@ ColumnMapping column_mapping_from_yaml(YamlMap& file) {
       }
       const double f = scales->number(key, Range{});
       if (f == 0.0) throw InputError(scales->where(key), "0 is not allowed: must be non-zero");
+      if (f < 0.0 && key.rfind("speed_", 0) == 0)
+        throw InputError(scales->where(key), format_value(f) + " is not allowed: a speed's scale must be positive");
       m.scale_for_canonical[key] = f;
     }
     scales->finish();

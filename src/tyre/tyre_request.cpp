@@ -101,9 +101,10 @@ JsonObject tyre_point_json(const TyreSpec& spec, double load_n, double speed_kmh
   if (spec.size) j.add("size", spec.size->designation);
   j.add("outer_radius_m", spec.state.geometry.outer_radius_m)
       .add("section_width_m", spec.state.geometry.section_width_m)
-      .add("rim_radius_m", spec.state.geometry.rim_radius_m)
       .add("pressure_bar", units::pa_to_bar(spec.state.pressure_pa))
       .add("load_n", load_n);
+  // An unknown rim is null, as an unknown rated load is (it read 0 m).
+  if (spec.state.geometry.rim_radius_m > 0.0) j.add("rim_radius_m", spec.state.geometry.rim_radius_m); else j.add_null("rim_radius_m");
   if (spec.max_load_n > 0.0) j.add("max_load_n", spec.max_load_n); else j.add_null("max_load_n");
   j.add("speed_kmh", speed_kmh)
       .add("rrc", r.rrc)

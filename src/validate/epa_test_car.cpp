@@ -130,7 +130,7 @@ std::string to_string(SkipReason r) {
     case SkipReason::fuel_cell: return "hydrogen fuel cell: no fuel-cell model";
     case SkipReason::unsupported_fuel: return "fuel without properties here";
     case SkipReason::unknown_unit: return "result in a unit not given for its fuel";
-    case SkipReason::missing_field: return "missing field";
+    case SkipReason::missing_field: return "missing or unreadable field";
     case SkipReason::absurd_field: return "field outside its physical range";
     case SkipReason::cannot_follow_cycle: return "the car from the row cannot follow the cycle (the driver keeps within 2 mph)";
     case SkipReason::simulation_failed: return "simulation failed";

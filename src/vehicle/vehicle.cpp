@@ -234,8 +234,10 @@ CombustionPowertrainParams read_combustion(YamlMap& pt, double driven_radius_m, 
     auto up = m.numbers("upshift_speeds_kmh", Range::open_low(0.0, 500.0), shifts);
     auto down = m.numbers("downshift_speeds_kmh", Range::open_low(0.0, 500.0), shifts);
     if (up.size() != shifts || down.size() != shifts)
-      throw InputError(m.where("upshift_speeds_kmh"), "needs exactly " + std::to_string(shifts) +
-                                                          " values (one per shift) for both up and down shifts");
+      throw InputError(m.where(up.size() != shifts ? "upshift_speeds_kmh" : "downshift_speeds_kmh"),
+                       "has " + std::to_string(up.size() != shifts ? up.size() : down.size()) + " speeds; " +
+                           std::to_string(g.ratios.size()) + " gear ratios have " + std::to_string(shifts) +
+                           " shifts, one speed each, up and down");
     for (std::size_t i = 0; i < shifts; ++i) {
       // The upshifts' order first: [16, 48, 33, 65] was blamed on the downshift speeds (session 22).
       if (i > 0 && up[i] <= up[i - 1])
