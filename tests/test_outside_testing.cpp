@@ -859,6 +859,7 @@ TEST_F(OutsideTesting, VehicleUnitSlipsAreNamedAtTheirOwnKey) {
 // limit, -1e11 N near standstill, and CVODE failed at the first launch: exit 1 with no key named (session 22's notes).
 TEST_F(OutsideTesting, AnEngineTooWeakForItsAccessoriesIsNamed) {
   const std::string ice = write("weak.yaml", shipped_vehicle_with("ice.yaml", "max_power_kw: 88", "max_power_kw: 0.2"));
+  expect_refused("tyre 175-70R14 --pressure-bar 2 --pressure-bar 3", "error: --pressure-bar: At Most 1 required but received 2");
   expect_refused("simulate --vehicle '" + ice + "'",
                  "key 'powertrain.engine.max_power_kw': 0.2 kW cannot carry the accessories: aux_power_w 300 W through "
                  "alternator_efficiency 0.6 takes 0.500 kW of the engine; allowed: above 0.500 kW");
@@ -1280,6 +1281,7 @@ TEST_F(OutsideTesting, ErrorsNameTheirCause) {
   EXPECT_FALSE(has(r.err, "--update")) << r.err;
   const std::string ice = write("ice5.yaml", shipped_vehicle_with("ice.yaml", "upshift_speeds_kmh: [16, 33, 48, 65]",
                                                                   "upshift_speeds_kmh: [16, 33, 48, 65, 80]"));
+  expect_refused("tyre 175-70R14 --pressure-bar 2 --pressure-bar 3", "error: --pressure-bar: At Most 1 required but received 2");
   expect_refused("simulate --vehicle '" + ice + "'",
                  "key 'powertrain.gearbox.upshift_speeds_kmh': has 5 speeds; 5 gear ratios have 4 shifts, one speed "
                  "each, up and down");
