@@ -664,8 +664,8 @@ every core). Returns a list of dicts, one
 per point: the swept values (pressure_bar, diameter_mm, width_mm, load_n, load_pct, speed_kmh), the load_n and
 speed_kmh evaluated at when not swept, rrc,
 rr_force_n, rr_power_w, deflection_m, and the car's kwh_per_10km or l_per_100km with followed_trace (False, and a
-warning, where the car could not follow the cycle). A range leaving the
-model's domain stops with a warning and returns the valid points.)");
+warning, where the car could not follow the cycle). Points outside the
+model's domain are left out with a warning wherever they fall, and the valid ones are returned.)");
 
   m.def("tyre_fit", &api_tyre_fit, "size"_a, py::kw_only(), "points"_a = py::none(), "label"_a = py::none(),
         "j2452"_a = py::none(), "drum_radius_m"_a = py::none(), "free"_a = py::none(),
