@@ -168,6 +168,10 @@ TEST(CliSimulate, OverloadedTyreRunsWithAWarning) {
   EXPECT_NE(r.err.find("warning:"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("rated maximum"), std::string::npos) << r.err;
   EXPECT_NE(r.out.find("kWh/10 km"), std::string::npos);
+  // The tyre put on the car is rated too low; the car's mass is not in pounds (its own tyres carry it), which the
+  // warning had asked (session 27's outside tester).
+  EXPECT_NE(r.err.find("; the tyre's load rating is too low for this car"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find(" in lb?"), std::string::npos) << r.err;
 }
 
 

@@ -64,7 +64,7 @@ Sensitivity vehicle_sensitivity(const Vehicle& vehicle, const TyreSpec& tyre, co
   s.energy_unit = energy_unit(vehicle);
   Vehicle base = vehicle;
   fit_tyres(base, tyre);
-  s.vehicle_warnings = check_tyre_loads(base, "--tyre '" + tyre.source + "'");
+  s.vehicle_warnings = check_tyre_loads(base, "--tyre '" + tyre.source + "'", false);
   const EnergyFigure at_base = run_forward(base, cycle);
   s.energy = at_base.value;
   s.followed_trace = at_base.trace.followed;

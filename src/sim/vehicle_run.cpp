@@ -20,7 +20,7 @@ VehicleRun run_vehicle(const Vehicle& base, const std::optional<TyreSpec>& tyre,
     run.tyre_label = tyre->name;
   }
   run.warnings = base.warnings;
-  for (auto& w : check_tyre_loads(run.vehicle, tyre ? "--tyre '" + tyre->source + "'" : base.source)) run.warnings.push_back(w);
+  for (auto& w : check_tyre_loads(run.vehicle, tyre ? "--tyre '" + tyre->source + "'" : base.source, !tyre)) run.warnings.push_back(w);
   if (run.vehicle.front_tyre && !cycle.speed_mps.empty()) {
     const double top_mps = *std::max_element(cycle.speed_mps.begin(), cycle.speed_mps.end());
     const bool same = run.vehicle.front_tyre->name == run.vehicle.rear_tyre->name;

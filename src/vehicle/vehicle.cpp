@@ -382,7 +382,7 @@ Vehicle load_vehicle(YamlMap root) {
   return v;
 }
 
-std::vector<std::string> check_tyre_loads(const Vehicle& vehicle, const std::string& where) {
+std::vector<std::string> check_tyre_loads(const Vehicle& vehicle, const std::string& where, bool own_tyres) {
   std::vector<std::string> warnings;
   if (!vehicle.front_tyre) return warnings;
   const auto loads = wheel_loads(vehicle.body, 0.0);
@@ -394,10 +394,13 @@ std::vector<std::string> check_tyre_loads(const Vehicle& vehicle, const std::str
       throw InputError(where + ": " + axle + " tyre '" + tyre.name + "'", e.what());
     }
     if (tyre.max_load_n > 0.0 && load_n > tyre.max_load_n) {
-      // Tyres loaded a third beyond their rating that would carry the mass read in pounds: it was typed in pounds.
+      // The file's own tyres loaded a third beyond their rating that would carry the mass read in pounds: it was typed
+      // in pounds. A tyre put on the car (--tyre) is simply rated too low for it (the pound hint had pointed an
+      // outside tester at the mass: session 27).
       const double kKgPerLb = 0.45359237;
       const double mass_kg = vehicle.body.test_mass_kg;
-      const std::string lb = load_n > 1.3 * tyre.max_load_n && load_n * kKgPerLb <= tyre.max_load_n
+      const std::string lb = !own_tyres ? "; the tyre's load rating is too low for this car"
+                             : load_n > 1.3 * tyre.max_load_n && load_n * kKgPerLb <= tyre.max_load_n
                                  ? "; is body.test_mass_kg in lb? (" + format_value(mass_kg) + " lb = " + significant(mass_kg * kKgPerLb, 4) + " kg)"
                                  : "";
       warnings.push_back(where + ": " + axle + " tyre '" + tyre.name + "': wheel load " + format_value(std::round(load_n)) +

@@ -79,7 +79,7 @@ void fit_tyres(Vehicle& vehicle, const TyreSpec& tyre);
 /// Checks that each axle's tyre carries its static wheel load (the model has no solution past the rim); throws
 /// InputError naming `where`, the axle and the tyre. Returns a warning for each tyre loaded above its rating
 /// (allowed, but worth saying), empty when none is.
-std::vector<std::string> check_tyre_loads(const Vehicle& vehicle, const std::string& where);
+std::vector<std::string> check_tyre_loads(const Vehicle& vehicle, const std::string& where, bool own_tyres = true);
 
 /// Static normal load on one tyre of each axle [N] on a grade (front, rear).
 struct AxleWheelLoads {
