@@ -191,6 +191,13 @@ TEST_F(OutsideTesting, OptionsAreCheckedWholly) {
                  "--label: not allowed with --evaluate-j2452");
   expect_refused("tyre fit --evaluate-j2452 ../shared/data/tyres/j2452_michelin_part.csv --rrc-uncertainty-pct 3",
                  "--rrc-uncertainty-pct: not allowed with --evaluate-j2452");  // was ignored (session 24)
+  // A size that does not parse is named by file, line and column (it was "J2452 set 'garbage MED'": session 27).
+  std::ifstream j2452("../shared/data/tyres/j2452_michelin_part.csv");
+  std::string head, first;
+  std::getline(j2452, head);
+  std::getline(j2452, first);
+  const std::string garbage = write("badsize.csv", head + "\ngarbage" + first.substr(first.find(',')) + "\n");
+  expect_refused("tyre fit --evaluate-j2452 '" + garbage + "'", garbage + ": line 2, column 'size': 'garbage' does not parse");
   expect_refused("validate --epa-test-car-list ../shared/data/vehicles/epa_test_car_list_2022_part.csv --threads 2.5",
                  "--threads: '2.5' is not a whole number");
   expect_refused("diagnose --vehicle camry_2018 --preset anl_d3 --recording '" + kCamryUdds + "' --window-s nan",

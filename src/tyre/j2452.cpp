@@ -8,6 +8,7 @@
 #include "rollsim/common/error.hpp"
 #include "rollsim/common/units.hpp"
 #include "rollsim/common/yaml_reader.hpp"
+#include "rollsim/tyre/tyre_spec.hpp"
 
 namespace rollsim {
 
@@ -111,6 +112,9 @@ std::vector<J2452Set> load_j2452_csv(const std::string& path) {
     };
     J2452Set s{trim(t.rows[i][size]) + " " + trim(t.rows[i][cls]), trim(t.rows[i][size]), num(al), num(be), num(a),
                num(b), num(c), num(r)};
+    // The size is read here, where its file and line are known (it was read at evaluation, as "J2452 set 'garbage
+    // MED'": session 27's outside tester).
+    parse_tyre_size(s.size, t.where(i, size));
     if (const auto e = coefficient_error(s)) {
       const std::size_t column[] = {al, be, a, b, c};
       throw InputError(t.where(i, column[e->field]), "'" + t.rows[i][column[e->field]] + "' is not allowed: " + e->allowed);
