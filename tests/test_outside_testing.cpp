@@ -192,7 +192,7 @@ TEST_F(OutsideTesting, OptionsAreCheckedWholly) {
   expect_refused("tyre fit --evaluate-j2452 ../shared/data/tyres/j2452_michelin_part.csv --rrc-uncertainty-pct 3",
                  "--rrc-uncertainty-pct: not allowed with --evaluate-j2452");  // was ignored (session 24)
   // A size that does not parse is named by file, line and column (it was "J2452 set 'garbage MED'": session 27).
-  std::ifstream j2452("../shared/data/tyres/j2452_michelin_part.csv");
+  std::ifstream j2452(std::string(ROLLSIM_SHARED_DIR) + "/data/tyres/j2452_michelin_part.csv");
   std::string head, first;
   std::getline(j2452, head);
   std::getline(j2452, first);
