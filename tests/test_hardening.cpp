@@ -505,6 +505,14 @@ TEST_F(Hardening, AnOutputWherePermissionBitsLieIsRefusedBeforeTheRun) {
   EXPECT_EQ(report.exit_code, 2);
   EXPECT_TRUE(has(report.err, "--report '/proc/nope': cannot be created: '/proc' is not a writable folder")) << report.err;
   EXPECT_TRUE(report.out.empty()) << report.out;
+  // The report's folder is made in a folder that exists, as every other output's file is; a missing parent made a
+  // tree of folders (session 27's outside tester).
+  const fs::path deep = fs::temp_directory_path() / "rollsim_no_such_parent_27" / "rep";
+  const CmdResult nested = run_rollsim("diagnose --vehicle twizy --preset rsk_twizy --recording '" + std::string(ROLLSIM_SHARED_DIR) +
+                                       "/data/recordings/rsk_renault_twizy/T2_03_29_2021.csv' --report '" + deep.string() + "'");
+  EXPECT_EQ(nested.exit_code, 2);
+  EXPECT_TRUE(has(nested.err, "cannot be created: folder '" + deep.parent_path().string() + "' does not exist")) << nested.err;
+  EXPECT_FALSE(fs::exists(deep.parent_path()));
 }
 
 // A SIGTERM while the outputs are written leaves neither the output nor its temporary (session 24's note: the

@@ -171,8 +171,12 @@ void check_output_dir(const std::string& dir, const std::string& option) {
     if (!writable_dir(p)) throw InputError(where(option, dir), "is not a writable folder");
     return;
   }
-  while (p.has_parent_path() && p != p.parent_path() && !fs::exists(p, ec)) p = p.parent_path();
-  if (!writable_dir(p)) throw InputError(where(option, dir), "cannot be created: '" + p.string() + "' is not a writable folder");
+  // The folder itself is made, in a folder that exists, as every other output's file is: a mistyped parent made a
+  // tree of folders where --json and --output refuse (session 27's outside tester).
+  const fs::path parent = p.parent_path();
+  if (!fs::exists(parent, ec))
+    throw InputError(where(option, dir), "cannot be created: folder '" + parent.string() + "' does not exist");
+  if (!writable_dir(parent)) throw InputError(where(option, dir), "cannot be created: '" + parent.string() + "' is not a writable folder");
 }
 
 void write_files_atomically(const std::vector<OutputFile>& files) {

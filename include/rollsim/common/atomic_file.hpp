@@ -20,8 +20,8 @@ void check_not_an_input(const std::string& path, const std::string& option, cons
 /// Checks that no two of a command's outputs (path, option) are one file. Throws InputError naming both.
 void check_outputs_distinct(const std::vector<std::pair<std::string, std::string>>& path_and_option);
 
-/// Checks that `dir` is a writable folder, or can be created as one (its nearest existing parent is a
-/// writable folder: a probe file is made there and removed, since root passes the permission bits under /proc).
+/// Checks that `dir` is a writable folder, or can be created as one in a writable folder that exists (a probe file is
+/// made there and removed, since root passes the permission bits under /proc).
 /// Creates nothing that stays. Throws InputError naming `option` and the folder otherwise.
 void check_output_dir(const std::string& dir, const std::string& option);
 
