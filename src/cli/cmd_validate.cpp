@@ -129,6 +129,23 @@ std::string check_plot_target(const std::string& file) {
 }
 
 // Predicted against measured, one series per powertrain, with the line of perfect agreement.
+// Labelled ticks for a log axis over [a, b]: a list within one decade (19-55 mpg) had none, gnuplot's log ticks being
+// the powers of ten (session 27's outside tester). Over a factor 3 or more, 1, 2, 3 and 5 of each decade; below it,
+// evenly spaced at 1, 2 or 5 of a power of ten, some five of them.
+std::vector<double> tick_values(double a, double b) {
+  std::vector<double> at;
+  if (b / a >= 3.0) {
+    for (double decade = std::pow(10.0, std::floor(std::log10(a))); decade <= b; decade *= 10.0)
+      for (double m : {1.0, 2.0, 3.0, 5.0})
+        if (m * decade >= a && m * decade <= b) at.push_back(m * decade);
+    return at;
+  }
+  const double raw = (b - a) / 5.0, power = std::pow(10.0, std::floor(std::log10(raw)));
+  const double step = raw <= power ? power : raw <= 2.0 * power ? 2.0 * power : raw <= 5.0 * power ? 5.0 * power : 10.0 * power;
+  for (double t = std::ceil(a / step) * step; t <= b; t += step) at.push_back(t);
+  return at;
+}
+
 void plot(const validate::Validation& v, const std::string& file) {
   namespace fs = std::filesystem;
   const std::string gnuplot = check_plot_target(file);
@@ -158,20 +175,7 @@ void plot(const validate::Validation& v, const std::string& file) {
   // Both axes over the data's own span (gnuplot's log autoscale widens to whole decades: 1-1000 for 9-200 mpg).
   if (lo > 0.0 && hi >= lo) {  // one row (or all on the line) still has a span about it
     gp << "set xrange [" << lo / 1.1 << ":" << hi * 1.1 << "]\nset yrange [" << lo / 1.1 << ":" << hi * 1.1 << "]\n";
-    // Labelled ticks inside the span: a list within one decade (19-55 mpg) had none on either axis, gnuplot's log
-    // ticks being the powers of ten (session 27's outside tester). Over a factor 3 or more, 1, 2, 3 and 5 of each
-    // decade; below it, evenly spaced at 1, 2 or 5 of a power of ten, some five of them.
-    const double a = lo / 1.1, b = hi * 1.1;
-    std::vector<double> at;
-    if (b / a >= 3.0) {
-      for (double decade = std::pow(10.0, std::floor(std::log10(a))); decade <= b; decade *= 10.0)
-        for (double m : {1.0, 2.0, 3.0, 5.0})
-          if (m * decade >= a && m * decade <= b) at.push_back(m * decade);
-    } else {
-      const double raw = (b - a) / 5.0, power = std::pow(10.0, std::floor(std::log10(raw)));
-      const double step = raw <= power ? power : raw <= 2.0 * power ? 2.0 * power : raw <= 5.0 * power ? 5.0 * power : 10.0 * power;
-      for (double t = std::ceil(a / step) * step; t <= b; t += step) at.push_back(t);
-    }
+    const std::vector<double> at = tick_values(lo / 1.1, hi * 1.1);
     std::ostringstream ticks;
     for (std::size_t k = 0; k < at.size(); ++k) ticks << (k ? ", " : "") << at[k];
     if (!at.empty()) gp << "set xtics (" << ticks.str() << ")\nset ytics (" << ticks.str() << ")\n";

@@ -189,6 +189,15 @@ void parse_column_option(const std::string& text, ColumnMapping& mapping, const 
   mapping.source_for_canonical[canonical] = source;
 }
 
+namespace {
+// A power's sign is a logger's convention, a speed's is not: a negative speed scale was blamed on the recording's
+// line 23 (session 27's outside tester).
+void check_scale_sign(const std::string& canonical, double factor, const std::string& where) {
+  if (factor < 0.0 && canonical.rfind("speed_", 0) == 0)
+    throw InputError(where, format_value(factor) + " is not allowed: a speed's scale must be positive");
+}
+}  // namespace
+
 void parse_scale_option(const std::string& text, ColumnMapping& mapping, const std::string& option) {
   const auto [canonical, value] = split_option(option, text, "FACTOR, e.g. speed_kmh=1.609344");
   const std::string where = option + " '" + text + "'";
@@ -198,10 +207,7 @@ void parse_scale_option(const std::string& text, ColumnMapping& mapping, const s
   const auto f = parse_number(value);
   if (!f) throw InputError(where, "'" + value + "' is not a number");
   if (!std::isfinite(*f) || *f == 0.0) throw InputError(where, format_value(*f) + " is not allowed: must be finite and non-zero");
-  // A power's sign is a logger's convention, a speed's is not: a negative speed scale was blamed on the recording's
-  // line 23 (session 27's outside tester).
-  if (*f < 0.0 && canonical.rfind("speed_", 0) == 0)
-    throw InputError(where, format_value(*f) + " is not allowed: a speed's scale must be positive");
+  check_scale_sign(canonical, *f, where);
   if (mapping.scale_for_canonical.count(canonical)) throw InputError(where, "'" + canonical + "' is already scaled; give it once");
   mapping.scale_for_canonical[canonical] = *f;
 }
@@ -227,8 +233,7 @@ ColumnMapping column_mapping_from_yaml(YamlMap& file) {
       }
       const double f = scales->number(key, Range{});
       if (f == 0.0) throw InputError(scales->where(key), "0 is not allowed: must be non-zero");
-      if (f < 0.0 && key.rfind("speed_", 0) == 0)
-        throw InputError(scales->where(key), format_value(f) + " is not allowed: a speed's scale must be positive");
+      check_scale_sign(key, f, scales->where(key));
       m.scale_for_canonical[key] = f;
     }
     scales->finish();
