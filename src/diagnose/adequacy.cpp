@@ -120,6 +120,7 @@ Adequacy test_adequacy(const Observations& o, const std::vector<Recording>& recs
     best.flagged = 0;
     best.blocks = static_cast<int>(blocks.size());
     best.flagged_j = 0.0, best.flagged_abs_j = 0.0;
+    best.flagged_abs_by_recording_j.assign(recs.size(), 0.0);
     best.first_s = 1e300, best.last_s = 0.0, best.first_m = 1e300, best.last_m = 0.0;
     double moving_s = 0.0, moving_m = 0.0;
     for (const auto& b : blocks) {
@@ -127,6 +128,7 @@ Adequacy test_adequacy(const Observations& o, const std::vector<Recording>& recs
       ++best.flagged;
       best.flagged_j += b.residual_j;
       best.flagged_abs_j += std::abs(b.residual_j);
+      best.flagged_abs_by_recording_j[b.rec] += std::abs(b.residual_j);
       best.first_s = std::min(best.first_s, b.start_s);
       best.last_s = std::max(best.last_s, b.end_s);
       best.first_m = std::min(best.first_m, b.distance_start_m);
@@ -140,7 +142,8 @@ Adequacy test_adequacy(const Observations& o, const std::vector<Recording>& recs
 }
 
 // The residual left above the noise floor, in words: how far above, where, and how much energy.
-Finding adequacy_finding(const Adequacy& a, const NoiseFloor& nf, const Observations& o, const std::vector<RegimeResidual>& located,
+Finding adequacy_finding(const Adequacy& a, const NoiseFloor& nf, const Observations& o, const std::vector<Recording>& recs,
+                         const std::vector<RegimeResidual>& located,
                          bool grade_from_elevation) {
   Finding f;
   f.effect = "unexplained";
@@ -166,6 +169,15 @@ Finding adequacy_finding(const Adequacy& a, const NoiseFloor& nf, const Observat
     f.description += ", a swing about the model of " + fixed(a.flagged_abs_j / 1e3, 0) +
                      " kJ up and down that nets out: no energy is missing overall, but a shape the model lacks (a "
                      "consumer switching on and off, a sensor drifting, or effects that cancel)";
+  // Across recordings, the one that holds most of it: one trip with a load of its own read as the whole set's
+  // "unexplained ... most in regime 'braking'", naming no trip (session 27's outside tester).
+  if (recs.size() > 1 && a.flagged_abs_j > 0.0) {
+    const auto most = std::max_element(a.flagged_abs_by_recording_j.begin(), a.flagged_abs_by_recording_j.end());
+    const double share = *most / a.flagged_abs_j;
+    if (share >= 0.5)
+      f.description += "; " + fixed(100.0 * share, 0) + " % of it in " + recs[static_cast<std::size_t>(most - a.flagged_abs_by_recording_j.begin())].source +
+                       " (diagnose that recording alone, and the others without it)";
+  }
   // The regime whose mean residual is furthest from zero, in units of its interval.
   const RegimeResidual* worst = nullptr;
   double worst_z = 2.0;

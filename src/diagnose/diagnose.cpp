@@ -436,7 +436,7 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
   // Never nothing_missing above the noise floor, nor behind a calibration held at its prior's bound.
   if (after.inadequate || (cal.outside_prior && out.findings.empty())) {
     const bool from_elevation = std::any_of(recordings.begin(), recordings.end(), grade_from_recorded_elevation);
-    Finding f = adequacy_finding(after, floor, obs, out.located, from_elevation);
+    Finding f = adequacy_finding(after, floor, obs, recordings, out.located, from_elevation);
     if (cal.at_bound) f.description += (after.inadequate ? "; " : "") + calibration_outside_prior_text(cal, obs, sig.candidates);
     out.findings.push_back(std::move(f));
   } else if (cal.at_bound) {

@@ -382,6 +382,7 @@ struct Adequacy {
   int blocks = 0, flagged = 0;
   double flagged_j = 0.0, first_s = 0.0, last_s = 0.0, first_m = 0.0, last_m = 0.0, flagged_mean_speed_mps = 0.0;
   double flagged_abs_j = 0.0;  ///< the flagged blocks' residuals summed by size, whatever their sign
+  std::vector<double> flagged_abs_by_recording_j;  ///< the same per recording
 };
 Adequacy test_adequacy(const Observations& o, const std::vector<Recording>& recs, const Eigen::VectorXd& resid,
                        const NoiseFloor& nf, const DiagnoseOptions& opt);
@@ -390,7 +391,7 @@ std::vector<RegimeResidual> locate_regimes(const Observations& o, const std::vec
                                            const std::vector<DriveCycle>& cycles, const Signatures& s,
                                            const Eigen::VectorXd& cal_coef, double lag_samples,
                                            SelectionContext::Standing* standing);
-Finding adequacy_finding(const Adequacy& a, const NoiseFloor& nf, const Observations& o,
+Finding adequacy_finding(const Adequacy& a, const NoiseFloor& nf, const Observations& o, const std::vector<Recording>& recs,
                          const std::vector<RegimeResidual>& located, bool grade_from_elevation);
 
 }  // namespace rollsim::diag
