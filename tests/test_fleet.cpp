@@ -3,6 +3,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 #include "rollsim/common/error.hpp"
@@ -187,4 +188,22 @@ TEST(Fleet, JsonKeepsEveryFindingOfADiagnosis) {
   EXPECT_NE(line.find("}, {\"effect\": \"unexplained\", \"parameter\": \"residual_to_noise_variance_ratio\", \"value\": 2.5", list),
             std::string::npos) << line;
   EXPECT_EQ(line.find("\"unexplained\": {"), std::string::npos) << line;
+}
+
+// A group whose recordings carry the ambient column only in part cannot test the ambient laws, and the fleet said
+// only nothing_missing (session 27's outside tester): the group's warning goes where warnings go, and into its JSON.
+TEST(Fleet, AGroupsWarningsAreSaidBesideItsVerdict) {
+  const std::string a = kRecordings + "rsk_renault_twizy/T1_06_30_2021_1.csv", b = kRecordings + "rsk_renault_twizy/T1_06_30_2021_2.csv";
+  const std::string m = write_manifest("partial_ambient.csv", "group,vehicle,recording,preset,columns\nt,twizy," + a +
+                                                                 ",rsk_twizy,\nt,twizy," + b + ",rsk_twizy,ambient_temp_c=\n");
+  const auto json = test::temp_dir() / "partial_ambient.json";
+  const test::CmdResult r = test::run_rollsim("diagnose --fleet '" + m + "' --json '" + json.string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string said = "ambient_rrc and hvac_ambient not tested: " + b + " has no ambient_temp_c column, where the other 1 "
+                           "recording does";
+  EXPECT_NE(r.err.find("warning: t: " + said), std::string::npos) << r.err;
+  std::ifstream in(json);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("\"warnings\": ["), std::string::npos) << text;
+  EXPECT_NE(text.find("\"" + said), std::string::npos) << text;
 }

@@ -122,6 +122,10 @@ void run_fleet(const DiagnoseCliOptions& o, const ProcessGroup& group) {
   }
   const FleetResult r = diagnose_fleet(manifest, fo);
   std::cout << fleet_text(r);
+  // Each group's warnings, where a single diagnosis' go: a recording without the ambient column left the across-trip
+  // laws untested, and the fleet said only nothing_missing (session 27's outside tester).
+  for (const auto& e : r.entries)
+    for (const auto& w : e.warnings) std::cerr << "warning: " << e.group << ": " << w << "\n";
   if (o.json.empty()) return;
   std::string lines;
   for (const auto& j : fleet_json(r)) lines += j.str() + "\n";

@@ -67,6 +67,13 @@ JsonObject& JsonObject::add_null(const std::string& key) {
   return *this;
 }
 
+JsonObject& JsonObject::add(const std::string& key, const std::vector<std::string>& values) {
+  std::string list = "[";
+  for (std::size_t i = 0; i < values.size(); ++i) list += (i ? ", " : "") + json_string(values[i]);
+  add_raw(key, list + "]");
+  return *this;
+}
+
 std::string JsonObject::str() const { return "{" + body_ + "}"; }
 
 JsonObject& JsonObject::add(const std::string& key, const JsonObject& value) {

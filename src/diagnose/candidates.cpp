@@ -204,6 +204,18 @@ AmbientSetting ambient_setting(const std::vector<Recording>& recordings, Channel
     return a;
   }
   if (!std::all_of(recordings.begin(), recordings.end(), [](const Recording& r) { return r.ambient_temp_k.has_value(); })) {
+    // Some with it and some without is likely a slip, and leaves the laws the others could show untested: said.
+    std::string without;
+    std::size_t with = 0;
+    for (const auto& r : recordings) {
+      if (r.ambient_temp_k) ++with;
+      else without += (without.empty() ? "" : ", ") + r.source;
+    }
+    if (with > 0)
+      notes.push_back("warning: ambient_rrc and hvac_ambient not tested: " + without + " ha" +
+                      (recordings.size() - with > 1 ? "ve" : "s") + " no ambient_temp_c column, where the other " +
+                      std::to_string(with) + " recording" + (with > 1 ? "s do" : " does") +
+                      " (give it, or leave those out, to test the ambient laws)");
     notes.push_back("ambient_rrc not tested: not every recording has an ambient_temp_c column");
     notes.push_back("hvac_ambient not tested: not every recording has an ambient_temp_c column");
     return a;

@@ -108,7 +108,9 @@ FleetEntry diagnose_group(const FleetGroup& g, const DiagnoseOptions& o) {
   DiagnoseOptions group_options = o;
   group_options.priors = calibration_priors_from_yaml(vehicle_file);  // each car's own calibration bounds
   const Diagnosis d = diagnose(v, recs, group_options);
-  FleetEntry e{g.name, v.name, d.verdict, d.channel, recs.size(), {}};
+  FleetEntry e{g.name, v.name, d.verdict, d.channel, recs.size(), {}, {}};
+  for (const auto& note : d.notes)
+    if (note.rfind("warning: ", 0) == 0) e.warnings.push_back(note.substr(9));
   for (const auto& f : d.findings) {
     FleetFinding ff{f.effect, "", "", 0.0, f.energy_share_pct};
     if (!f.parameters.empty()) {
@@ -134,6 +136,10 @@ void each_field(Entry& e, Field&& field) {
     field(f.value);
     field(f.energy_share_pct);
   }
+  std::size_t w = e.warnings.size();
+  field(w);
+  if constexpr (!std::is_const_v<Entry>) e.warnings.resize(w);
+  for (auto& s : e.warnings) field(s);
 }
 
 std::string to_bytes(const FleetEntry& e) {
@@ -246,6 +252,7 @@ std::vector<JsonObject> fleet_json(const FleetResult& r) {
       findings.push_back(fj);
     }
     j.add("findings", findings);
+    j.add("warnings", e.warnings);
     out.push_back(j);
   }
   for (const auto& f : r.effects) {

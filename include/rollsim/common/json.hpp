@@ -27,6 +27,8 @@ class JsonObject {
   /// An array of objects as the value of `key` (a key may appear only once in an object: RFC 8259 leaves a repeat
   /// to the parser, and most keep the last).
   JsonObject& add(const std::string& key, const std::vector<JsonObject>& values);
+  /// An array of strings as the value of `key`.
+  JsonObject& add(const std::string& key, const std::vector<std::string>& values);
   /// "{...}" without a trailing newline.
   std::string str() const;
 

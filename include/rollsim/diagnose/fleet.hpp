@@ -49,6 +49,7 @@ struct FleetEntry {
   std::string group, vehicle, verdict, channel;
   std::size_t recordings = 0;
   std::vector<FleetFinding> findings;
+  std::vector<std::string> warnings;  ///< the diagnosis' warnings (a verdict to be read with them)
 };
 
 /// One effect across the fleet: in how many diagnoses it was found, and its median size there.
