@@ -172,10 +172,11 @@ Finding adequacy_finding(const Adequacy& a, const NoiseFloor& nf, const Observat
   // Across recordings, the one that holds most of it: one trip with a load of its own read as the whole set's
   // "unexplained ... most in regime 'braking'", naming no trip (session 27's outside tester).
   if (recs.size() > 1 && a.flagged_abs_j > 0.0) {
-    const auto most = std::max_element(a.flagged_abs_by_recording_j.begin(), a.flagged_abs_by_recording_j.end());
-    const double share = *most / a.flagged_abs_j;
+    const auto& by = a.flagged_abs_by_recording_j;
+    const auto most = static_cast<std::size_t>(std::max_element(by.begin(), by.end()) - by.begin());
+    const double share = by[most] / a.flagged_abs_j;
     if (share >= 0.5)
-      f.description += "; " + fixed(100.0 * share, 0) + " % of it in " + recs[static_cast<std::size_t>(most - a.flagged_abs_by_recording_j.begin())].source +
+      f.description += "; " + fixed(100.0 * share, 0) + " % of it in " + recs[most].source +
                        " (diagnose that recording alone, and the others without it)";
   }
   // The regime whose mean residual is furthest from zero, in units of its interval.
