@@ -207,3 +207,17 @@ TEST(Fleet, AGroupsWarningsAreSaidBesideItsVerdict) {
   EXPECT_NE(text.find("\"warnings\": ["), std::string::npos) << text;
   EXPECT_NE(text.find("\"" + said), std::string::npos) << text;
 }
+
+// Small figures keep four significant digits (an ambient law's 0.0075 /K printed as 0.007: session 27's outside
+// tester); from 1 up, three decimals as before.
+TEST(Fleet, SmallFiguresKeepTheirDigits) {
+  FleetResult r;
+  r.manifest = "m.csv";
+  r.entries.push_back({"a", "car", "missing_physics", "battery_power", 4, {{"ambient_rrc", "rrc_change_per_k", "1/K", 0.0075, 0.0}}, {}});
+  r.entries.push_back({"b", "car", "missing_physics", "battery_power", 4, {{"unexplained", "ratio", "1", 6.4851, 0.0}}, {}});
+  r.effects = summarise_fleet(r.entries);
+  const std::string text = fleet_text(r);
+  EXPECT_NE(text.find("ambient_rrc (0.0075 1/K)"), std::string::npos) << text;
+  EXPECT_NE(text.find("unexplained (6.485 1)"), std::string::npos) << text;
+  EXPECT_NE(text.find("0.0075  1/K"), std::string::npos) << text;
+}

@@ -210,6 +210,12 @@ FleetResult diagnose_fleet(const FleetManifest& m, const FleetOptions& o) {
   return r;
 }
 
+namespace {
+// A figure of the fleet's table: three decimals from 1 up, four significant digits below (an ambient law's 0.0075 /K
+// read 0.007, one digit: session 27's outside tester).
+std::string figure(double v) { return std::abs(v) >= 1.0 ? fixed(v, 3) : significant(v, 4); }
+}  // namespace
+
 std::string fleet_text(const FleetResult& r) {
   std::size_t recordings = 0;
   for (const auto& e : r.entries) recordings += e.recordings;
@@ -221,7 +227,7 @@ std::string fleet_text(const FleetResult& r) {
     std::string found;
     for (const auto& f : e.findings) {
       found += (found.empty() ? "" : ", ") + f.effect;
-      if (!f.parameter.empty()) found += " (" + fixed(f.value, 3) + " " + f.unit + ")";
+      if (!f.parameter.empty()) found += " (" + figure(f.value) + " " + f.unit + ")";
     }
     t.add_row({e.group, e.vehicle, std::to_string(e.recordings), e.channel, e.verdict, found.empty() ? "-" : found});
   }
@@ -230,7 +236,7 @@ std::string fleet_text(const FleetResult& r) {
   for (std::size_t c : {0u, 3u, 5u}) s.set_left_aligned(c);
   for (const auto& f : r.effects) {
     s.add_row({f.effect, std::to_string(f.groups), fixed(f.share_pct, 1), f.parameter.empty() ? "-" : f.parameter,
-               f.parameter.empty() ? "-" : fixed(f.median_value, 3), f.unit.empty() ? "-" : f.unit});
+               f.parameter.empty() ? "-" : figure(f.median_value), f.unit.empty() ? "-" : f.unit});
   }
   out << (r.effects.empty() ? "  none: nothing missing in any diagnosis\n" : s.render());
   return out.str();
