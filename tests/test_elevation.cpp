@@ -289,5 +289,12 @@ TEST(Elevation, AWanderingAltitudeLoggedAtTenHertzIsReadOverTheSameSeconds) {
   EXPECT_LT(*std::max_element(sd.begin(), sd.end()), 4.5);
 }
 
+// The typical sample interval the drift's lags and the speed lattice are read in: a gap does not move it.
+TEST(Statistics, MedianStepIsTheTypicalSampleInterval) {
+  EXPECT_DOUBLE_EQ(median_step({0.0, 1.0, 2.0, 30.0, 31.0, 32.0}), 1.0);
+  EXPECT_DOUBLE_EQ(median_step({0.0, 0.1, 0.2, 0.3}), 0.1);
+  EXPECT_TRUE(std::isnan(median_step({5.0})));
+}
+
 }  // namespace
 }  // namespace rollsim

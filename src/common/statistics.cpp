@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <numbers>
 #include <stdexcept>
+#include <utility>
 
 namespace rollsim {
 
@@ -15,6 +16,12 @@ double median(std::vector<double> values) {
   const double upper = values[n];
   if (values.size() % 2) return upper;
   return 0.5 * (upper + *std::max_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(n)));
+}
+
+double median_step(const std::vector<double>& values) {
+  std::vector<double> steps;
+  for (std::size_t i = 1; i < values.size(); ++i) steps.push_back(values[i] - values[i - 1]);
+  return median(std::move(steps));
 }
 
 namespace {

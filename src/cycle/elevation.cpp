@@ -229,9 +229,7 @@ void estimate_standing_wander(const std::vector<double>& time_s, const std::vect
   // seconds a 1 Hz one does; it had seen 6 s, and read a 3 m drift as 12 m over 300 s): sums of squared differences,
   // of times apart, and pairs.
   constexpr std::size_t kLags = 60;
-  std::vector<double> steps;
-  for (std::size_t k = 1; k < n; ++k) steps.push_back(time_s[k] - time_s[k - 1]);
-  const double sample_s = steps.empty() ? 1.0 : median(std::move(steps));
+  const double sample_s = median_step(time_s);
   const std::size_t stride = sample_s > 0.0 ? std::max<std::size_t>(1, std::lround(1.0 / sample_s)) : 1;
   std::vector<double> d2(kLags + 1, 0.0), dt(kLags + 1, 0.0), pairs(kLags + 1, 0.0);
   std::size_t i = 0;

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <utility>
 
 #include "rollsim/common/statistics.hpp"
 
@@ -29,12 +28,6 @@ double lattice_quantum(const std::vector<double>& v) {
   return moving > 0 && static_cast<double>(on) >= 0.95 * static_cast<double>(moving) ? q : 0.0;
 }
 
-double median_interval_s(const std::vector<double>& t) {
-  std::vector<double> d;
-  for (std::size_t i = 1; i < t.size(); ++i) d.push_back(t[i] - t[i - 1]);
-  return d.empty() ? 0.0 : median(std::move(d));
-}
-
 }  // namespace
 
 SpeedResolution read_speed_resolution(const std::vector<double>& time_s, const std::vector<double>& speed_mps,
@@ -44,7 +37,7 @@ SpeedResolution read_speed_resolution(const std::vector<double>& time_s, const s
   const std::size_t n = std::min(time_s.size(), speed_mps.size());
   if (n < 3) return out;
   out.quantum_mps = lattice_quantum(speed_mps);
-  const double dt = median_interval_s(time_s);
+  const double dt = median_step(time_s);
   if (!(out.quantum_mps > 0.0) || !(dt > 0.0)) return out;
   out.step_accel_mps2 = out.quantum_mps / dt;
   if (out.step_accel_mps2 < threshold_mps2) return out;
