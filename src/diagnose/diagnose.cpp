@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "pipeline.hpp"
 #include "rollsim/common/error.hpp"
@@ -53,6 +54,39 @@ double moving_rms(const Recording& r, const std::vector<std::vector<double>>& dr
 // The recording's grade is derived from its elevation (not given, and not withheld).
 bool grade_from_recorded_elevation(const Recording& r) { return !r.grade && r.elevation_m.has_value(); }
 
+// The replay's cycle of a recording, from its speed as replayed (`speed_mps`: a staircase undone) and, where its
+// grade comes from its elevation, that grade (`elevation_grade`), each read once by the caller.
+DriveCycle cycle_from(const Recording& r, double engine_off_min_s, EngineStart start, std::vector<double> speed_mps,
+                      const std::vector<double>* elevation_grade) {
+  DriveCycle c;
+  if (r.latitude_deg && r.longitude_deg) c.heading_rad = heading_from_gps(*r.latitude_deg, *r.longitude_deg);
+  c.engine_hot_start = start == EngineStart::hot;
+  if (r.fuel_rate_m3ps && engine_off_min_s > 0.0) {
+    std::vector<bool> off = engine_off_samples(r, engine_off_min_s);
+    // A segment is off when it starts in a run and the run goes on past it (the run's last sample restarts).
+    for (std::size_t i = 0; i + 1 < off.size(); ++i) off[i] = off[i] && off[i + 1];
+    if (!off.empty()) off.back() = false;
+    c.set_engine_off(std::move(off));
+  }
+  c.name = r.source;
+  c.source = r.source;
+  // Time from the start of the recording: effects that decay from the start of a trip read it.
+  c.time_s = r.time_s;
+  for (double& t : c.time_s) t -= r.time_s.front();
+  c.speed_mps = std::move(speed_mps);
+  if (r.grade) {
+    // A recorded grade is read at each instant, and the replay holds a sample's grade over its segment to the next:
+    // the segment's mean is the two ends' (the instant's lagged the road by half a sample: session 26's outside testing).
+    c.grade = *r.grade;
+    for (std::size_t i = 0; i + 1 < c.grade.size(); ++i) c.grade[i] = 0.5 * ((*r.grade)[i] + (*r.grade)[i + 1]);
+  } else if (elevation_grade) c.grade = *elevation_grade;
+  else c.grade.assign(r.time_s.size(), 0.0);
+  // Quantised to 0.05 % (under 0.3 N per 100 kg of grade force error): the simulator prepares the tyre model once
+  // per distinct grade, which otherwise is once per sample and 90 % of a hilly recording's diagnosis.
+  for (double& g : c.grade) g = 0.0005 * std::round(g / 0.0005);
+  return c;
+}
+
 // The replay's cycle of each recording, what its speed and elevation channels are said to be, and the Monte Carlo
 // draws of its elevation-derived grade's errors (`grade_draws`, one entry per recording) for the noise floor.
 std::vector<DriveCycle> cycles_of(const std::vector<Recording>& recordings, const DiagnoseOptions& opt,
@@ -62,23 +96,28 @@ std::vector<DriveCycle> cycles_of(const std::vector<Recording>& recordings, cons
   for (std::size_t k = 0; k < recordings.size(); ++k) {
     const Recording& r = recordings[k];
     const EngineStart start = k < opt.engine_start.size() ? opt.engine_start[k] : EngineStart::infer;
-    cycles.push_back(cycle_of_recording(r, opt.engine_off_min_s, start));
-    if (const SpeedResolution res = read_speed_resolution(r.time_s, r.speed_mps); res.smoothed)
+    // The speed and the elevation are read once, for the cycle and for what is said of them (each had been read
+    // twice: in cycle_of_recording and again here).
+    const SpeedResolution res = read_speed_resolution(r.time_s, r.speed_mps);
+    std::optional<ElevationGrade> read;
+    if (grade_from_recorded_elevation(r)) read = grade_from_elevation(r.time_s, r.speed_mps, *r.elevation_m);
+    cycles.push_back(cycle_from(r, opt.engine_off_min_s, start, res.speed_mps, read ? &read->grade : nullptr));
+    if (res.smoothed)
       notes.push_back(r.source + ": speed on a " + fixed(units::mps_to_kmh(res.quantum_mps), 3) + " km/h lattice, one step per "
                       "sample a " + fixed(res.step_accel_mps2, 2) + " m/s^2 acceleration the car did not make: the replay "
                       "follows a quadratic fitted over " + std::to_string(2 * res.half_window + 1) +
                       " samples about each (standstills kept)");
-    if (grade_from_recorded_elevation(r)) {
-      const ElevationGrade read = grade_from_elevation(r.time_s, r.speed_mps, *r.elevation_m);
-      grade_draws[k] = grade_noise_draws(r.time_s, r.speed_mps, *r.elevation_m, read.noise_sd_m, diag::kGradeNoiseDraws,
-                                         0x9e3779b9u + static_cast<unsigned>(k), read.drift_sd_m, read.drift_time_s);
+    if (read) {
+      grade_draws[k] = grade_noise_draws(r.time_s, r.speed_mps, *r.elevation_m, read->noise_sd_m,
+                                         diag::kGradeNoiseDraws, 0x9e3779b9u + static_cast<unsigned>(k), read->drift_sd_m,
+                                         read->drift_time_s);
       const double grade_rms = moving_rms(r, grade_draws[k]);
-      notes.push_back(r.source + ": grade from recorded elevation (" + std::to_string(read.rejected_steps) +
+      notes.push_back(r.source + ": grade from recorded elevation (" + std::to_string(read->rejected_steps) +
                       " elevation steps rejected as glitches, Savitzky-Golay slope over 300 m; white noise of " +
-                      fixed(read.noise_sd_m, 2) + " m per reading about the road" +
-                      (read.drift_sd_m > 0.0
-                           ? " and a drift of " + fixed(read.drift_sd_m, 2) + " m correlated over " +
-                                 fixed(read.drift_time_s, 0) + " s (from its standstills)"
+                      fixed(read->noise_sd_m, 2) + " m per reading about the road" +
+                      (read->drift_sd_m > 0.0
+                           ? " and a drift of " + fixed(read->drift_sd_m, 2) + " m correlated over " +
+                                 fixed(read->drift_time_s, 0) + " s (from its standstills)"
                            : std::string()) +
                       ", " + fixed(100.0 * grade_rms, 2) +
                       " % of grade rms after the filter, carried into the noise floor; the uphill and downhill regimes "
@@ -88,10 +127,11 @@ std::vector<DriveCycle> cycles_of(const std::vector<Recording>& recordings, cons
       // session 26's outside tester's UDDS and WLTC nulls the wander was 0.95-1.17 x the white noise for white noise,
       // 1 m steps and glitches, and 1.89-3.0 x for AR(1) and random-walk drifts of 2-5 m; with 200 readings standing,
       // 1.5 is some ten of white noise's sds. A route without standstills (HWFET) cannot show it.
-      if (read.standing_s >= ElevationGrade::kMinStandingForDrift_s && read.standing_wander_m > 1.5 * read.noise_sd_m + 0.2)
-        notes.push_back("warning: " + r.source + ": the recorded elevation wanders " + fixed(read.standing_wander_m, 1) +
-                        " m rms while the car stands (" + fixed(read.standing_s, 0) + " s of standstills of 20 s or more), "
-                        "against " + fixed(read.noise_sd_m, 2) + " m of white noise: an altitude drifting over tens of "
+      if (read->standing_s >= ElevationGrade::kMinStandingForDrift_s &&
+          read->standing_wander_m > 1.5 * read->noise_sd_m + 0.2)
+        notes.push_back("warning: " + r.source + ": the recorded elevation wanders " + fixed(read->standing_wander_m, 1) +
+                        " m rms while the car stands (" + fixed(read->standing_s, 0) + " s of standstills of 20 s or more), "
+                        "against " + fixed(read->noise_sd_m, 2) + " m of white noise: an altitude drifting over tens of "
                         "seconds, which the grade's filter takes for road. It is carried into the noise floor as the "
                         "standstills show it; where the GPS drifts otherwise while driving it is not, so read "
                         "grade, mass and unexplained findings, and the uphill and downhill residuals, with that in mind");
@@ -333,34 +373,11 @@ std::vector<double> heading_from_gps(const std::vector<double>& latitude_deg, co
 }
 
 DriveCycle cycle_of_recording(const Recording& r, double engine_off_min_s, EngineStart start) {
-  DriveCycle c;
-  if (r.latitude_deg && r.longitude_deg) c.heading_rad = heading_from_gps(*r.latitude_deg, *r.longitude_deg);
-  c.engine_hot_start = start == EngineStart::hot;
-  if (r.fuel_rate_m3ps && engine_off_min_s > 0.0) {
-    std::vector<bool> off = engine_off_samples(r, engine_off_min_s);
-    // A segment is off when it starts in a run and the run goes on past it (the run's last sample restarts).
-    for (std::size_t i = 0; i + 1 < off.size(); ++i) off[i] = off[i] && off[i + 1];
-    if (!off.empty()) off.back() = false;
-    c.set_engine_off(std::move(off));
-  }
-  c.name = r.source;
-  c.source = r.source;
-  // Time from the start of the recording: effects that decay from the start of a trip read it.
-  c.time_s = r.time_s;
-  for (double& t : c.time_s) t -= r.time_s.front();
   // A staircase speed (a coarse channel sampled fast) replayed as it is fakes accelerations of a step per sample.
-  c.speed_mps = read_speed_resolution(r.time_s, r.speed_mps).speed_mps;
-  if (r.grade) {
-    // A recorded grade is read at each instant, and the replay holds a sample's grade over its segment to the next:
-    // the segment's mean is the two ends' (the instant's lagged the road by half a sample: session 26's outside testing).
-    c.grade = *r.grade;
-    for (std::size_t i = 0; i + 1 < c.grade.size(); ++i) c.grade[i] = 0.5 * ((*r.grade)[i] + (*r.grade)[i + 1]);
-  } else if (r.elevation_m) c.grade = grade_from_elevation(r.time_s, r.speed_mps, *r.elevation_m).grade;
-  else c.grade.assign(r.time_s.size(), 0.0);
-  // Quantised to 0.05 % (under 0.3 N per 100 kg of grade force error): the simulator prepares the tyre model once
-  // per distinct grade, which otherwise is once per sample and 90 % of a hilly recording's diagnosis.
-  for (double& g : c.grade) g = 0.0005 * std::round(g / 0.0005);
-  return c;
+  std::vector<double> speed = read_speed_resolution(r.time_s, r.speed_mps).speed_mps;
+  if (r.grade || !r.elevation_m) return cycle_from(r, engine_off_min_s, start, std::move(speed), nullptr);
+  const ElevationGrade read = grade_from_elevation(r.time_s, r.speed_mps, *r.elevation_m);
+  return cycle_from(r, engine_off_min_s, start, std::move(speed), &read.grade);
 }
 
 Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordings, const DiagnoseOptions& opt) {
@@ -424,7 +441,7 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
       // The detection limits are the profile's residual's: they had been read from the hills' own residual (aux_load
       // 6.5-10 kW, wind 167-262 m/s behind 25 m hills; session 27's outside tester). The catalogue is not searched
       // again behind the profile: the linearised profile leaves shapes that a second search named (rr_speed 0.17
-      // beside a 400 W load, test WhatWithheldHillsHideIsLookedForBehindTheirProfile); what it leaves is described by
+      // beside a 400 W load, test DetectionLimitsBehindWithheldHillsAreTheirProfilesResiduals); what it leaves goes to
       // the unexplained basis below.
       chosen.push_back(EffectId::road_profile);  // the profile's column, so that each later column keeps its effect
       out.detection_limits = detection_limits(sig.candidates, chosen, m, opt);
