@@ -221,6 +221,41 @@ namespace {
 // Standstills this long show a wandering GPS altitude (a light's red phase; shorter ones hold too few readings).
 constexpr double kWanderStandstill_s = 20.0;
 
+// The drift from the standstills' per-lag sums (squared differences `d2`, times apart `dt`, `pairs`), beyond the white
+// noise already in `out`.
+void fit_drift(const std::vector<double>& d2, const std::vector<double>& dt, const std::vector<double>& pairs,
+               ElevationGrade& out) {
+  const std::size_t lags = pairs.size() - 1;
+  // D(t) = 2 white^2 + 2 sd^2 (1 - exp(-t / time)): sd^2 by weighted least squares at each time of a grid, the time of
+  // least squared misfit kept (weights: the pairs, most at short lags).
+  // Times beyond twice the longest lag seen are not tried: short stops show how fast the differences grow, not where
+  // they level off, and the least misfit among times they cannot tell apart was a matter of chance (a 3 m, 30 s drift
+  // seen in 20 s stops at 10 Hz read 1.7 m over 8 s with one noise draw and 15 m over 300 s with another).
+  double longest_lag_s = 0.0;
+  for (std::size_t lag = 1; lag <= lags; ++lag)
+    if (pairs[lag] > 0.0) longest_lag_s = std::max(longest_lag_s, dt[lag] / pairs[lag]);
+  const double white2 = 2.0 * out.noise_sd_m * out.noise_sd_m;
+  double best = 1e300;
+  for (double time : {2.0, 3.0, 5.0, 8.0, 12.0, 20.0, 30.0, 50.0, 80.0, 120.0, 200.0, 300.0}) {
+    if (time > 2.0 * longest_lag_s && time > 2.0) break;
+    double sxy = 0.0, sxx = 0.0;
+    for (std::size_t lag = 1; lag <= lags; ++lag) {
+      if (pairs[lag] == 0.0) continue;
+      const double x = 2.0 * (1.0 - std::exp(-dt[lag] / pairs[lag] / time));
+      sxy += pairs[lag] * x * (d2[lag] / pairs[lag] - white2);
+      sxx += pairs[lag] * x * x;
+    }
+    const double var = sxx > 0.0 ? std::max(0.0, sxy / sxx) : 0.0;
+    double sse = 0.0;
+    for (std::size_t lag = 1; lag <= lags; ++lag) {
+      if (pairs[lag] == 0.0) continue;
+      const double e = d2[lag] / pairs[lag] - white2 - var * 2.0 * (1.0 - std::exp(-dt[lag] / pairs[lag] / time));
+      sse += pairs[lag] * e * e;
+    }
+    if (sse < best) best = sse, out.drift_sd_m = std::sqrt(var), out.drift_time_s = time;
+  }
+}
+
 void estimate_standing_wander(const std::vector<double>& time_s, const std::vector<double>& speed_mps,
                               const std::vector<double>& elevation_m, ElevationGrade& out) {
   const std::size_t n = time_s.size();
@@ -255,35 +290,7 @@ void estimate_standing_wander(const std::vector<double>& time_s, const std::vect
     i = j + 1;
   }
   out.standing_wander_m = count > 0.0 ? std::sqrt(ss / count) : 0.0;
-  if (out.standing_s < ElevationGrade::kMinStandingForDrift_s) return;
-  // D(t) = 2 white^2 + 2 sd^2 (1 - exp(-t / time)): sd^2 by weighted least squares at each time of a grid, the time of
-  // least squared misfit kept (weights: the pairs, most at short lags).
-  // Times beyond twice the longest lag seen are not tried: short stops show how fast the differences grow, not where
-  // they level off, and the least misfit among times they cannot tell apart was a matter of chance (a 3 m, 30 s drift
-  // seen in 20 s stops at 10 Hz read 1.7 m over 8 s with one noise draw and 15 m over 300 s with another).
-  double longest_lag_s = 0.0;
-  for (std::size_t lag = 1; lag <= kLags; ++lag)
-    if (pairs[lag] > 0.0) longest_lag_s = std::max(longest_lag_s, dt[lag] / pairs[lag]);
-  const double white2 = 2.0 * out.noise_sd_m * out.noise_sd_m;
-  double best = 1e300;
-  for (double time : {2.0, 3.0, 5.0, 8.0, 12.0, 20.0, 30.0, 50.0, 80.0, 120.0, 200.0, 300.0}) {
-    if (time > 2.0 * longest_lag_s && time > 2.0) break;
-    double sxy = 0.0, sxx = 0.0;
-    for (std::size_t lag = 1; lag <= kLags; ++lag) {
-      if (pairs[lag] == 0.0) continue;
-      const double x = 2.0 * (1.0 - std::exp(-dt[lag] / pairs[lag] / time));
-      sxy += pairs[lag] * x * (d2[lag] / pairs[lag] - white2);
-      sxx += pairs[lag] * x * x;
-    }
-    const double var = sxx > 0.0 ? std::max(0.0, sxy / sxx) : 0.0;
-    double sse = 0.0;
-    for (std::size_t lag = 1; lag <= kLags; ++lag) {
-      if (pairs[lag] == 0.0) continue;
-      const double e = d2[lag] / pairs[lag] - white2 - var * 2.0 * (1.0 - std::exp(-dt[lag] / pairs[lag] / time));
-      sse += pairs[lag] * e * e;
-    }
-    if (sse < best) best = sse, out.drift_sd_m = std::sqrt(var), out.drift_time_s = time;
-  }
+  if (out.standing_s >= ElevationGrade::kMinStandingForDrift_s) fit_drift(d2, dt, pairs, out);
 }
 }  // namespace
 
