@@ -387,6 +387,12 @@ TEST_F(DriveCycleFiles, BadInputNamesFileLineColumnAndValue) {
   EXPECT_TRUE(has(m, "line 4, column 'time_s'"));
   EXPECT_TRUE(has(m, "line 3"));
   EXPECT_TRUE(has(m, "strictly increasing"));
+  // Epoch-like times a fine step apart are one double: the message says precision is why, not "1e+16 is not after
+  // 1e+16" alone; times that are the same number written twice get no such sentence.
+  m = error_of("time_s,speed_kmh\n1e16,0\n1.0000000000000001e16,5\n");
+  EXPECT_TRUE(has(m, "one number in double precision"));
+  EXPECT_TRUE(has(m, "'1.0000000000000001e16'"));
+  EXPECT_FALSE(has(error_of("time_s,speed_kmh\n0,0\n1,5\n1.0,6\n"), "double precision"));
   m = error_of("time_s,speed_kmh\n0,0\n2,5\n1,6\n");  // time goes backwards
   EXPECT_TRUE(has(m, "line 4"));
   EXPECT_TRUE(has(m, "1 s is not after 2 s"));

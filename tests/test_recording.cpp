@@ -318,6 +318,13 @@ TEST_F(RecordingFiles, BadInputNamesFileRowAndColumn) {
   m = error_of(trip(70, [](int t) -> std::string { return t == 7 ? "6,36,89" : ""; }));
   EXPECT_TRUE(has(m, "line 9, column 'time_s'"));
   EXPECT_TRUE(has(m, "the same as 6 on line 8"));
+  m = error_of(trip(70, [](int t) -> std::string { return t == 7 ? "6.0,36,89" : ""; }));
+  EXPECT_FALSE(has(m, "double precision"));  // one number written two ways
+  // Epoch seconds at a fine step read as one double: precision is named as why.
+  m = error_of(trip(70, [](int t) -> std::string {
+    return t == 6 ? "1e16,36,89" : t == 7 ? "1.0000000000000001e16,36,89" : "";
+  }));
+  EXPECT_TRUE(has(m, "one number in double precision"));
   m = error_of(trip(70, [](int t) -> std::string { return t == 7 ? "5,36,89" : ""; }));
   EXPECT_TRUE(has(m, "before 6 on line 8"));
   m = error_of(trip(70, [](int t) -> std::string { return t == 7 ? ",36,89" : ""; }));

@@ -4,6 +4,7 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -254,6 +255,22 @@ CsvTable read_csv(const std::string& path, char delimiter, std::size_t max_rows,
   }
   if (!have_header) throw InputError(path, "file is empty: expected a header line naming the columns");
   return table;
+}
+
+std::string same_in_double_precision(const std::string& cell, const std::string& previous_cell, double value,
+                                     double previous_value) {
+  if (value != previous_value) return "";
+  const auto wide = [](const std::string& text) -> std::optional<long double> {
+    const std::string t = trim(text);
+    char* end = nullptr;
+    const long double v = std::strtold(t.c_str(), &end);
+    if (t.empty() || end != t.c_str() + t.size()) return std::nullopt;
+    return v;
+  };
+  const auto a = wide(cell), b = wide(previous_cell);
+  if (!a || !b || *a == *b) return "";  // the same number written two ways, or not a plain number (a clock time)
+  return " (written as '" + trim(previous_cell) + "' and '" + trim(cell) +
+         "', they are one number in double precision, about 16 significant digits: give times from the start)";
 }
 
 }  // namespace rollsim

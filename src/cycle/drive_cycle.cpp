@@ -326,7 +326,8 @@ DriveCycle cycle_from_table(const CsvTable& table, const std::string& name) {
     if (r > 0 && !(c.time_s[r] > c.time_s[r - 1])) {
       throw InputError(table.where(r, *col_t),
                        format_value(c.time_s[r]) + " s is not after " + format_value(c.time_s[r - 1]) + " s on line " +
-                           std::to_string(table.row_line[r - 1]) + ": time must be strictly increasing");
+                           std::to_string(table.row_line[r - 1]) + ": time must be strictly increasing" +
+                           same_in_double_precision(table.rows[r][*col_t], table.rows[r - 1][*col_t], c.time_s[r], c.time_s[r - 1]));
     }
     const double dt = r > 0 ? c.time_s[r] - c.time_s[r - 1] : 0.0;
     // A relative tolerance, so that times written 1 ms apart (0.008, 0.009: 0.00099999999999999 in binary) pass.

@@ -382,7 +382,8 @@ Recording load_recording(const std::string& path, const ColumnMapping& mapping) 
       throw InputError(table.where(r, col_t),
                        "time " + cell + " is " + (t == rec.time_s[r - 1] ? "the same as" : "before") + " " +
                            table.rows[r - 1][col_t] + " on line " + std::to_string(table.row_line[r - 1]) +
-                           ": time must increase from row to row");
+                           ": time must increase from row to row" +
+                           same_in_double_precision(cell, table.rows[r - 1][col_t], t, rec.time_s[r - 1]));
     }
     rec.time_s[r] = t;
   }

@@ -44,6 +44,11 @@ std::optional<double> parse_number(const std::string& text);
 /// "'x' is not a number", saying so when the cell is a number written with a decimal comma ('1,5').
 std::string not_a_number(const std::string& cell);
 
+/// "" unless two cells written differently read as the same number `value` (a time of 1e16 s and the next sample's):
+/// then a sentence saying that double precision is why, for an error that says the second is not after the first.
+std::string same_in_double_precision(const std::string& cell, const std::string& previous_cell, double value,
+                                     double previous_value);
+
 /// Trims spaces and tabs at both ends.
 std::string trim(const std::string& text);
 
