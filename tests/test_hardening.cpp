@@ -121,6 +121,14 @@ TEST_F(Hardening, ErrorsDeepInParsingNameFileAndPlace) {
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_TRUE(has(r.err, loop + ": line 1: nested more than 64 levels")) << r.err;
 
+  // Nested past yaml-cpp's own guard (a few thousand '['), which said only "bad file"; a '[' in quotes or a comment
+  // does not count.
+  const std::string deep = write("deep.yaml", "size: \"175/70 R14 84T\"  # [[[\npressure_bar: \"[[[\"\nx: " +
+                                                  std::string(5000, '[') + std::string(5000, ']') + "\n");
+  r = run_rollsim("tyre '" + deep + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, deep + ": line 3: nested more than 64 levels")) << r.err;
+
   // A list item's key is written item.key.
   const std::string neg = write("neg.yaml", "cases:\n  - {name: a, vehicle: ev, tyre: nominal, cycle: nedc, unit: kwh_per_10km, "
                                              "expected: -1, tolerance_pct: 1}\n");

@@ -37,6 +37,9 @@ std::string Range::describe() const {
 
 namespace {
 
+// No rollsim file nests more than a few levels; a tree deeper than this is not one of its inputs.
+constexpr int kMaxYamlDepth = 64;
+
 // yaml-cpp keeps every occurrence of a repeated key and answers lookups with the first, so a second
 // `pressure_bar:` further down would be silently ignored; keys that are lists or mappings cannot be named.
 // Both are rejected here, at the line of the offending key, for every mapping in the document.
@@ -44,9 +47,9 @@ namespace {
 // anchor): the walk stops at bounds no real input nears.
 void check_keys(const YAML::Node& node, const std::string& path, std::size_t& visited, int depth = 0) {
   if (++visited > 1000000) throw InputError(path, "more than a million values (aliases repeated?); not an input file of rollsim");
-  if (depth > 64) {
+  if (depth > kMaxYamlDepth) {
     throw InputError(path + ": line " + std::to_string(node.Mark().line + 1),
-                     "nested more than 64 levels deep (an alias inside its own anchor?)");
+                     "nested more than " + std::to_string(kMaxYamlDepth) + " levels deep (an alias inside its own anchor?)");
   }
   if (node.IsSequence()) {
     for (const auto& item : node) check_keys(item, path, visited, depth + 1);
@@ -63,6 +66,26 @@ void check_keys(const YAML::Node& node, const std::string& path, std::size_t& vi
     seen.push_back(key);
     check_keys(kv.second, path, visited, depth + 1);
   }
+}
+
+// The line (from 1) where '[' and '{' first nest deeper than `depth` outside quotes and comments, or 0. yaml-cpp
+// gives up on a deep flow collection with "bad file", which does not say why.
+int flow_nested_beyond(const std::string& text, int depth) {
+  int level = 0, line = 1;
+  char quote = 0;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char ch = text[i];
+    if (ch == '\n') ++line;
+    if (quote) {
+      if (ch == quote) quote = 0;
+      continue;
+    }
+    if (ch == '"' || ch == '\'') quote = ch;
+    else if (ch == '#') i = std::min(text.find('\n', i), text.size()) - 1;
+    else if ((ch == '[' || ch == '{') && ++level > depth) return line;
+    else if ((ch == ']' || ch == '}') && level > 0) --level;
+  }
+  return 0;
 }
 
 // The first line up to `line` (from 1) whose indentation holds a tab, or 0. YAML forbids tabs in indentation, and
@@ -152,6 +175,8 @@ YamlMap YamlMap::load_text(const std::string& given, const std::string& path) {
                        "a second YAML document (after '---'): a rollsim file is one document; merge its keys into the first");
     }
   } catch (const YAML::Exception& e) {
+    if (const int deep = flow_nested_beyond(text, kMaxYamlDepth))
+      throw InputError(path + ": line " + std::to_string(deep), "nested more than " + std::to_string(kMaxYamlDepth) + " levels deep");
     const int line = e.mark.line + 1;
     const int tab = tab_indented_line(text, line);
     throw InputError(path + ": line " + std::to_string(line),
