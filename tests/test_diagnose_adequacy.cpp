@@ -266,6 +266,30 @@ TEST(DiagnoseAdequacy, AMassFoundBesideAPinnedScaleHasAnIntervalThatLetsTheScale
   EXPECT_GT(mass.ci_high - mass.value, 3.0 * (mass.value - mass.ci_low)) << diagnosis_text(d);
 }
 
+TEST(DiagnoseAdequacy, AFindingAScaleBeyondItsBoxWouldCarryIsConfoundedWithTheScale) {
+  // Logged 8 % high with nothing else wrong, against a +5 % box: what the box leaves is sometimes named (session
+  // 28's outside tester: a 40-80 kg mass on 6 of its nulls at scales 1.06-1.08, nothing saying the scale would do).
+  // Each named effect now carries the channel scale as its alternative, with the scale that would carry it.
+  const Vehicle v = ev();
+  int named = 0;
+  for (unsigned seed = 1; seed <= 6; ++seed) {
+    const Diagnosis d = run(v, recording(v, nullptr, 1.0, 0.0, 1.08, seed), 60.0);
+    for (const Finding& f : d.findings) {
+      if (f.effect == "unexplained") continue;
+      ++named;
+      EXPECT_NE(std::find(f.confounded_with.begin(), f.confounded_with.end(), "channel_scale"), f.confounded_with.end())
+          << diagnosis_text(d);
+      EXPECT_EQ(d.verdict, "confounded") << diagnosis_text(d);
+    }
+  }
+  EXPECT_GE(named, 1) << "no seed named an effect: the test shows nothing";
+  // A payload whose shape a scale cannot take keeps its own name, beside a pinned scale.
+  const Diagnosis d = run(v, recording(v, std::make_shared<Payload>(250.0), 1.0, 0.0, 1.048, 41), 60.0);
+  ASSERT_FALSE(d.findings.empty()) << diagnosis_text(d);
+  const auto& with = d.findings.front().confounded_with;
+  EXPECT_EQ(std::find(with.begin(), with.end(), "channel_scale"), with.end()) << diagnosis_text(d);
+}
+
 TEST(DiagnoseAdequacy, DutyCycledCompressorIsAnAuxLoadNotAScale) {
   // 1.5 kW mean on a battery-power channel: the scale may not take it (a few per cent), the standing residual
   // names it, and its fitted size is the compressor's mean.
@@ -386,15 +410,19 @@ TEST(DiagnoseAdequacy, ScaleOutsideItsPriorIsReportedNotApplied) {
   EXPECT_NE(diagnosis_json(d).find("\"channel_scale_prior\""), std::string::npos);
 }
 
-TEST(DiagnoseAdequacy, ScalePinnedJustBeyondItsBoxIsNotNothingMissing) {
-  // 5.7 % high against the +5 % box: within the 1 % margin the RRC level and C keep, but a flat prior pinned at its
-  // edge is the data asking for more than it allows.
+TEST(DiagnoseAdequacy, ScalePinnedJustBeyondItsBoxIsNotedNotMissingPhysics) {
+  // 5.7 % high against the +5 % box, where the boxed model still meets the trip's energy held out (the RRC level
+  // takes the rest): the pin is said in a note, and no missing physics is claimed. Session 28's outside tester had
+  // 5 nulls (true scales 1.045-1.05) called missing_physics with an `unexplained` at Delta BIC 0 beside a residual
+  // of 0.3 x the noise floor. The Twizy trip below, where the pinned model misses by 10 %, still is.
   const Vehicle v = ev();
   const Diagnosis d = run(v, recording(v, nullptr, 1.0, 0.0, 1.057, 7), 60.0);
   EXPECT_GT(d.channel_scale_free, 1.05) << diagnosis_text(d);
   EXPECT_LT(d.channel_scale_free, 1.06) << diagnosis_text(d);
-  EXPECT_TRUE(d.calibration_outside_prior);
-  EXPECT_NE(d.verdict, "nothing_missing") << diagnosis_text(d);
+  EXPECT_LT(std::abs(d.heldout_energy_error_pct_calibrated), 1.0) << diagnosis_text(d);
+  EXPECT_FALSE(d.calibration_outside_prior);
+  EXPECT_EQ(d.verdict, "nothing_missing") << diagnosis_text(d);
+  EXPECT_NE(diagnosis_text(d).find("calibration at its prior's bound"), std::string::npos) << diagnosis_text(d);
 }
 
 TEST(DiagnoseAdequacy, TwizyTripUnderPredictedBehindAPinnedScaleIsNotNothingMissing) {
