@@ -30,8 +30,13 @@ void note_engine_state(const DriveCycle& c, const Recording& r, const EngineStar
   const std::string how =
       start.inferred ? " (inferred: its first minutes of running burn " + fixed(100.0 * start.early_excess, 1) + " % [" +
                            fixed(100.0 * start.early_excess_ci_low, 1) + ", " + fixed(100.0 * start.early_excess_ci_high, 1) +
-                           "] more fuel than the warm model, relative to its later running; hot only where that interval "
-                           "ends under " + fixed(100.0 * opt.engine_start_min_cold_excess, 0) + " %)"
+                           "] more fuel than the warm model, relative to its later running" +
+                           (start.idle_inferred ? ", and its early idling " + fixed(100.0 * start.idle_excess, 1) + " % [" +
+                                                      fixed(100.0 * start.idle_excess_ci_low, 1) + ", " +
+                                                      fixed(100.0 * start.idle_excess_ci_high, 1) + "] more than its later idling"
+                                                : std::string()) +
+                           "; hot only where " + (start.idle_inferred ? "either interval ends" : "that interval ends") +
+                           " under " + fixed(100.0 * opt.engine_start_min_cold_excess, 0) + " %)"
       : to_infer ? " (too little running to infer it from its first " + fixed(opt.engine_start_early_s, 0) +
                        " s against its running after " + fixed(opt.engine_start_late_s, 0) + " s: taken cold)"
                  : " (set)";

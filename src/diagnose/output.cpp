@@ -48,7 +48,11 @@ std::string diagnosis_json(const Diagnosis& d) {
     const auto& e = d.engine_starts[i];
     os << (i ? ", " : "") << "{\"recording\": " << json_string(e.recording) << ", \"start\": " << json_string(to_string(e.start))
        << ", \"inferred\": " << (e.inferred ? "true" : "false") << ", \"early_excess\": " << jnum(e.early_excess)
-       << ", \"early_excess_ci\": [" << jnum(e.early_excess_ci_low) << ", " << jnum(e.early_excess_ci_high) << "]}";
+       << ", \"early_excess_ci\": [" << jnum(e.early_excess_ci_low) << ", " << jnum(e.early_excess_ci_high) << "]";
+    if (e.idle_inferred)
+      os << ", \"idle_excess\": " << jnum(e.idle_excess) << ", \"idle_excess_ci\": [" << jnum(e.idle_excess_ci_low) << ", "
+         << jnum(e.idle_excess_ci_high) << "]";
+    os << "}";
   }
   os << "],\n";
   os << "  \"channel_sampling\": {\"chosen\": \"" << d.channel_sampling << "\", \"interval_over_instant_sse\": "

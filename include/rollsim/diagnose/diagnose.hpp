@@ -191,6 +191,9 @@ struct EngineStartState {
   EngineStart start = EngineStart::cold;  ///< cold or hot
   bool inferred = false;                  ///< false: set (--engine-start), or too short to infer (then cold)
   double early_excess = 0.0, early_excess_ci_low = 0.0, early_excess_ci_high = 0.0;
+  /// The same read on the standstills alone (engine idling), where the first minutes hold two or more.
+  bool idle_inferred = false;
+  double idle_excess = 0.0, idle_excess_ci_low = 0.0, idle_excess_ci_high = 0.0;
 };
 
 struct Diagnosis {
