@@ -81,7 +81,7 @@ TEST(EngineStart, AHotEngineCarryingALoadAllTripIsInferredHotByItsIdling) {
   // engine at the margin, petrol 32 MJ/l) added wherever the engine burns fuel.
   const Vehicle v = ice();
   constexpr double kLoadFuel_m3ps = 700.0 / 0.6 / 0.3 / 32e9;
-  int hot = 0;
+  int hot = 0, standing_named = 0;
   for (unsigned seed : {1u, 2u, 3u, 4u}) {
     SyntheticCase c;
     c.channel = SyntheticChannel::fuel_rate;
@@ -95,8 +95,15 @@ TEST(EngineStart, AHotEngineCarryingALoadAllTripIsInferredHotByItsIdling) {
     EXPECT_LE(d.engine_starts[0].idle_excess_ci_low, 0.0) << seed;
     hot += d.engine_starts[0].start == EngineStart::hot;
     EXPECT_EQ(warmup_excess(d), 0.0) << seed;
+    // Named from its standing residual on a fuel channel, the load is said alike an idle richer than the model's.
+    for (const auto& f : d.findings)
+      if (f.effect == "aux_load" && f.description.find("residual when standing") != std::string::npos) {
+        EXPECT_NE(f.description.find("or an idle fuel rate above the model's"), std::string::npos) << f.description;
+        ++standing_named;
+      }
   }
   EXPECT_GE(hot, 3);
+  EXPECT_GE(standing_named, 1);
   // A cold start's idling carries its excess, and stays cold (ColdStartIsInferredColdAndAHotStartHot, on UDDS).
   const Diagnosis cold = diagnose(v, {soak_test("engine_cold_soak", 3)});
   EXPECT_TRUE(cold.engine_starts[0].idle_inferred);
