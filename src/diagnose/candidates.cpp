@@ -64,11 +64,12 @@ class SignatureForce final : public Effect {
 // looked more like a fast tyre warm-up than like the one slow engine shape (and a cold-start test's 3-minute one
 // like a decaying constant power until the 15 kJ/K shape was added), and a 4 kW regen cap needed a friction
 // share above 1 at the one 10 kW limit, out of bounds, so a force-squared loss took its place.
-std::vector<EffectParameters> shapes_of(const EffectInfo& info, ChannelKind channel, bool regenerates) {
+std::vector<EffectParameters> shapes_of(const EffectInfo& info, ChannelKind channel, bool regenerates, bool any_cold_start) {
   if (info.id == EffectId::tyre_warmup)
     return {{{"heat_capacity_j_per_k", 20000.0}}, {{"heat_capacity_j_per_k", 50000.0}}, {{"heat_capacity_j_per_k", 120000.0}}};
   if (info.id == EffectId::engine_warmup) {
     if (channel != ChannelKind::fuel_rate) return {};  // no fuel power to scale: its signature is zero
+    if (!any_cold_start) return {};                    // every engine started hot: nothing warms up
     return {{{"heat_capacity_j_per_k", 15000.0}}, {{"heat_capacity_j_per_k", 40000.0}}, {{"heat_capacity_j_per_k", 100000.0}},
             {{"heat_capacity_j_per_k", 250000.0}}};
   }
@@ -244,6 +245,7 @@ Signatures compute_signatures(const Replayer& rp, const Observations& o, const V
   s.base = base;
   std::vector<EffectList> extras{{std::make_shared<RrcLevel>(0.1)}, {std::make_shared<DragScale>(0.1, ctx.rho_cda_kg_per_m)}};
   std::vector<double> nominal_of_run;
+  const bool any_cold_start = std::any_of(rp.cycles.begin(), rp.cycles.end(), [](const DriveCycle& c) { return !c.engine_hot_start; });
   for (const auto& info : effect_catalogue()) {
     const EffectParameterInfo& amp = info.amplitude();
     if (info.id == EffectId::ambient_rrc) {
@@ -262,7 +264,7 @@ Signatures compute_signatures(const Replayer& rp, const Observations& o, const V
       if (headings_known(rp.cycles)) add_bearing_candidates(info, ctx, extras, s.candidates);
       continue;
     }
-    for (const auto& shape : shapes_of(info, o.channel, rp.vehicle.battery() != nullptr)) {
+    for (const auto& shape : shapes_of(info, o.channel, rp.vehicle.battery() != nullptr, any_cold_start)) {
       Candidate c;
       c.id = info.id;
       c.shape = shape;

@@ -211,6 +211,15 @@ void set_engine_starts(std::vector<DriveCycle>& cycles, const std::vector<Record
     note_engine_state(cycles[k], recordings[k], s, set == EngineStart::infer, opt, out.notes);
     out.engine_starts.push_back(s);
   }
+  // The detection limits had read "cold_fuel_excess 192 (beyond its physical bounds)" on every hot start (session
+  // 28's outside tester): a hot engine does not warm up, so its shape is not run (shapes_of).
+  if (o.channel == ChannelKind::fuel_rate && !out.engine_starts.empty() &&
+      std::all_of(cycles.begin(), cycles.end(), [](const DriveCycle& c) { return c.engine_hot_start; }))
+    out.notes.push_back("engine_warmup not tested: every recording's engine started hot (" +
+                        std::string(std::any_of(out.engine_starts.begin(), out.engine_starts.end(),
+                                                [](const EngineStartState& e) { return e.inferred; })
+                                        ? "inferred or set" : "set") +
+                        "), and a hot engine does not warm up");
 }
 
 // A logger integrates its channel over each sample's interval (the replay's segment means) or reads it at the
