@@ -473,7 +473,8 @@ std::string reference_for(ChannelKind channel) {
 // A finding whose energy a channel scale just beyond its prior would carry as well: the model without its column and
 // with the scale's box open fits within the evidence bar of the model with it. Session 28's outside testers: nulls at
 // a true scale of 1.06-1.08 (box 1.05) were named a 40-80 kg mass, and a payload beside a pinned scale read 39-66 kg
-// for 150 kg, each with nothing saying its size rested on the box.
+// for 150 kg, each with nothing saying its size rested on the box; and a mass shape with the impossible sign swung
+// the scale from one edge of its box to the other beside a scale the data wanted at 0.933.
 void add_scale_alternative(std::vector<Finding>& findings, const Model& m, const SelectionContext& sc) {
   Prior open = m.prior;
   std::erase_if(open.boxes, [](const Prior::Box& b) { return b.column == 0; });
@@ -481,7 +482,7 @@ void add_scale_alternative(std::vector<Finding>& findings, const Model& m, const
   for (std::size_t k = 0; k < findings.size(); ++k) {
     Finding& f = findings[k];
     const auto col = static_cast<Eigen::Index>(3 + k);
-    if (f.wrong_sign || col >= m.x.cols()) continue;
+    if (col >= m.x.cols()) continue;
     Eigen::MatrixXd x(m.x.rows(), m.x.cols() - 1);
     x << m.x.leftCols(col), m.x.rightCols(m.x.cols() - col - 1);
     const Fit alt = least_squares(x, *m.y, open);
@@ -494,8 +495,7 @@ void add_scale_alternative(std::vector<Finding>& findings, const Model& m, const
     if (m.n_eff * std::log(alt.rss / std::max(1e-300, m.fit.rss)) - std::log(m.n_eff) >= sc.opt.bic_threshold) continue;
     f.confounded_with.push_back("channel_scale");
     f.separating_tests.push_back("channel_scale: a channel scale of " + fixed(scale, 3) + ", beyond its prior [" +
-                                 fixed(1.0 - bound, 2) + ", " + fixed(1.0 + bound, 2) + "], explains the data as well without " +
-                                 f.effect + ": check the " + to_string(sc.obs.channel) + " channel against " +
+                                 fixed(1.0 - bound, 2) + ", " + fixed(1.0 + bound, 2) + "], explains the data as well without this finding: check the " + to_string(sc.obs.channel) + " channel against " +
                                  reference_for(sc.obs.channel) +
                                  ", or set the vehicle file's calibration_priors if the logger is known to be looser");
   }
