@@ -1199,5 +1199,23 @@ TEST(CliValidate, ThePlotsTitleGivesTheListsModelYears) {
   EXPECT_EQ(title_of({list_line_with(lines, 2, {{"Model Year", ""}})}), "EPA Test Car List");
 }
 
+// A figure for a slide or a report: `--plot F.png` draws a PNG (it took only .svg, session 27's outside testing);
+// other endings are refused naming the option.
+TEST(CliValidate, ThePlotIsAPngWhereItsNameSaysSo) {
+  if (report::find_gnuplot().empty()) GTEST_SKIP() << "gnuplot not installed";
+  const auto lines = list_head(4);
+  const auto png = test::temp_dir() / "figure.png";
+  std::filesystem::remove(png);
+  auto r = validate_lines(lines, {list_line_with(lines, 2, {})}, "--threads 1 --plot " + png.string());
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  std::ifstream in(png, std::ios::binary);
+  std::string magic(8, '\0');
+  in.read(magic.data(), 8);
+  EXPECT_EQ(magic, std::string("\x89PNG\r\n\x1a\n", 8));
+  r = validate_lines(lines, {list_line_with(lines, 2, {})}, "--threads 1 --plot " + (test::temp_dir() / "figure.pdf").string());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("must end in .svg or .png"), std::string::npos) << r.err;
+}
+
 }  // namespace
 }  // namespace rollsim

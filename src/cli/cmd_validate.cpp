@@ -118,7 +118,7 @@ std::string list_title(const validate::Validation& v) {
 std::string check_plot_target(const std::string& file) {
   namespace fs = std::filesystem;
   const std::string ext = fs::path(file).extension().string();
-  if (ext != ".svg") throw InputError("--plot " + file, "must end in .svg");
+  if (ext != ".svg" && ext != ".png") throw InputError("--plot " + file, "must end in .svg or .png");
   const std::string gnuplot = report::find_gnuplot();
   if (gnuplot.empty()) throw InputError("--plot " + file, "gnuplot is not installed or not on PATH (Debian: apt-get install gnuplot-nox)");
   const fs::path target(file);
@@ -165,9 +165,10 @@ void plot(const validate::Validation& v, const std::string& file) {
   // gnuplot draws in the scratch folder, and the figure is then written as every output is (atomically, under the
   // user's path as given): a path with a line break was turned into another name by gnuplot's quoting, and a stray
   // temporary file was left beside it (session 21).
-  const fs::path figure = work / "figure.svg";
+  const std::string ext = fs::path(file).extension().string();
+  const fs::path figure = work / ("figure" + ext);
   std::ofstream gp(work / "plot.gp");
-  gp << report::gnuplot_terminal("svg size 800,700 dynamic font 'Sans,12'")
+  gp << report::gnuplot_terminal(ext == ".svg" ? "svg size 800,700 dynamic font 'Sans,12'" : "pngcairo size 800,700 font 'Sans,11'")
      << "set output " << report::gnuplot_string(figure.string()) << "\n"
      << "set title " << report::gnuplot_string(list_title(v) + ": rollsim from certification data against the dynamometer") << "\n"
      << "set xlabel 'measured [mpg or mpge]'\nset ylabel 'predicted [mpg or mpge]'\n"
@@ -225,7 +226,7 @@ void register_validate_command(CLI::App& app, const ProcessGroup& group) {
   auto* sub = app.add_subcommand("validate", "Simulate every car of the EPA Test Car List from its certification data and compare with its measured result");
   sub->add_option("--epa-test-car-list", o->list, "EPA Test Car List CSV (e.g. ../shared/data/vehicles/epa_test_car_list_2022_part.csv)")->type_name("FILE");
   sub->add_flag("--json", o->json, "One JSON object per row instead of the summary");
-  sub->add_option("--plot", o->plot, "Draw predicted against measured (gnuplot, .svg)")->type_name("FILE");
+  sub->add_option("--plot", o->plot, "Draw predicted against measured (gnuplot)")->type_name("FILE.svg|.png");
   sub->add_option("--threads", o->threads, "Worker threads (default: every core)")->type_name("N");
   sub->callback([o, &group] { run_validate(*o, group); });
 }
