@@ -283,6 +283,9 @@ TEST(DiagnoseAdequacy, AFindingAScaleBeyondItsBoxWouldCarryIsConfoundedWithTheSc
     }
   }
   EXPECT_GE(named, 1) << "no seed named an effect: the test shows nothing";
+  // The scale's own share is said where the RRC level and C took it (the total read "absorbed -0.0 %").
+  const Diagnosis d8 = run(v, recording(v, nullptr, 1.0, 0.0, 1.08, 1), 60.0);
+  EXPECT_NE(diagnosis_text(d8).find("its scale alone"), std::string::npos) << diagnosis_text(d8);
   // A payload whose shape a scale cannot take keeps its own name, beside a pinned scale.
   const Diagnosis d = run(v, recording(v, std::make_shared<Payload>(250.0), 1.0, 0.0, 1.048, 41), 60.0);
   ASSERT_FALSE(d.findings.empty()) << diagnosis_text(d);
@@ -448,6 +451,9 @@ TEST(DiagnoseAdequacy, ScalePinnedJustBeyondItsBoxIsNotedNotMissingPhysics) {
   EXPECT_FALSE(d.calibration_outside_prior);
   EXPECT_EQ(d.verdict, "nothing_missing") << diagnosis_text(d);
   EXPECT_NE(diagnosis_text(d).find("calibration at its prior's bound"), std::string::npos) << diagnosis_text(d);
+  // Nor does the note beside nothing_missing say what the model lacks (it did: "a drive efficiency or consumer the
+  // model lacks", session 28's outside tester).
+  EXPECT_EQ(diagnosis_text(d).find("the model lacks"), std::string::npos) << diagnosis_text(d);
 }
 
 TEST(DiagnoseAdequacy, TwizyTripUnderPredictedBehindAPinnedScaleIsNotNothingMissing) {

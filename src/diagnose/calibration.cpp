@@ -134,6 +134,16 @@ std::string calibration_outside_prior_text(const Calibration& c, const Observati
       could += (could.empty() ? "" : ", ") + to_string(cand.id) + " (" + fixed(amp, 3) + " " + cand.amplitude->unit + ")";
   }
   const Eigen::VectorXd& f = c.free_coef;
+  // The free scale's own share: where the RRC level and C take what the box held back, the total "absorbed" reads
+  // about 0 beside a scale the data are sure of (an outside tester's meter 8 % high read "-0.0 %", session 28).
+  const double measured_j = std::max(1e-9, std::abs(o.measured_j.sum()));
+  const double scale_part_pct = 100.0 * (f[0] - s) * c.model.x.col(0).sum() / measured_j;
+  const double taken_pct = scale_part_pct - 100.0 * c.absorbed_j / measured_j;
+  const std::string scale_part =
+      std::abs(scale_part_pct) >= 0.5 && std::abs(taken_pct) >= 0.5
+          ? " (its scale alone " + fixed(scale_part_pct, 1) + " %, of which the RRC level and C took " + fixed(taken_pct, 1) +
+                " % within their boxes)"
+          : "";
   std::string beyond;
   for (const auto& term : c.beyond) beyond += (beyond.empty() ? "" : ", ") + term;
   return "the calibration alone wanted a channel scale of " + fixed(f[0], 3) + " (prior [" + fixed(1.0 - c.prior_scale_bound, 2) +
@@ -141,7 +151,7 @@ std::string calibration_outside_prior_text(const Calibration& c, const Observati
          fixed(100.0 * 0.1 * f[1] / f[0], 0) + " % and aero C " + fixed(100.0 * 0.1 * f[2] / f[0], 0) + " %" +
          (beyond.empty() ? std::string() : ", beyond the box: " + beyond) + " (Delta BIC " + fixed(c.dbic_leave, 1) + " for leaving its prior: " +
          (c.sure ? "this data is sure of it" : "this data alone cannot tell") + "); it would have absorbed " +
-         fixed(100.0 * c.absorbed_j / std::max(1e-9, std::abs(o.measured_j.sum())), 1) + " % of the measured energy" +
+         fixed(100.0 * c.absorbed_j / measured_j, 1) + " % of the measured energy" + scale_part +
          (!with_explanations ? std::string() : ". ") +
          (!with_explanations ? std::string()
           : could.empty() ? std::string("No catalogue effect alone explains that energy (none takes 80 % of it within its bounds): ") +

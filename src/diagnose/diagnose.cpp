@@ -478,7 +478,9 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
     const bool found = !out.findings.empty();
     out.notes.push_back((cal.outside_prior ? "calibration beyond its prior's bound before the findings: "
                                            : "calibration at its prior's bound, not significantly beyond it: ") +
-                        calibration_outside_prior_text(cal, obs, sig.candidates, !found) +
+                        // Within its prior, what "could explain it" or "the model lacks" would contradict the
+                        // verdict beside it (session 28's outside tester read both on one nothing_missing).
+                        calibration_outside_prior_text(cal, obs, sig.candidates, !found && cal.outside_prior) +
                         (found ? "; beside the findings it is as the calibration line says" : ""));
   }
   if (!out.findings.empty()) {
