@@ -74,13 +74,13 @@ Calibration calibrate(const Observations& o, const Variant& base, const Variant&
   const double rho = std::clamp(lag1_autocorrelation(resid), 0.0, 0.95);
   m.n_eff = std::max(4.0, static_cast<double>(n) * (1.0 - rho) / (1.0 + rho));
   m.inflate = std::sqrt(static_cast<double>(n) / m.n_eff);  // autocorrelated windows carry less information
-  // The data want out of the boxes when the free scale lies beyond its box at all, when the free RRC level or C lies
-  // beyond theirs by more than 1 %, or when freeing them passes a discovery's evidence bar (the scale's edge: see below). Either way it is
-  // reported, never a silent nothing_missing; the Delta BIC says whether this data alone is sure of it. The scale's
-  // prior is flat inside its box (no penalty pulls it), so a scale pinned at the edge is the data asking for more
-  // than the prior allows, and the model under it is then as far off as the edge leaves it (a Twizy trip: 1.107
-  // wanted against 1.10, held-out trip energy -10 %). RRC level and C also carry Gaussian penalties whose boxes sit
-  // at two sds, which a null reaches by chance: for them the 1 % margin stays.
+  // The data want out of the boxes when the free RRC level or C lies beyond theirs by more than 1 %, when freeing
+  // them passes a discovery's evidence bar, or when the scale is pinned at its box and the model under it is left off
+  // (below). Either way it is reported, never a silent nothing_missing; the Delta BIC says whether this data alone is
+  // sure of it. The scale's prior is flat inside its box (no penalty pulls it), so a scale pinned at the edge is the
+  // data asking for more than the prior allows, and the model under it is as far off as the edge leaves it (a Twizy
+  // trip: 1.107 wanted against 1.10, held-out trip energy -10 %). RRC level and C also carry Gaussian penalties whose
+  // boxes sit at two sds, which a null reaches by chance: for them the 1 % margin stays.
   c.dbic_leave = c.at_bound ? m.n_eff * std::log(m.fit.rss / std::max(1e-300, free.rss)) - std::log(m.n_eff) : 0.0;
   double excess = 0.0;
   bool scale_pinned = false;

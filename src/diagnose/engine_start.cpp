@@ -77,7 +77,7 @@ struct Excess {
 
 // The early blocks' ratio of measured to simulated fuel over the late blocks' ratio, less 1; its standard error from
 // the late blocks' own scatter (energy-weighted: a small block's ratio is noisier).
-Excess early_excess(const std::vector<Block>& blocks, double block_s, const DiagnoseOptions& opt, std::size_t min_early) {
+Excess early_excess(const std::vector<Block>& blocks, double block_s, const DiagnoseOptions& opt) {
   double em = 0.0, es = 0.0, lm = 0.0, ls = 0.0;
   std::size_t ne = 0;
   std::vector<double> late_ratio, late_weight;
@@ -91,7 +91,7 @@ Excess early_excess(const std::vector<Block>& blocks, double block_s, const Diag
     }
   }
   const auto nl = late_ratio.size();
-  if (ne < min_early || nl < 3 || !(es > 0.0) || !(ls > 0.0) || !(lm > 0.0)) return {};
+  if (ne < 2 || nl < 3 || !(es > 0.0) || !(ls > 0.0) || !(lm > 0.0)) return {};
   const double late = lm / ls, early = em / es;
   const double mean_w = ls / static_cast<double>(nl);
   double ss = 0.0;
@@ -115,13 +115,13 @@ EngineStartState infer_engine_start(const std::vector<double>& measured_w, const
   constexpr double kBlock_s = 60.0;
   EngineStartState s;
   s.start = EngineStart::cold;
-  const Excess drive = early_excess(running_blocks(measured_w, sim_w, dt_s, c, kBlock_s), kBlock_s, opt, 2);
+  const Excess drive = early_excess(running_blocks(measured_w, sim_w, dt_s, c, kBlock_s), kBlock_s, opt);
   if (!drive.known) return s;  // too short to tell: cold, as before
   s.inferred = true;
   s.early_excess = drive.value;
   s.early_excess_ci_low = drive.value - 1.96 * drive.se;
   s.early_excess_ci_high = drive.value + 1.96 * drive.se;
-  const Excess idle = early_excess(idle_blocks(measured_w, sim_w, dt_s, c), 0.0, opt, 2);
+  const Excess idle = early_excess(idle_blocks(measured_w, sim_w, dt_s, c), 0.0, opt);
   if (idle.known) {
     s.idle_inferred = true;
     s.idle_excess = idle.value;

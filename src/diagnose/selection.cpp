@@ -456,15 +456,6 @@ std::string reference_for(ChannelKind channel) {
   }
 }
 
-// A finding whose energy a calibration quantity just beyond its prior would carry as well: the model without its
-// column, with that quantity's box (and penalty) open, fits within the evidence bar of the model with it, at a value
-// between the box and twice its bound. Session 28's outside testers: nulls at a true scale of 1.06-1.08 (box 1.05)
-// were named a 40-80 kg mass, and a payload beside a pinned scale read 39-66 kg for 150 kg, each with nothing saying
-// its size rested on the box; a mass shape with the impossible sign swung the scale from one edge of its box to the
-// other beside a scale the data wanted at 0.933; a CdA 20 % above the file's was named rr_speed in 20 of 20, a
-// shape the aero C beyond its box gives as well. Beyond twice the bound no calibrated logger or published CdA or
-// RRC reaches (the scorecard's 1 kW duty-cycled compressor was confounded with scales beyond that in 3 of its 10
-// real-logger seeds): the finding's own evidence holds.
 // Whether column `col`'s signature and calibration column `q` are alike (|corr| above `limit`) once both are cleaned
 // of every other column: then only the prior's box tells them apart, whatever the size (rr_speed, m g v^2, and the
 // aero C, v^2, are nearly one shape: a CdA 56 % above the file's was named rr_speed, an outside tester's, session 28).
@@ -477,16 +468,48 @@ bool collinear_with_column(const Model& m, Eigen::Index col, Eigen::Index q, dou
   return std::abs(a.dot(b)) > limit * a.norm() * b.norm();
 }
 
+// A calibration quantity that could carry a finding: the model's column, its name in confounded_with, and its
+// prior's bound (of the fraction: scale - 1, RRC level change, C change).
+struct CalibrationQuantity {
+  Eigen::Index column;
+  const char* name;
+  double bound;
+};
+
+// The separating test of a finding `q` could carry at `change` (beyond its box): what to check.
+std::string calibration_alternative_text(const CalibrationQuantity& q, double change, bool as_well, ChannelKind channel) {
+  const std::string why = as_well ? ", explains the data as well without this finding: "
+                                  : ", has this finding's shape (only the prior tells them apart): ";
+  const std::string looser = ", or set the vehicle file's calibration_priors if it is known to be looser";
+  if (q.column == 0)
+    return "channel_scale: a channel scale of " + fixed(1.0 + change, 3) + ", beyond its prior [" + fixed(1.0 - q.bound, 2) +
+           ", " + fixed(1.0 + q.bound, 2) + "]" + why + "check the " + to_string(channel) + " channel against " +
+           reference_for(channel) + looser;
+  const std::string range = " of " + fixed(100.0 * change, 1) + " %, beyond its prior [" + fixed(-100.0 * q.bound, 0) + ", " +
+                            fixed(100.0 * q.bound, 0) + "] %" + why;
+  if (q.column == 1)
+    return "rrc_level: an RRC level" + range +
+           "check the tyre pressures and the tyre file's RRC against a measured one (a tyre under-inflated, worn or on a "
+           "rougher road rolls harder by the same constant force); a grade reverses with the direction of travel, a "
+           "tyre's rolling resistance does not" + looser;
+  return "drag: an aero C (drag)" + range + "check the CdA against a coast-down or the maker's figure" + looser;
+}
+
+// A finding whose energy a calibration quantity just beyond its prior would carry as well: the model without its
+// column, with that quantity's box (and penalty) open, fits within the evidence bar of the model with it, at a value
+// between the box and twice its bound. Session 28's outside testers: nulls at a true scale of 1.06-1.08 (box 1.05)
+// were named a 40-80 kg mass, and a payload beside a pinned scale read 39-66 kg for 150 kg, each with nothing saying
+// its size rested on the box; a mass shape with the impossible sign swung the scale from one edge of its box to the
+// other beside a scale the data wanted at 0.933; a CdA 20 % above the file's was named rr_speed in 20 of 20, a
+// shape the aero C beyond its box gives as well. Beyond twice the bound no calibrated logger or published CdA or
+// RRC reaches (the scorecard's 1 kW duty-cycled compressor was confounded with scales beyond that in 3 of its 10
+// real-logger seeds): the finding's own evidence holds, unless (RRC level, C) the finding has that quantity's shape,
+// when only the prior tells them apart whatever the size.
 void add_calibration_alternatives(std::vector<Finding>& findings, const Model& m, const SelectionContext& sc) {
   const CalibrationPriors& p = sc.opt.priors;
-  const double scale_bound = p.scale_bound(sc.obs.channel);
-  struct Quantity {
-    Eigen::Index column;
-    const char* name;
-    double bound;  // of the fraction: scale - 1, RRC level change, C change
-  };
-  for (const Quantity q : {Quantity{0, "channel_scale", scale_bound}, Quantity{1, "rrc_level", 2.0 * p.rrc_level_sd},
-                           Quantity{2, "drag", 2.0 * p.drag_sd}}) {
+  for (const CalibrationQuantity q : {CalibrationQuantity{0, "channel_scale", p.scale_bound(sc.obs.channel)},
+                                      CalibrationQuantity{1, "rrc_level", 2.0 * p.rrc_level_sd},
+                                      CalibrationQuantity{2, "drag", 2.0 * p.drag_sd}}) {
     Prior open = m.prior;
     std::erase_if(open.boxes, [&](const Prior::Box& b) { return b.column == q.column; });
     std::erase_if(open.rows, [&](const Prior::Row& r) { return r.column == q.column; });
@@ -507,23 +530,7 @@ void add_calibration_alternatives(std::vector<Finding>& findings, const Model& m
       const bool alike = q.column != 0 && collinear_with_column(m, col, q.column, sc.opt.collinear_corr);
       if (!((as_well && std::abs(change) <= 2.0 * q.bound) || alike)) continue;
       f.confounded_with.push_back(q.name);
-      const std::string within = alike && !as_well ? ", has this finding's shape (only the prior tells them apart): "
-                                                   : ", explains the data as well without this finding: ";
-      if (q.column == 0)
-        f.separating_tests.push_back("channel_scale: a channel scale of " + fixed(alt.coef[0], 3) + ", beyond its prior [" +
-                                     fixed(1.0 - q.bound, 2) + ", " + fixed(1.0 + q.bound, 2) + "]" + within + "check the " +
-                                     to_string(sc.obs.channel) + " channel against " + reference_for(sc.obs.channel) +
-                                     ", or set the vehicle file's calibration_priors if the logger is known to be looser");
-      else
-        f.separating_tests.push_back(std::string(q.name) + ": " + (q.column == 1 ? "an RRC level" : "an aero C (drag)") + " of " +
-                                     fixed(100.0 * change, 1) + " %, beyond its prior [" + fixed(-100.0 * q.bound, 0) + ", " +
-                                     fixed(100.0 * q.bound, 0) + "] %" + within +
-                                     (q.column == 1 ? "check the tyre pressures and the tyre file's RRC against a measured one "
-                                                      "(a tyre under-inflated, worn or on a rougher road rolls harder by the "
-                                                      "same constant force); a grade reverses with the direction of travel, "
-                                                      "a tyre's rolling resistance does not"
-                                                    : "check the CdA against a coast-down or the maker's figure") +
-                                     ", or set the vehicle file's calibration_priors if it is known to be looser");
+      f.separating_tests.push_back(calibration_alternative_text(q, change, as_well, sc.obs.channel));
     }
   }
 }
