@@ -272,8 +272,10 @@ TEST(DiagnoseAdequacy, AFindingAScaleBeyondItsBoxWouldCarryIsConfoundedWithTheSc
   // Each named effect now carries the channel scale as its alternative, with the scale that would carry it.
   const Vehicle v = ev();
   int named = 0;
-  for (unsigned seed = 1; seed <= 6; ++seed) {
+  for (unsigned seed = 1; seed <= 3; ++seed) {
     const Diagnosis d = run(v, recording(v, nullptr, 1.0, 0.0, 1.08, seed), 60.0);
+    // The scale's own share is said where the RRC level and C took it (the total read "absorbed -0.0 %").
+    EXPECT_NE(diagnosis_text(d).find("its scale alone"), std::string::npos) << diagnosis_text(d);
     for (const Finding& f : d.findings) {
       if (f.effect == "unexplained") continue;
       ++named;
@@ -283,9 +285,6 @@ TEST(DiagnoseAdequacy, AFindingAScaleBeyondItsBoxWouldCarryIsConfoundedWithTheSc
     }
   }
   EXPECT_GE(named, 1) << "no seed named an effect: the test shows nothing";
-  // The scale's own share is said where the RRC level and C took it (the total read "absorbed -0.0 %").
-  const Diagnosis d8 = run(v, recording(v, nullptr, 1.0, 0.0, 1.08, 1), 60.0);
-  EXPECT_NE(diagnosis_text(d8).find("its scale alone"), std::string::npos) << diagnosis_text(d8);
   // A payload whose shape a scale cannot take keeps its own name, beside a pinned scale.
   const Diagnosis d = run(v, recording(v, std::make_shared<Payload>(250.0), 1.0, 0.0, 1.048, 41), 60.0);
   ASSERT_FALSE(d.findings.empty()) << diagnosis_text(d);
@@ -337,7 +336,7 @@ TEST(DiagnoseAdequacy, ASpeedSquaredFindingBesideAnAeroCBeyondItsBoxIsConfounded
   // Only the prior tells them apart, so a v^2 finding says that the drag is its other reading.
   const Vehicle v = ev();
   int named = 0;
-  for (unsigned seed = 1; seed <= 3; ++seed) {
+  for (unsigned seed = 1; seed <= 2; ++seed) {
     const Diagnosis d = run(v, recording(v, std::make_shared<LargerDragArea>(0.5), 1.0, 0.0, 1.0, seed), 60.0);
     for (const Finding& f : d.findings) {
       if (f.effect != "rr_speed" && f.effect != "wind") continue;
