@@ -280,6 +280,24 @@ TEST(Generate, FuelAndSocChannelsCarryTheirTruths) {
   EXPECT_LT(worn.soc_fraction->back(), sb.back());  // the extra resistance's loss drains the cells faster
 }
 
+// A state of charge's quantum is an error of each reading, not of each second: the floor, read from 2 s windows and
+// scaled with a block's length as white noise, was tens of times a long block's (a session 28 outside tester's
+// SOC-only nulls read 0.004-0.72 x it, median 0.02). On a null whose only noise is the 0.1 % quantum the residual now
+// sits at its floor.
+TEST(DiagnoseLimits, AStateOfChargeNullSitsAtItsNoiseFloor) {
+  const rollsim::Vehicle v = rollsim::load_vehicle_file(std::string(ROLLSIM_SOURCE_DIR) + "/vehicles/ev.yaml");
+  for (unsigned seed : {1u, 2u}) {
+    rollsim::SyntheticCase c;
+    c.channel = rollsim::SyntheticChannel::soc;
+    c.seed = seed;
+    const auto d = rollsim::diagnose(v, {rollsim::generate_case(v, c)});
+    ASSERT_EQ(d.channel, "soc");
+    EXPECT_GT(d.residual_to_noise_ratio, 0.2) << seed;
+    EXPECT_LT(d.residual_to_noise_ratio, 3.0) << seed;
+    EXPECT_EQ(d.verdict, "nothing_missing") << seed;
+  }
+}
+
 // A state of charge counts what leaves the cells, so the model side must include the cells' internal loss: then an
 // extra internal resistance has a signature and a detection limit on SOC recordings (it had none when the diagnosis
 // compared SOC with terminal energy only).

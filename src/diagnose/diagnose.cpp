@@ -441,7 +441,7 @@ Diagnosis diagnose(const Vehicle& vehicle, const std::vector<Recording>& recordi
   out.located = locate_regimes(obs, recordings, cycles, sig, cal.model.fit.coef, lag.samples, &sc.standing);
   const NoiseFloor floor = calibrated_noise_floor(obs, recordings, sig, cal, lag.samples, ctx.mass_kg, grade_draws, opt);
   const Adequacy before = test_adequacy(obs, recordings, per_recording_residual(cal.model, obs, recordings.size()), floor, opt);
-  out.noise_floor_j = std::sqrt(floor.variance_per_s * floor.window_s);
+  out.noise_floor_j = std::sqrt(floor.window_variance_j2());
   out.residual_to_noise_ratio = before.ratio, out.residual_to_noise_z = before.z, out.adequacy_scale_s = before.scale_s;
 
   Model m = cal.model;

@@ -45,6 +45,8 @@ Observations build_windows(const Vehicle& vehicle, const std::vector<Recording>&
                            const DiagnoseOptions& opt, std::vector<std::string>& notes);
 /// Windows of `window_s` over the same samples, measured energies only (the noise floor's short windows).
 Observations rewindow(const Observations& o, const std::vector<Recording>& recordings, double window_s);
+/// Median of the non-zero steps of a quantised signal (its quantum), 0 if it never changes.
+double quantum_of(const std::vector<double>& x);
 
 // ---- replay (replay.cpp) ---------------------------------------------------------------------------------------
 
@@ -364,16 +366,22 @@ namespace rollsim::diag {
 // ---- adequacy against the noise floor (adequacy.cpp) -----------------------------------------------------------
 
 struct NoiseFloor {
-  double variance_per_s = 0.0;  // of a window's noise energy [J^2], per second of window
+  double variance_per_s = 0.0;  // of a window's noise energy [J^2], per second of window (white)
+  /// Of each reading a window's energy is taken between [J^2]: a state of charge's quantum, (q C)^2 / 12. It does not
+  /// grow with a window's length (two readings bound any window), where white noise does.
+  double endpoint_variance_j2 = 0.0;
   int triples = 0;
   double window_s = 0.0;
+  /// A noise window's energy variance [J^2].
+  double window_variance_j2() const { return variance_per_s * window_s + 2.0 * endpoint_variance_j2; }
   /// Per window of the observations, per Monte Carlo draw: the energy the grade's errors from a recorded elevation's
   /// white noise add [J] (errors in the model's input, correlated over the filter's 300 m: no short window sees them).
   /// Empty without an elevation column.
   Eigen::MatrixXd grade_window_j;
 };
-/// From the calibrated residual of short windows (`short_obs`): the mean squared second difference over 6.
-NoiseFloor noise_floor(const Observations& short_obs, const Eigen::VectorXd& resid);
+/// From the calibrated residual of short windows (`short_obs`): the mean squared second difference over 6, less the
+/// part the readings' own errors (`endpoint_variance_j2` each) put in it (20 of them in a second difference).
+NoiseFloor noise_floor(const Observations& short_obs, const Eigen::VectorXd& resid, double endpoint_variance_j2 = 0.0);
 
 struct Adequacy {
   double ratio = 0.0, z = -1e300, scale_s = 0.0;  // at the scale of largest z

@@ -14,14 +14,6 @@ constexpr double kMinDiagnosedDistance_m = 100.0;
 // One whole percent of a small pack (the Twizy's 6.1 kWh: 61 Wh) lasts under a kilometre; 5 km is several.
 constexpr double kMinStuckSocDistance_m = 5000.0;
 
-// Median of the non-zero steps of a quantised signal (its quantum), 0 if it never changes.
-double quantum_of(const std::vector<double>& x) {
-  std::vector<double> steps;
-  for (std::size_t i = 1; i < x.size(); ++i)
-    if (x[i] != x[i - 1]) steps.push_back(std::abs(x[i] - x[i - 1]));
-  return steps.empty() ? 0.0 : median(std::move(steps));
-}
-
 // SOC: windows lengthened until the quantisation error (sd q / sqrt 6 of two quantised readings) is at most a
 // fixed fraction of the mean window energy.
 double soc_window_s(const std::vector<Recording>& recordings, const std::vector<std::vector<char>>& breaks, double capacity_j,
@@ -151,6 +143,14 @@ void check_informative(const Recording& r, const std::vector<double>& measured_w
 }
 
 }  // namespace
+
+// Median of the non-zero steps of a quantised signal (its quantum), 0 if it never changes.
+double quantum_of(const std::vector<double>& x) {
+  std::vector<double> steps;
+  for (std::size_t i = 1; i < x.size(); ++i)
+    if (x[i] != x[i - 1]) steps.push_back(std::abs(x[i] - x[i - 1]));
+  return steps.empty() ? 0.0 : median(std::move(steps));
+}
 
 std::vector<double> measured_power_w(const Vehicle& v, const Recording& r, ChannelKind& kind) {
   // As a SOC or a fuel channel against the wrong car: an EV's battery power against ice.yaml read +217 % and named
