@@ -254,10 +254,8 @@ NoiseFloor calibrated_noise_floor(const Observations& o, const std::vector<Recor
   const bool soc = o.channel == ChannelKind::soc;
   double endpoint_j2 = 0.0;
   if (soc) {
-    double q = 0.0;
-    for (const Recording& r : recs)
-      if (r.soc_fraction) q = std::max(q, quantum_of(*r.soc_fraction));
-    endpoint_j2 = q * o.soc_capacity_j * q * o.soc_capacity_j / 12.0;
+    const double q_j = soc_quantum(recs) * o.soc_capacity_j;
+    endpoint_j2 = q_j * q_j / 12.0;
   }
   const Observations shortw = rewindow(o, recs, soc ? o.window_s : std::min(std::max(opt.noise_window_s, 2.0 * dt), o.window_s));
   if (shortw.n() < 4) return {};

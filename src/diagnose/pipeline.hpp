@@ -45,8 +45,8 @@ Observations build_windows(const Vehicle& vehicle, const std::vector<Recording>&
                            const DiagnoseOptions& opt, std::vector<std::string>& notes);
 /// Windows of `window_s` over the same samples, measured energies only (the noise floor's short windows).
 Observations rewindow(const Observations& o, const std::vector<Recording>& recordings, double window_s);
-/// Median of the non-zero steps of a quantised signal (its quantum), 0 if it never changes.
-double quantum_of(const std::vector<double>& x);
+/// The coarsest state-of-charge quantum of the recordings (the median non-zero step of each), 0 without one.
+double soc_quantum(const std::vector<Recording>& recordings);
 
 // ---- replay (replay.cpp) ---------------------------------------------------------------------------------------
 

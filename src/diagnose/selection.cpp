@@ -1,5 +1,6 @@
 // Diagnosis stage 5: forward selection of catalogue effects by BIC and held-out fit, within their physical signs.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <tuple>
@@ -507,22 +508,28 @@ std::string calibration_alternative_text(const CalibrationQuantity& q, double ch
 // when only the prior tells them apart whatever the size.
 void add_calibration_alternatives(std::vector<Finding>& findings, const Model& m, const SelectionContext& sc) {
   const CalibrationPriors& p = sc.opt.priors;
-  for (const CalibrationQuantity q : {CalibrationQuantity{0, "channel_scale", p.scale_bound(sc.obs.channel)},
-                                      CalibrationQuantity{1, "rrc_level", 2.0 * p.rrc_level_sd},
-                                      CalibrationQuantity{2, "drag", 2.0 * p.drag_sd}}) {
-    Prior open = m.prior;
-    std::erase_if(open.boxes, [&](const Prior::Box& b) { return b.column == q.column; });
-    std::erase_if(open.rows, [&](const Prior::Row& r) { return r.column == q.column; });
-    for (std::size_t k = 0; k < findings.size(); ++k) {
-      Finding& f = findings[k];
-      const auto col = static_cast<Eigen::Index>(3 + k);
-      if (col >= m.x.cols()) continue;
+  const std::array<CalibrationQuantity, 3> quantities{CalibrationQuantity{0, "channel_scale", p.scale_bound(sc.obs.channel)},
+                                                      CalibrationQuantity{1, "rrc_level", 2.0 * p.rrc_level_sd},
+                                                      CalibrationQuantity{2, "drag", 2.0 * p.drag_sd}};
+  std::array<Prior, 3> open;  // the model's prior with each quantity's box and penalty taken off
+  for (std::size_t i = 0; i < quantities.size(); ++i) {
+    open[i] = m.prior;
+    const Eigen::Index column = quantities[i].column;
+    std::erase_if(open[i].boxes, [&](const Prior::Box& b) { return b.column == column; });
+    std::erase_if(open[i].rows, [&](const Prior::Row& r) { return r.column == column; });
+  }
+  for (std::size_t k = 0; k < findings.size(); ++k) {
+    Finding& f = findings[k];
+    const auto col = static_cast<Eigen::Index>(3 + k);
+    if (col >= m.x.cols()) continue;
+    Eigen::MatrixXd x(m.x.rows(), m.x.cols() - 1);  // the model without the finding
+    x << m.x.leftCols(col), m.x.rightCols(m.x.cols() - col - 1);
+    for (std::size_t i = 0; i < quantities.size(); ++i) {
+      const CalibrationQuantity& q = quantities[i];
       // A load draws standing, rolling resistance and drag do not: where standstills are logged they separate them
       // (the scorecard's 600 W compressor was otherwise confounded with an RRC level of +20-40 % in 4 of 10 seeds).
       if (q.column != 0 && sc.standing.available && (f.effect == "aux_load" || f.effect == "hvac_ambient")) continue;
-      Eigen::MatrixXd x(m.x.rows(), m.x.cols() - 1);
-      x << m.x.leftCols(col), m.x.rightCols(m.x.cols() - col - 1);
-      const Fit alt = least_squares(x, *m.y, open);
+      const Fit alt = least_squares(x, *m.y, open[i]);
       const double change = q.column == 0 ? alt.coef[0] - 1.0 : 0.1 * alt.coef[q.column] / alt.coef[0];
       if (std::abs(change) <= q.bound) continue;
       // How much better the finding's model is than the open quantity's, less its one amplitude.

@@ -14,16 +14,24 @@ constexpr double kMinDiagnosedDistance_m = 100.0;
 // One whole percent of a small pack (the Twizy's 6.1 kWh: 61 Wh) lasts under a kilometre; 5 km is several.
 constexpr double kMinStuckSocDistance_m = 5000.0;
 
+// Median of the non-zero steps of a quantised signal (its quantum), 0 if it never changes.
+double quantum_of(const std::vector<double>& x) {
+  std::vector<double> steps;
+  for (std::size_t i = 1; i < x.size(); ++i)
+    if (x[i] != x[i - 1]) steps.push_back(std::abs(x[i] - x[i - 1]));
+  return steps.empty() ? 0.0 : median(std::move(steps));
+}
+
 // SOC: windows lengthened until the quantisation error (sd q / sqrt 6 of two quantised readings) is at most a
 // fixed fraction of the mean window energy.
 double soc_window_s(const std::vector<Recording>& recordings, const std::vector<std::vector<char>>& breaks, double capacity_j,
                     double window_s, const DiagnoseOptions& opt, std::vector<std::string>& notes) {
   // The mean power over the recorded driving: a charge in a gap between trips, and the gap's hours, are not driving
   // (twenty trips two hours apart read 54 W where each trip draws 2706 W, and windows of 1670 s: session 23).
-  double q = 0.0, drop_j = 0.0, duration = 0.0;
+  const double q = soc_quantum(recordings);
+  double drop_j = 0.0, duration = 0.0;
   for (std::size_t ri = 0; ri < recordings.size(); ++ri) {
     const Recording& r = recordings[ri];
-    q = std::max(q, quantum_of(*r.soc_fraction));
     const auto& soc = *r.soc_fraction;
     for (std::size_t i = 1; i < r.time_s.size(); ++i) {
       if (breaks[ri][i]) continue;
@@ -144,13 +152,13 @@ void check_informative(const Recording& r, const std::vector<double>& measured_w
 
 }  // namespace
 
-// Median of the non-zero steps of a quantised signal (its quantum), 0 if it never changes.
-double quantum_of(const std::vector<double>& x) {
-  std::vector<double> steps;
-  for (std::size_t i = 1; i < x.size(); ++i)
-    if (x[i] != x[i - 1]) steps.push_back(std::abs(x[i] - x[i - 1]));
-  return steps.empty() ? 0.0 : median(std::move(steps));
+double soc_quantum(const std::vector<Recording>& recordings) {
+  double q = 0.0;
+  for (const Recording& r : recordings)
+    if (r.soc_fraction) q = std::max(q, quantum_of(*r.soc_fraction));
+  return q;
 }
+
 
 std::vector<double> measured_power_w(const Vehicle& v, const Recording& r, ChannelKind& kind) {
   // As a SOC or a fuel channel against the wrong car: an EV's battery power against ice.yaml read +217 % and named
